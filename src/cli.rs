@@ -1,0 +1,342 @@
+//! Command-line definitions (clap) and the glue from flags to the library.
+
+use anyhow::{Context, Result};
+use clap::{ArgGroup, Args, Parser, Subcommand, ValueEnum};
+use rubber_atlas::critical::CriticalSet;
+use rubber_atlas::error::AtlasError;
+use rubber_atlas::store::{write_table, Column};
+use rubber_atlas::trajectory::{integrate, Model, Start};
+use rubber_atlas::EllipsoidBody;
+use std::path::PathBuf;
+
+/// Atlases of the dynamics of a "rubber" ellipsoid of revolution rolling on a plane.
+#[derive(Debug, Parser)]
+#[command(name = "rubber-atlas", version, about, long_about = None)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// The critical set of one body (paper §4): diagram type, permanent rotations with their
+    /// stability, equilibria, cusp, ε_min.
+    Diagram(DiagramArgs),
+    /// θ, ψ, φ, centre of mass and contact point over time, from the reduced or the full model.
+    Trajectory(TrajectoryArgs),
+}
+
+/// α and β of the ellipsoid.
+#[derive(Debug, Args)]
+pub struct ShapeArgs {
+    /// α = a/b3: displacement of the centre of mass along the axis, 0 <= α < 1.
+    #[arg(long, allow_negative_numbers = true)]
+    pub alpha: f64,
+    /// β = b1/b3: < 1 prolate, > 1 oblate, 1 sphere.
+    #[arg(long, allow_negative_numbers = true)]
+    pub beta: f64,
+}
+
+#[derive(Debug, Args)]
+pub struct DiagramArgs {
+    #[command(flatten)]
+    pub shape: ShapeArgs,
+    /// ν = i3/i1 (does not change the critical set; recorded in the output).
+    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
+    pub nu: f64,
+    /// η = m b3²/i1 (does not change the critical set; recorded in the output).
+    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
+    pub eta: f64,
+    /// Print the critical set as one JSON object.
+    #[arg(long, conflicts_with = "out")]
+    pub json: bool,
+    /// Write the sampled curves to FILE (.csv, .h5 or .hdf5).
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// Samples of θ0 per half (θ0 < π/2, θ0 > π/2) of the fixed-point curves.
+    #[arg(long, default_value_t = 2000)]
+    pub samples: usize,
+    /// Truncate the sampled curves at this κ.
+    #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
+    pub kappa_max: f64,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ModelArg {
+    /// The reduced system `eqsys` with its quadratures.
+    Reduced,
+    /// The full redundant system `eqred` with the kinematics.
+    Full,
+}
+
+#[derive(Debug, Args)]
+#[command(group(ArgGroup::new("start").required(true).args(["energy", "theta0"])))]
+#[command(group(ArgGroup::new("length").required(true).args(["periods", "t_end"])))]
+pub struct TrajectoryArgs {
+    #[command(flatten)]
+    pub shape: ShapeArgs,
+    /// ν = i3/i1, 0 < ν <= 2.
+    #[arg(long, allow_negative_numbers = true)]
+    pub nu: f64,
+    /// η = m b3²/i1 > 0.
+    #[arg(long, allow_negative_numbers = true)]
+    pub eta: f64,
+    /// κ, the value of the integral F2 = J ω3.
+    #[arg(long, allow_negative_numbers = true)]
+    pub kappa: f64,
+    /// Energy ε: start at the lower turning point of component --component, θ̇ = 0.
+    #[arg(long, allow_negative_numbers = true)]
+    pub energy: Option<f64>,
+    /// Which component of the level set (κ, ε) to start on, counted from the smallest θ.
+    #[arg(long, default_value_t = 0, requires = "energy")]
+    pub component: usize,
+    /// Initial inclination θ(0).
+    #[arg(long, allow_negative_numbers = true)]
+    pub theta0: Option<f64>,
+    /// Initial θ̇(0) (with --theta0).
+    #[arg(long, default_value_t = 0.0, requires = "theta0", allow_negative_numbers = true)]
+    pub theta_dot0: f64,
+    /// Length in θ-periods of the starting component.
+    #[arg(long, allow_negative_numbers = true)]
+    pub periods: Option<f64>,
+    /// Length in time units √(b3/g).
+    #[arg(long, allow_negative_numbers = true)]
+    pub t_end: Option<f64>,
+    /// Number of output intervals (the file has SAMPLES + 1 rows).
+    #[arg(long, default_value_t = 2000)]
+    pub samples: usize,
+    /// Relative and absolute tolerance of the DOP853 integrator.
+    #[arg(long, default_value_t = 1e-12, allow_negative_numbers = true)]
+    pub tol: f64,
+    /// Which equations to integrate.
+    #[arg(long, value_enum, default_value_t = ModelArg::Reduced)]
+    pub model: ModelArg,
+    /// Output file: .csv, .h5 or .hdf5.
+    #[arg(long, value_name = "FILE")]
+    pub out: PathBuf,
+}
+
+/// Runs one parsed command line.
+pub fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Diagram(args) => diagram(args),
+        Command::Trajectory(args) => trajectory(args),
+    }
+}
+
+fn command_line() -> String {
+    std::env::args().collect::<Vec<_>>().join(" ")
+}
+
+fn positive_finite(name: &'static str, value: f64) -> Result<f64> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(AtlasError::InvalidParameter {
+            name,
+            value,
+            reason: "must be a finite number > 0",
+        }
+        .into())
+    }
+}
+
+fn diagram(args: DiagramArgs) -> Result<()> {
+    let body = EllipsoidBody::ellipsoid(args.shape.alpha, args.shape.beta, args.nu, args.eta)?;
+    let set = CriticalSet::of(&body, args.samples, args.kappa_max)?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&set)?);
+        return Ok(());
+    }
+    if let Some(out) = &args.out {
+        write_diagram(out, &set)?;
+        eprintln!(
+            "wrote {} points on {} branches to {}",
+            set.branches.iter().map(|b| b.points.len()).sum::<usize>(),
+            set.branches.len(),
+            out.display()
+        );
+    }
+    print_diagram(&set);
+    Ok(())
+}
+
+fn print_diagram(set: &CriticalSet) {
+    println!(
+        "ellipsoid alpha = {}, beta = {} (nu = {}, eta = {}): diagram type ({})",
+        set.alpha,
+        set.beta,
+        set.nu,
+        set.eta,
+        set.diagram_type.label()
+    );
+    println!("  eps_min (roll over the top at kappa = 0) = {:.12}", set.energy_min);
+    if let Some(t) = set.theta_star {
+        println!("  inclined equilibrium theta* = {t:.12}");
+    }
+    for e in &set.equilibria {
+        println!(
+            "  equilibrium {:<10} theta = {:.12}  eps = {:.12}  {}{}",
+            e.name,
+            e.theta,
+            e.energy,
+            if e.stable { "stable" } else { "unstable" },
+            if e.isolated { ", isolated" } else { "" }
+        );
+    }
+    if let Some(c) = &set.cusp {
+        println!(
+            "  cusp theta_c = {:.12}  kappa_c = {:.12}  eps_c = {:.12}",
+            c.theta, c.kappa, c.energy
+        );
+    }
+    if let Some(k) = set.kappa_c_equator {
+        println!("  equator sigma_pi2 stable for |kappa| > {k:.12}");
+    }
+    for b in &set.branches {
+        println!(
+            "  branch {:<10} {:<8} theta0 in [{:.6}, {:.6}]  kappa in [{:.6}, {:.6}]  eps in [{:.6}, {:.6}]",
+            b.name,
+            if b.stable { "stable" } else { "unstable" },
+            b.theta0_range[0],
+            b.theta0_range[1],
+            b.kappa_range[0],
+            b.kappa_range[1],
+            b.energy_range[0],
+            b.energy_range[1]
+        );
+    }
+}
+
+fn write_diagram(out: &std::path::Path, set: &CriticalSet) -> Result<()> {
+    let names = ["sigma_s0", "sigma_u", "sigma_spi", "sigma_pi2"];
+    let mut cols: [Vec<f64>; 8] = Default::default();
+    for (i, b) in set.branches.iter().enumerate() {
+        let code = names.iter().position(|n| *n == b.name).unwrap_or(0) as f64;
+        for p in &b.points {
+            for (col, v) in cols.iter_mut().zip([
+                i as f64,
+                code,
+                p.theta0,
+                p.kappa,
+                p.energy,
+                if p.stable { 1.0 } else { 0.0 },
+                p.rho_c,
+                p.rho_p,
+            ]) {
+                col.push(v);
+            }
+        }
+    }
+    let columns = [
+        Column { name: "segment", values: &cols[0], units: "1", long_name: "index of the run of one stability along a branch" },
+        Column { name: "branch", values: &cols[1], units: "1", long_name: "0 sigma_s0, 1 sigma_u, 2 sigma_spi, 3 sigma_pi2" },
+        Column { name: "theta0", values: &cols[2], units: "rad", long_name: "inclination of the permanent rotation" },
+        Column { name: "kappa", values: &cols[3], units: "sqrt(m g b3)", long_name: "integral F2 on the curve (kappa >= 0)" },
+        Column { name: "energy", values: &cols[4], units: "m g b3", long_name: "energy on the curve" },
+        Column { name: "stable", values: &cols[5], units: "1", long_name: "1 linearly stable (centre), 0 unstable" },
+        Column { name: "rho_c", values: &cols[6], units: "b3", long_name: "radius of the circle of the centre of mass" },
+        Column { name: "rho_p", values: &cols[7], units: "b3", long_name: "radius of the circle of the contact point" },
+    ];
+    let summary = serde_json::to_string(set)?;
+    write_table(
+        out,
+        &columns,
+        &[
+            ("program", format!("rubber-atlas {}", env!("CARGO_PKG_VERSION"))),
+            ("command_line", command_line()),
+            ("critical_set_json", summary),
+        ],
+    )
+    .with_context(|| format!("writing the diagram of alpha = {}, beta = {}", set.alpha, set.beta))?;
+    Ok(())
+}
+
+fn trajectory(args: TrajectoryArgs) -> Result<()> {
+    let body = EllipsoidBody::ellipsoid(args.shape.alpha, args.shape.beta, args.nu, args.eta)?;
+    if !args.kappa.is_finite() {
+        return Err(AtlasError::InvalidParameter { name: "kappa", value: args.kappa, reason: "must be a finite number" }.into());
+    }
+    let tol = args.tol;
+    if !(tol.is_finite() && tol > 0.0 && tol < 1.0) {
+        return Err(AtlasError::InvalidParameter { name: "tol", value: tol, reason: "must satisfy 0 < tol < 1" }.into());
+    }
+    if args.samples == 0 {
+        return Err(AtlasError::InvalidParameter { name: "samples", value: 0.0, reason: "must be >= 1" }.into());
+    }
+    let start = match (args.energy, args.theta0) {
+        (Some(e), None) => {
+            if !e.is_finite() {
+                return Err(AtlasError::InvalidParameter { name: "energy", value: e, reason: "must be a finite number" }.into());
+            }
+            Start::at_energy(&body, args.kappa, e, args.component)?
+        }
+        (None, Some(t)) => {
+            let valid = t.is_finite() && (args.kappa == 0.0 || (t > 0.0 && t < std::f64::consts::PI));
+            if !valid {
+                return Err(AtlasError::InvalidInitialAngle {
+                    theta0: t,
+                    reason: "must be finite, and 0 < theta0 < pi when kappa != 0",
+                }
+                .into());
+            }
+            if !args.theta_dot0.is_finite() {
+                return Err(AtlasError::InvalidParameter { name: "theta-dot0", value: args.theta_dot0, reason: "must be a finite number" }.into());
+            }
+            Start { kappa: args.kappa, theta0: t, theta_dot0: args.theta_dot0 }
+        }
+        _ => unreachable!("clap requires exactly one of --energy, --theta0"),
+    };
+    let t_end = match (args.periods, args.t_end) {
+        (Some(k), None) => positive_finite("periods", k)? * start.period(&body, 1e-13)?,
+        (None, Some(t)) => positive_finite("t-end", t)?,
+        _ => unreachable!("clap requires exactly one of --periods, --t-end"),
+    };
+    let model = match args.model {
+        ModelArg::Reduced => Model::Reduced,
+        ModelArg::Full => Model::Full,
+    };
+    let traj = integrate(&body, &start, model, t_end, args.samples, tol)?;
+    let units = ["sqrt(b3/g)", "rad", "rad/sqrt(b3/g)", "rad", "rad", "b3", "b3", "b3", "b3", "b3"];
+    let long = [
+        "time",
+        "inclination of the symmetry axis to the vertical",
+        "rate of inclination",
+        "proper rotation angle",
+        "precession angle (azimuth of the axis)",
+        "x of the centre of mass",
+        "y of the centre of mass",
+        "height of the centre of mass",
+        "x of the contact point",
+        "y of the contact point",
+    ];
+    let columns: Vec<Column> = traj
+        .columns()
+        .into_iter()
+        .zip(units.iter().zip(long.iter()))
+        .map(|((name, values), (u, l))| Column { name, values, units: u, long_name: l })
+        .collect();
+    let attrs = [
+        ("program", format!("rubber-atlas {}", env!("CARGO_PKG_VERSION"))),
+        ("command_line", command_line()),
+        ("model", format!("{:?}", model).to_lowercase()),
+        ("alpha", args.shape.alpha.to_string()),
+        ("beta", args.shape.beta.to_string()),
+        ("nu", args.nu.to_string()),
+        ("eta", args.eta.to_string()),
+        ("kappa", start.kappa.to_string()),
+        ("energy", start.energy(&body).to_string()),
+        ("theta0", start.theta0.to_string()),
+        ("theta_dot0", start.theta_dot0.to_string()),
+        ("tolerance", tol.to_string()),
+    ];
+    write_table(&args.out, &columns, &attrs)?;
+    eprintln!(
+        "wrote {} samples over t in [0, {}] ({} model) to {}",
+        traj.t.len(),
+        t_end,
+        format!("{:?}", model).to_lowercase(),
+        args.out.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,415 @@
+//! The critical set of the integral map for the ellipsoid (paper §4, SPEC §1.5): the diagram
+//! type on the (α, β²) plane, the branches of permanent rotations σ_s0, σ_u, σ_sπ (`s1`) and,
+//! for α = 0, the equator σ_π/2 (`s2`), the equilibria σ0, σπ (`s0`) and θ* (`thz`), the cusp
+//! of type (c), and ε_min, the energy needed to roll over the top at κ = 0.
+//!
+//! Several of the paper's printed formulas carry misprints; the corrected forms used here are
+//! those of SPEC §1.5, and the tests check each against a direct numerical search.
+
+use crate::body::{EllipsoidBody, Shape};
+use crate::error::{AtlasError, Result};
+use crate::reduced::ReducedSystem;
+use crate::torus::bisect;
+use serde::Serialize;
+use std::f64::consts::{FRAC_PI_2, PI};
+
+/// The five types of bifurcation diagram of paper Fig. `ab` (SPEC §1.5), plus the degenerate
+/// and boundary cases.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DiagramType {
+    /// β² < 1 − α (α > 0).
+    A,
+    /// 1 − α < β² < 1 + α (α > 0).
+    B,
+    /// β² > 1 + α (α > 0): the fixed-point curve has a cusp.
+    C,
+    /// α = 0, β < 1.
+    D,
+    /// α = 0, β > 1.
+    E,
+    /// α = 0, β = 1: a homogeneous ball, U ≡ 1, every attitude an equilibrium.
+    Sphere,
+    /// β² = 1 − α exactly.
+    BoundaryAB,
+    /// β² = 1 + α exactly.
+    BoundaryBC,
+}
+
+impl DiagramType {
+    /// The type of an ellipsoid with α ≥ 0.
+    pub fn of(alpha: f64, beta: f64) -> Self {
+        let b2 = beta * beta;
+        if alpha == 0.0 {
+            return if beta < 1.0 {
+                Self::D
+            } else if beta > 1.0 {
+                Self::E
+            } else {
+                Self::Sphere
+            };
+        }
+        if b2 < 1.0 - alpha {
+            Self::A
+        } else if b2 == 1.0 - alpha {
+            Self::BoundaryAB
+        } else if b2 < 1.0 + alpha {
+            Self::B
+        } else if b2 == 1.0 + alpha {
+            Self::BoundaryBC
+        } else {
+            Self::C
+        }
+    }
+
+    /// The paper's letter or a word for the degenerate cases.
+    pub fn label(&self) -> &'static str {
+        match self {
+            Self::A => "a",
+            Self::B => "b",
+            Self::C => "c",
+            Self::D => "d",
+            Self::E => "e",
+            Self::Sphere => "sphere",
+            Self::BoundaryAB => "a|b",
+            Self::BoundaryBC => "b|c",
+        }
+    }
+}
+
+/// A permanent rotation: a fixed point θ = θ0, p = 0 of `eqsys`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct FixedPoint {
+    /// θ0, the constant inclination of the axis.
+    pub theta0: f64,
+    /// κ ≥ 0 on the curve (the mirror branch −κ has the same ε and stability).
+    pub kappa: f64,
+    /// ε on the curve.
+    pub energy: f64,
+    /// Linear stability: V″(θ0) > 0 (G0′ < 0, a centre).
+    pub stable: bool,
+    /// Radius of the circle of the centre of mass, ρ_c = Z tanθ0 + α sinθ0 (∞ on σ_π/2).
+    pub rho_c: f64,
+    /// Radius of the circle of the contact point, ρ_p = β² tanθ0 / Z.
+    pub rho_p: f64,
+}
+
+/// A run of fixed points with one stability along one branch.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Branch {
+    /// `sigma_s0` (stable, θ0 < π/2), `sigma_spi` (stable, θ0 > π/2), `sigma_u` (unstable),
+    /// `sigma_pi2` (α = 0: the equator θ0 = π/2, any κ).
+    pub name: &'static str,
+    /// Stability of every point of the run.
+    pub stable: bool,
+    /// [min, max] of θ0 over the run.
+    pub theta0_range: [f64; 2],
+    /// [min, max] of κ over the run.
+    pub kappa_range: [f64; 2],
+    /// [min, max] of ε over the run.
+    pub energy_range: [f64; 2],
+    /// Points ordered by θ0 (by κ on σ_π/2); written by `--out`, not in the JSON summary.
+    #[serde(skip)]
+    pub points: Vec<FixedPoint>,
+}
+
+/// An equilibrium κ = 0.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Equilibrium {
+    /// `sigma_0` (resting on the vertex θ = 0), `sigma_pi` (θ = π), `theta_star` (inclined).
+    pub name: &'static str,
+    /// Inclination θ of the axis.
+    pub theta: f64,
+    /// ε = U(θ).
+    pub energy: f64,
+    /// Linear stability, U″(θ) > 0.
+    pub stable: bool,
+    /// No branch of permanent rotations ends at this point of the (κ, ε) plane.
+    pub isolated: bool,
+}
+
+/// The cusp of type (c): the saddle-node where σ_s0 and σ_u meet (V′ = V″ = 0, `eq2`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Cusp {
+    pub theta: f64,
+    pub kappa: f64,
+    pub energy: f64,
+}
+
+/// The critical set of one body.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CriticalSet {
+    pub alpha: f64,
+    pub beta: f64,
+    pub nu: f64,
+    pub eta: f64,
+    pub diagram_type: DiagramType,
+    /// Inclination of the inclined equilibrium θ*, where it exists (α ≠ 0).
+    pub theta_star: Option<f64>,
+    /// ε_min: the top of U on the circle; at κ = 0 a body with ε > ε_min rolls over the top.
+    pub energy_min: f64,
+    /// κ_c = √((β² − 1)/β) for α = 0, β > 1: σ_π/2 is stable for |κ| > κ_c.
+    pub kappa_c_equator: Option<f64>,
+    pub equilibria: Vec<Equilibrium>,
+    pub cusp: Option<Cusp>,
+    /// The sampled fixed-point curves, κ ≥ 0, truncated at `kappa_max`.
+    pub branches: Vec<Branch>,
+    /// The truncation of the sampled curves.
+    pub kappa_max: f64,
+}
+
+/// κ² on the fixed-point curve (`s1`): κ² = sin⁴θ0 ((β² − 1)/Z − α / cosθ0).
+pub fn fixed_point_kappa_sq(body: &EllipsoidBody, theta0: f64) -> f64 {
+    let (a, b) = (body.shape.alpha, body.shape.beta);
+    let s2 = theta0.sin().powi(2);
+    s2 * s2 * ((b * b - 1.0) / body.shape.centre_height(theta0) - a / theta0.cos())
+}
+
+/// ε on the fixed-point curve (`s1`):
+/// ε = (3Z² − 1)/(2Z) + α (3cos²θ0 − 1)/(2cosθ0).
+pub fn fixed_point_energy(body: &EllipsoidBody, theta0: f64) -> f64 {
+    let z = body.shape.centre_height(theta0);
+    let c = theta0.cos();
+    (3.0 * z * z - 1.0) / (2.0 * z) + body.shape.alpha * (3.0 * c * c - 1.0) / (2.0 * c)
+}
+
+/// The permanent rotation at θ0 (θ0 ≠ π/2, κ² ≥ 0 there).
+pub fn fixed_point(body: &EllipsoidBody, theta0: f64) -> FixedPoint {
+    let kappa = fixed_point_kappa_sq(body, theta0).max(0.0).sqrt();
+    let sys = ReducedSystem::new(body, kappa);
+    let z = body.shape.centre_height(theta0);
+    let (s, c) = theta0.sin_cos();
+    let b2 = body.shape.beta * body.shape.beta;
+    FixedPoint {
+        theta0,
+        kappa,
+        energy: fixed_point_energy(body, theta0),
+        stable: sys.effective_potential_second(theta0) > 0.0,
+        rho_c: z * s / c + body.shape.alpha * s,
+        rho_p: b2 * s / (c * z),
+    }
+}
+
+/// θ* of the inclined equilibrium (corrected `thz`): cos²θ* = α²β² / ((β² − 1)(β² − 1 + α²))
+/// with the sign of cosθ* that of β² − 1, where that is ≤ 1 (types (a) and (c)).
+pub fn inclined_equilibrium(alpha: f64, beta: f64) -> Option<f64> {
+    let b2m1 = beta * beta - 1.0;
+    let den = b2m1 * (b2m1 + alpha * alpha);
+    if alpha == 0.0 || den <= 0.0 {
+        return None;
+    }
+    let cos2 = alpha * alpha * beta * beta / den;
+    if cos2 > 1.0 {
+        return None;
+    }
+    Some(cos2.sqrt().copysign(b2m1).acos())
+}
+
+/// ε_min = max of U on the circle: 1 + α if β² < 1 + α, else U(θ*) = β √((β² − 1 + α²)/(β² − 1))
+/// (SPEC §1.5; the paper prints (1 + α² − β²)/(1 − β²) under the root).
+pub fn energy_min(alpha: f64, beta: f64) -> f64 {
+    let b2 = beta * beta;
+    if b2 <= 1.0 + alpha.abs() {
+        1.0 + alpha.abs()
+    } else {
+        beta * ((b2 - 1.0 + alpha * alpha) / (b2 - 1.0)).sqrt()
+    }
+}
+
+impl CriticalSet {
+    /// The critical set of an ellipsoid body with α ≥ 0, its curves sampled with `samples`
+    /// points per half (θ0 < π/2, θ0 > π/2) and truncated at κ ≤ `kappa_max`.
+    pub fn of(body: &EllipsoidBody, samples: usize, kappa_max: f64) -> Result<Self> {
+        let (alpha, beta) = (body.shape.alpha, body.shape.beta);
+        if alpha < 0.0 {
+            return Err(AtlasError::InvalidParameter {
+                name: "alpha",
+                value: alpha,
+                reason: "the diagram is tabulated for alpha >= 0; alpha < 0 is its mirror image theta -> pi - theta",
+            });
+        }
+        if !(kappa_max.is_finite() && kappa_max > 0.0) {
+            return Err(AtlasError::InvalidParameter {
+                name: "kappa-max",
+                value: kappa_max,
+                reason: "must be a finite number > 0",
+            });
+        }
+        let samples = samples.max(16);
+        let diagram_type = DiagramType::of(alpha, beta);
+        let theta_star = inclined_equilibrium(alpha, beta);
+        let u = |t: f64| body.shape.potential(t);
+        let upp = |t: f64| body.shape.potential_second(t);
+
+        let mut equilibria = vec![
+            Equilibrium {
+                name: "sigma_0",
+                theta: 0.0,
+                energy: u(0.0),
+                stable: upp(0.0) > 0.0,
+                isolated: upp(0.0) < 0.0,
+            },
+            Equilibrium {
+                name: "sigma_pi",
+                theta: PI,
+                energy: u(PI),
+                stable: upp(PI) > 0.0,
+                isolated: upp(PI) < 0.0,
+            },
+        ];
+        if let Some(ts) = theta_star {
+            equilibria.push(Equilibrium {
+                name: "theta_star",
+                theta: ts,
+                energy: u(ts),
+                stable: upp(ts) > 0.0,
+                // The branch σ_u (type c) or σ_sπ (type a) ends at κ = 0 on θ*.
+                isolated: false,
+            });
+        }
+
+        let mut branches = Vec::new();
+        let mut cusp = None;
+        // The two halves of the θ0-range, each sampled and cut into runs of one stability.
+        let halves = [(0.0, FRAC_PI_2, "sigma_s0"), (FRAC_PI_2, PI, "sigma_spi")];
+        for (lo, hi, stable_name) in halves {
+            let mut pts: Vec<FixedPoint> = Vec::with_capacity(samples + 1);
+            // Interior samples; a pole is added only where a branch ends at it (U″ > 0 there,
+            // i.e. κ² ≥ 0 on its neighbourhood), never as a lone point.
+            for i in 1..samples {
+                let t = lo + (hi - lo) * i as f64 / samples as f64;
+                if fixed_point_kappa_sq(body, t) < 0.0 {
+                    continue;
+                }
+                let p = fixed_point(body, t);
+                if p.kappa <= kappa_max {
+                    pts.push(p);
+                }
+            }
+            let pole = if lo == 0.0 { 0.0 } else { PI };
+            if body.shape.potential_second(pole) > 0.0 && !pts.is_empty() {
+                pts.push(fixed_point(body, pole));
+            }
+            if let Some(ts) = theta_star {
+                if ts > lo && ts < hi {
+                    pts.push(fixed_point(body, ts));
+                }
+            }
+            pts.sort_by(|a, b| a.theta0.total_cmp(&b.theta0));
+            pts.dedup_by(|a, b| a.theta0 == b.theta0);
+            // Runs of equal stability; a flip inside a half is the cusp (V″ = 0 on the curve).
+            let mut run: Vec<FixedPoint> = Vec::new();
+            for p in pts {
+                if let Some(last) = run.last() {
+                    let contiguous = (p.theta0 - last.theta0) <= 1.5 * (hi - lo) / samples as f64;
+                    if last.stable != p.stable || !contiguous {
+                        if last.stable != p.stable && contiguous {
+                            let c = locate_cusp(body, last.theta0, p.theta0, last.stable);
+                            cusp = Some(c);
+                            let at = fixed_point(body, c.theta);
+                            let mut at_end = at;
+                            at_end.stable = last.stable;
+                            run.push(at_end);
+                            branches.push(make_branch(std::mem::take(&mut run), stable_name));
+                            let mut at_start = at;
+                            at_start.stable = p.stable;
+                            run.push(at_start);
+                        } else {
+                            branches.push(make_branch(std::mem::take(&mut run), stable_name));
+                        }
+                    }
+                }
+                run.push(p);
+            }
+            if !run.is_empty() {
+                branches.push(make_branch(run, stable_name));
+            }
+        }
+
+        let kappa_c_equator = (alpha == 0.0 && beta > 1.0).then(|| ((beta * beta - 1.0) / beta).sqrt());
+        if alpha == 0.0 {
+            // σ_π/2: ε = κ²/2 + β (`s2`), stable where V″(π/2) = κ² − (β² − 1)/β > 0.
+            let mut run: Vec<FixedPoint> = Vec::new();
+            let push_point = |kappa: f64, run: &mut Vec<FixedPoint>, force: Option<bool>| {
+                let v2 = kappa * kappa - (beta * beta - 1.0) / beta;
+                run.push(FixedPoint {
+                    theta0: FRAC_PI_2,
+                    kappa,
+                    energy: 0.5 * kappa * kappa + beta,
+                    stable: force.unwrap_or(v2 > 0.0),
+                    rho_c: f64::INFINITY,
+                    rho_p: f64::INFINITY,
+                });
+            };
+            for i in 0..=samples {
+                let kappa = kappa_max * i as f64 / samples as f64;
+                let stable = kappa * kappa - (beta * beta - 1.0) / beta > 0.0;
+                let last_stable = run.last().map(|p| p.stable);
+                if let (Some(kc), Some(last_stable)) = (kappa_c_equator, last_stable) {
+                    if last_stable != stable {
+                        push_point(kc, &mut run, Some(last_stable));
+                        branches.push(make_branch(std::mem::take(&mut run), "sigma_pi2"));
+                        push_point(kc, &mut run, Some(stable));
+                    }
+                }
+                push_point(kappa, &mut run, None);
+            }
+            branches.push(make_branch(run, "sigma_pi2"));
+        }
+
+        Ok(Self {
+            alpha,
+            beta,
+            nu: body.nu,
+            eta: body.eta,
+            diagram_type,
+            theta_star,
+            energy_min: energy_min(alpha, beta),
+            kappa_c_equator,
+            equilibria,
+            cusp,
+            branches,
+            kappa_max,
+        })
+    }
+}
+
+fn make_branch(points: Vec<FixedPoint>, stable_name: &'static str) -> Branch {
+    let stable = points.first().is_some_and(|p| p.stable);
+    let name = if stable_name == "sigma_pi2" {
+        "sigma_pi2"
+    } else if stable {
+        stable_name
+    } else {
+        "sigma_u"
+    };
+    let range = |f: fn(&FixedPoint) -> f64| {
+        points.iter().map(f).fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], x| {
+            [lo.min(x), hi.max(x)]
+        })
+    };
+    Branch {
+        name,
+        stable,
+        theta0_range: range(|p| p.theta0),
+        kappa_range: range(|p| p.kappa),
+        energy_range: range(|p| p.energy),
+        points,
+    }
+}
+
+/// The zero of V″(θ0) along the fixed-point curve between two samples of opposite stability.
+fn locate_cusp(body: &EllipsoidBody, lo: f64, hi: f64, lo_stable: bool) -> Cusp {
+    let f = |t: f64| {
+        let k2 = fixed_point_kappa_sq(body, t).max(0.0);
+        ReducedSystem::new(body, k2.sqrt()).effective_potential_second(t)
+    };
+    // V″ > 0 on the stable side.
+    let theta = bisect(&f, lo, hi, !lo_stable);
+    let p = fixed_point(body, theta);
+    Cusp {
+        theta,
+        kappa: p.kappa,
+        energy: p.energy,
+    }
+}

@@ -1,0 +1,70 @@
+//! The library's typed errors: every way an input or a computation can be refused, with the
+//! offending value named so that the command line can print one clear line.
+
+use thiserror::Error;
+
+/// Everything the library can refuse or fail at.
+#[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum AtlasError {
+    /// A parameter outside its allowed range, or not a finite number.
+    #[error("invalid {name} = {value}: {reason}")]
+    InvalidParameter {
+        name: &'static str,
+        value: f64,
+        reason: &'static str,
+    },
+    /// The energy is below every value of the effective potential: no motion at all.
+    #[error("no motion: energy {energy} is below the minimum {minimum} of the effective potential")]
+    NoMotion { energy: f64, minimum: f64 },
+    /// An initial angle outside the allowed set (κ ≠ 0 needs 0 < θ < π).
+    #[error("invalid theta0 = {theta0}: {reason}")]
+    InvalidInitialAngle { theta0: f64, reason: &'static str },
+    /// The ODE integrator gave up.
+    #[error("integration failed at t = {time}: {reason}")]
+    Integration { time: f64, reason: String },
+    /// A quantity that needs an oscillating component (a period) was asked of a fixed point
+    /// or of motion that is not periodic in θ.
+    #[error("no θ-period: {reason}")]
+    NotPeriodic { reason: &'static str },
+    /// Writing an output file failed.
+    #[error("cannot write {path}: {reason}")]
+    Output { path: String, reason: String },
+}
+
+/// Shorthand for results of this crate.
+pub type Result<T> = std::result::Result<T, AtlasError>;
+
+/// Checks that `value` is finite and lies in the interval described by `lower`/`upper`
+/// (each bound `Some((bound, inclusive))` or `None`), naming the parameter in the error.
+pub(crate) fn check_range(
+    name: &'static str,
+    value: f64,
+    lower: Option<(f64, bool)>,
+    upper: Option<(f64, bool)>,
+    reason: &'static str,
+) -> Result<f64> {
+    let fail = || AtlasError::InvalidParameter {
+        name,
+        value,
+        reason,
+    };
+    if !value.is_finite() {
+        return Err(AtlasError::InvalidParameter {
+            name,
+            value,
+            reason: "must be a finite number",
+        });
+    }
+    if let Some((lo, inclusive)) = lower {
+        if value < lo || (!inclusive && value == lo) {
+            return Err(fail());
+        }
+    }
+    if let Some((hi, inclusive)) = upper {
+        if value > hi || (!inclusive && value == hi) {
+            return Err(fail());
+        }
+    }
+    Ok(value)
+}

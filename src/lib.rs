@@ -1,0 +1,37 @@
+//! # rubber-atlas
+//!
+//! Dense atlases of the dynamics of a "rubber" body of revolution (no slipping, no spinning
+//! about the vertical) rolling on a plane, after Kilin & Pivovarova, *Bifurcation analysis of
+//! the problem of a "rubber" ellipsoid of revolution rolling on a plane* (`shared/paper.tex`).
+//!
+//! The crate follows the pipeline of the computation:
+//!
+//! - [`body`]: the shape behind the [`body::Shape`] trait (the ellipsoid first) and the mass
+//!   distribution; U(θ), B(θ), J(θ) of the reduction.
+//! - [`reduced`]: the one-degree-of-freedom system `eqsys` at fixed κ, its energy, and the
+//!   quadratures for φ, ψ, ω and the paths on the plane.
+//! - [`full`]: the full redundant system `eqred` with the kinematics `kin` — the independent
+//!   reference for everything reduced.
+//! - [`critical`]: the critical set of paper §4 — diagram types, permanent rotations, the cusp,
+//!   equilibria, ε_min.
+//! - [`torus`]: one level set (κ, ε): its components, turning points, period and precession.
+//! - [`trajectory`]: time histories from either model; [`ode`] wraps the DOP853 integrator.
+//! - [`store`]: CSV and HDF5 output.
+//!
+//! Units are the paper's: length b3, mass m, time √(b3/g). The paper's misprints (in B(θ), the
+//! velocity of the centre of mass, θ*, ε_min, the stability of the equator, the type (c)
+//! boundary) are corrected as in SPEC §1; each correction is pinned by a test against the full
+//! equations or a direct numerical search.
+
+pub mod body;
+pub mod critical;
+pub mod error;
+pub mod full;
+pub mod ode;
+pub mod reduced;
+pub mod store;
+pub mod torus;
+pub mod trajectory;
+
+pub use body::{Body, Ellipsoid, EllipsoidBody, Shape};
+pub use error::{AtlasError, Result};

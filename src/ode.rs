@@ -1,0 +1,96 @@
+//! A thin wrapper around the DOP853 integrator of the `ode_solvers` crate: dense output on a
+//! uniform time grid, tolerances as one knob, failures as typed errors.
+
+use crate::error::{AtlasError, Result};
+use nalgebra::SVector;
+use ode_solvers::{Dop853, OutputType, System};
+
+/// A right-hand side ẏ = f(y) of an autonomous system of N equations.
+pub trait Rate<const N: usize> {
+    /// f(y).
+    fn rate(&self, y: &SVector<f64, N>) -> SVector<f64, N>;
+}
+
+struct Adapter<'a, R>(&'a R);
+
+impl<const N: usize, R: Rate<N>> System<f64, SVector<f64, N>> for Adapter<'_, R> {
+    fn system(&self, _t: f64, y: &SVector<f64, N>, dy: &mut SVector<f64, N>) {
+        *dy = self.0.rate(y);
+    }
+}
+
+/// Samples of a solution on the grid t = 0, dt, 2 dt, …, t_end.
+#[derive(Debug, Clone)]
+pub struct DenseSolution<const N: usize> {
+    pub times: Vec<f64>,
+    pub states: Vec<SVector<f64, N>>,
+}
+
+/// Integrates ẏ = f(y) from y(0) = `y0` to `t_end` with DOP853 at relative and absolute
+/// tolerance `tol`, returning the solution at `samples + 1` equally spaced times.
+///
+/// Each output interval is integrated on its own, ending exactly at its sample time, rather
+/// than read from the method's dense output: the interpolant of `ode_solvers` 0.6 was measured
+/// off by 6e-7 at the end of a long step (tol 1e-13), far above the step error.
+pub fn integrate_dense<const N: usize, R: Rate<N>>(
+    rate: &R,
+    y0: SVector<f64, N>,
+    t_end: f64,
+    samples: usize,
+    tol: f64,
+) -> Result<DenseSolution<N>> {
+    let samples = samples.max(1);
+    let mut times = Vec::with_capacity(samples + 1);
+    let mut states = Vec::with_capacity(samples + 1);
+    times.push(0.0);
+    states.push(y0);
+    let mut y = y0;
+    let mut h_last = 0.0;
+    for i in 1..=samples {
+        let (t0, t1) = (
+            t_end * (i - 1) as f64 / samples as f64,
+            t_end * i as f64 / samples as f64,
+        );
+        let mut solver = Dop853::from_param(
+            Adapter(rate),
+            t0,
+            t1,
+            t1 - t0,
+            y,
+            tol,
+            tol,
+            0.9,
+            0.0,
+            0.333,
+            6.0,
+            t1 - t0,
+            // The previous interval's typical step seeds this one (0 = automatic choice).
+            h_last,
+            u32::MAX,
+            1000,
+            OutputType::Sparse,
+        );
+        let stats = solver.integrate().map_err(|e| AtlasError::Integration {
+            time: t0,
+            reason: e.to_string(),
+        })?;
+        let (ts, ys) = (solver.x_out(), solver.y_out());
+        let (Some(&t_last), Some(y_last)) = (ts.last(), ys.last()) else {
+            return Err(AtlasError::Integration {
+                time: t0,
+                reason: "the integrator returned no step".into(),
+            });
+        };
+        if (t_last - t1).abs() > 1e-12 * t1.abs().max(1.0) {
+            return Err(AtlasError::Integration {
+                time: t_last,
+                reason: format!("stopped before t = {t1}"),
+            });
+        }
+        h_last = (t1 - t0) / f64::from(stats.accepted_steps.max(1));
+        y = *y_last;
+        times.push(t1);
+        states.push(y);
+    }
+    Ok(DenseSolution { times, states })
+}

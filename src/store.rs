@@ -1,0 +1,120 @@
+//! Writing tables of columns (trajectories, sampled bifurcation curves) as CSV or HDF5, chosen
+//! by the file's extension. Files are written to a temporary name and renamed into place, so
+//! a failed write never leaves a partial output behind.
+
+use crate::error::{AtlasError, Result};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// A file format for a table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TableFormat {
+    Csv,
+    Hdf5,
+}
+
+impl TableFormat {
+    /// The format named by a path's extension: `.csv`, or `.h5` / `.hdf5` / `.nc`.
+    pub fn from_path(path: &Path) -> Result<Self> {
+        match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+            Some("csv") => Ok(Self::Csv),
+            Some("h5") | Some("hdf5") | Some("nc") => Ok(Self::Hdf5),
+            _ => Err(AtlasError::Output {
+                path: path.display().to_string(),
+                reason: "unknown extension: use .csv, .h5 or .hdf5".into(),
+            }),
+        }
+    }
+}
+
+/// A named numeric column with its unit and description.
+#[derive(Debug, Clone)]
+pub struct Column<'a> {
+    pub name: &'a str,
+    pub values: &'a [f64],
+    pub units: &'a str,
+    pub long_name: &'a str,
+}
+
+fn output_error(path: &Path, e: impl std::fmt::Display) -> AtlasError {
+    AtlasError::Output {
+        path: path.display().to_string(),
+        reason: e.to_string(),
+    }
+}
+
+fn temp_path(path: &Path) -> PathBuf {
+    let mut name = path.file_name().map(|n| n.to_os_string()).unwrap_or_default();
+    name.push(format!(".partial-{}", std::process::id()));
+    path.with_file_name(name)
+}
+
+/// Writes equal-length columns to `path` (CSV: a header line, then rows with shortest
+/// round-trip decimals; HDF5: one 1-D dataset per column with `units` and `long_name`, plus the
+/// string attributes `attributes` on the root).
+pub fn write_table(path: &Path, columns: &[Column<'_>], attributes: &[(&str, String)]) -> Result<()> {
+    let format = TableFormat::from_path(path)?;
+    let tmp = temp_path(path);
+    let written = match format {
+        TableFormat::Csv => write_csv(&tmp, columns, attributes),
+        TableFormat::Hdf5 => write_hdf5(&tmp, columns, attributes),
+    };
+    if let Err(e) = written {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(output_error(path, e));
+    }
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        output_error(path, e)
+    })
+}
+
+fn write_csv(path: &Path, columns: &[Column<'_>], attributes: &[(&str, String)]) -> std::result::Result<(), String> {
+    let file = std::fs::File::create(path).map_err(|e| e.to_string())?;
+    let mut w = std::io::BufWriter::new(file);
+    let io = |e: std::io::Error| e.to_string();
+    for (k, v) in attributes {
+        writeln!(w, "# {k}: {}", v.replace('\n', " ")).map_err(io)?;
+    }
+    let header: Vec<&str> = columns.iter().map(|c| c.name).collect();
+    writeln!(w, "{}", header.join(",")).map_err(io)?;
+    let rows = columns.first().map_or(0, |c| c.values.len());
+    let mut line = String::new();
+    for i in 0..rows {
+        line.clear();
+        for (j, c) in columns.iter().enumerate() {
+            if j > 0 {
+                line.push(',');
+            }
+            line.push_str(&format!("{:e}", c.values[i]));
+        }
+        writeln!(w, "{line}").map_err(io)?;
+    }
+    w.flush().map_err(io)
+}
+
+fn write_hdf5(path: &Path, columns: &[Column<'_>], attributes: &[(&str, String)]) -> std::result::Result<(), String> {
+    use hdf5::types::VarLenUnicode;
+    let err = |e: hdf5::Error| e.to_string();
+    let file = hdf5::File::create(path).map_err(err)?;
+    let string_attr = |loc: &hdf5::Location, name: &str, value: &str| -> std::result::Result<(), String> {
+        let v: VarLenUnicode = value.parse().map_err(|e: hdf5::types::StringError| e.to_string())?;
+        loc.new_attr::<VarLenUnicode>()
+            .create(name)
+            .and_then(|a| a.write_scalar(&v))
+            .map_err(err)
+    };
+    for (k, v) in attributes {
+        string_attr(&file, k, v)?;
+    }
+    for c in columns {
+        let ds = file
+            .new_dataset_builder()
+            .with_data(c.values)
+            .create(c.name)
+            .map_err(err)?;
+        string_attr(&ds, "units", c.units)?;
+        string_attr(&ds, "long_name", c.long_name)?;
+    }
+    file.close().map_err(err)
+}

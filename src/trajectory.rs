@@ -1,0 +1,208 @@
+//! Trajectories over time (paper Figs. `res`, `xy`): θ, p, φ, ψ, the centre of mass and the
+//! contact point, from the reduced system (`eqsys` with the quadratures `dfi`, `dpsi` and the
+//! velocity of the centre of mass) or from the full system (`eqred`, `kin`).
+
+use crate::body::{Body, Shape};
+use crate::error::{AtlasError, Result};
+use crate::full::{FullState, FullSystem, FULL_STATE_LEN};
+use crate::ode::{integrate_dense, Rate};
+use crate::reduced::ReducedSystem;
+use crate::torus::{components, period_integrals, Component, MotionKind};
+use nalgebra::SVector;
+
+/// Which equations are integrated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Model {
+    /// The reduced system with its quadratures (6 equations).
+    Reduced,
+    /// The full redundant system of paper `eqred` with the kinematics (14 equations).
+    Full,
+}
+
+/// Where a trajectory starts: θ(0), θ̇(0), at φ = ψ = 0 and the centre of mass at the origin.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Start {
+    pub kappa: f64,
+    pub theta0: f64,
+    pub theta_dot0: f64,
+}
+
+impl Start {
+    /// The start at the lower turning point θ_min of component `index` of the level set
+    /// (κ, ε), with θ̇ = 0 (the start of SPEC §2's drift).
+    pub fn at_energy<S: Shape>(body: &Body<S>, kappa: f64, energy: f64, index: usize) -> Result<Self> {
+        let comps = components(body, kappa, energy)?;
+        let count = comps.len();
+        let c = comps.get(index).ok_or(AtlasError::InvalidParameter {
+            name: "component",
+            value: index as f64,
+            reason: if count == 1 {
+                "this level set has only component 0"
+            } else {
+                "this level set has fewer components"
+            },
+        })?;
+        Ok(Self {
+            kappa,
+            theta0: c.theta_min,
+            theta_dot0: 0.0,
+        })
+    }
+
+    /// The energy of this start.
+    pub fn energy<S: Shape>(&self, body: &Body<S>) -> f64 {
+        ReducedSystem::new(body, self.kappa).energy(self.theta0, self.theta_dot0)
+    }
+
+    /// The component of the level set that holds θ(0).
+    pub fn component<S: Shape>(&self, body: &Body<S>) -> Result<Component> {
+        let energy = self.energy(body);
+        let comps = components(body, self.kappa, energy)?;
+        let nearest = comps.iter().min_by(|a, b| {
+            let d = |c: &Component| {
+                (c.theta_min - self.theta0).max(self.theta0 - c.theta_max).max(0.0)
+            };
+            d(a).total_cmp(&d(b))
+        });
+        nearest.copied().ok_or(AtlasError::NotPeriodic {
+            reason: "no component holds theta0",
+        })
+    }
+
+    /// The θ-period of the component that holds θ(0), from the quadrature of [`crate::torus`].
+    pub fn period<S: Shape>(&self, body: &Body<S>, tol: f64) -> Result<f64> {
+        let comp = self.component(body)?;
+        if comp.kind == MotionKind::FixedPoint {
+            return Err(AtlasError::NotPeriodic {
+                reason: "the start is a fixed point (a permanent rotation); give --t-end",
+            });
+        }
+        Ok(period_integrals(body, self.kappa, self.energy(body), &comp, tol)?.period)
+    }
+}
+
+/// Samples of a trajectory, one entry per time.
+#[derive(Debug, Clone, Default)]
+pub struct Trajectory {
+    pub t: Vec<f64>,
+    pub theta: Vec<f64>,
+    pub theta_dot: Vec<f64>,
+    pub phi: Vec<f64>,
+    pub psi: Vec<f64>,
+    pub x_c: Vec<f64>,
+    pub y_c: Vec<f64>,
+    pub z_c: Vec<f64>,
+    pub x_p: Vec<f64>,
+    pub y_p: Vec<f64>,
+}
+
+impl Trajectory {
+    /// Column names and columns, in output order.
+    pub fn columns(&self) -> Vec<(&'static str, &[f64])> {
+        vec![
+            ("t", &self.t),
+            ("theta", &self.theta),
+            ("theta_dot", &self.theta_dot),
+            ("phi", &self.phi),
+            ("psi", &self.psi),
+            ("x_c", &self.x_c),
+            ("y_c", &self.y_c),
+            ("z_c", &self.z_c),
+            ("x_p", &self.x_p),
+            ("y_p", &self.y_p),
+        ]
+    }
+}
+
+/// Reduced state [θ, p, φ, ψ, x_c, y_c].
+type ReducedState = SVector<f64, 6>;
+
+impl<S: Shape> Rate<6> for ReducedSystem<'_, S> {
+    fn rate(&self, y: &ReducedState) -> ReducedState {
+        let (theta, p, psi) = (y[0], y[1], y[3]);
+        let (vx, vy) = self.centre_velocity(theta, p, psi);
+        ReducedState::from([
+            p,
+            self.theta_acceleration(theta, p),
+            self.phi_rate(theta),
+            self.psi_rate(theta),
+            vx,
+            vy,
+        ])
+    }
+}
+
+impl<S: Shape> Rate<FULL_STATE_LEN> for FullSystem<'_, S> {
+    fn rate(&self, y: &FullState) -> FullState {
+        FullSystem::rate(self, y)
+    }
+}
+
+/// Integrates from `start` to `t_end` with DOP853 at tolerance `tol`, sampling `samples + 1`
+/// equally spaced times.
+pub fn integrate<S: Shape>(
+    body: &Body<S>,
+    start: &Start,
+    model: Model,
+    t_end: f64,
+    samples: usize,
+    tol: f64,
+) -> Result<Trajectory> {
+    let mut out = Trajectory::default();
+    match model {
+        Model::Reduced => {
+            let sys = ReducedSystem::new(body, start.kappa);
+            let y0 = ReducedState::from([start.theta0, start.theta_dot0, 0.0, 0.0, 0.0, 0.0]);
+            let sol = integrate_dense(&sys, y0, t_end, samples, tol)?;
+            for (t, y) in sol.times.iter().zip(&sol.states) {
+                let (dx, dy) = sys.contact_offset(y[0], y[3]);
+                out.t.push(*t);
+                out.theta.push(y[0]);
+                out.theta_dot.push(y[1]);
+                out.phi.push(y[2]);
+                out.psi.push(y[3]);
+                out.x_c.push(y[4]);
+                out.y_c.push(y[5]);
+                out.z_c.push(body.shape.potential(y[0]));
+                out.x_p.push(y[4] + dx);
+                out.y_p.push(y[5] + dy);
+            }
+        }
+        Model::Full => {
+            let sys = FullSystem::new(body);
+            let y0 = sys.state_from_reduced(start.kappa, start.theta0, start.theta_dot0, 0.0, 0.0, 0.0, 0.0);
+            let sol = integrate_dense(&sys, y0, t_end, samples, tol)?;
+            let mut prev: Option<(f64, f64)> = None;
+            for (t, y) in sol.times.iter().zip(&sol.states) {
+                let (theta, phi, psi) = FullSystem::<S>::euler_angles(y);
+                // Unwrap φ and ψ so that they are continuous in time like the reduced ones.
+                let (phi, psi) = match prev {
+                    Some((p0, s0)) => (unwrap_near(phi, p0), unwrap_near(psi, s0)),
+                    None => (phi, psi),
+                };
+                prev = Some((phi, psi));
+                // θ̇ from γ̇3 = −sinθ θ̇ is singular at the poles; use the body-frame formula
+                // θ̇ = ω1 cosφ − ω2 sinφ, which follows from `w12`.
+                let theta_dot = y[0] * phi.cos() - y[1] * phi.sin();
+                let (xp, yp) = sys.contact_position(y);
+                out.t.push(*t);
+                out.theta.push(theta);
+                out.theta_dot.push(theta_dot);
+                out.phi.push(phi);
+                out.psi.push(psi);
+                out.x_c.push(y[12]);
+                out.y_c.push(y[13]);
+                out.z_c.push(sys.centre_height(y));
+                out.x_p.push(xp);
+                out.y_p.push(yp);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The representative of `angle` + 2πk nearest to `reference`.
+fn unwrap_near(angle: f64, reference: f64) -> f64 {
+    let tau = std::f64::consts::TAU;
+    angle + tau * ((reference - angle) / tau).round()
+}
