@@ -161,7 +161,8 @@ impl Shape for Ellipsoid {
         let (s, c) = theta.sin_cos();
         let z = self.centre_height(theta);
         let zp = (self.beta * self.beta - 1.0) * s * c / z;
-        -self.alpha * c + (self.beta * self.beta - 1.0) * ((c * c - s * s) / z - s * c * zp / (z * z))
+        -self.alpha * c
+            + (self.beta * self.beta - 1.0) * ((c * c - s * s) / z - s * c * zp / (z * z))
     }
 
     /// |r|² = (β⁴ sin²θ + (cosθ + αZ)²) / Z² (SPEC §1.2; the paper's `eqsysell` prints

@@ -94,7 +94,12 @@ pub struct TrajectoryArgs {
     #[arg(long, allow_negative_numbers = true)]
     pub theta0: Option<f64>,
     /// Initial θ̇(0) (with --theta0).
-    #[arg(long, default_value_t = 0.0, requires = "theta0", allow_negative_numbers = true)]
+    #[arg(
+        long,
+        default_value_t = 0.0,
+        requires = "theta0",
+        allow_negative_numbers = true
+    )]
     pub theta_dot0: f64,
     /// Length in θ-periods of the starting component.
     #[arg(long, allow_negative_numbers = true)]
@@ -170,7 +175,10 @@ fn print_diagram(set: &CriticalSet) {
         set.eta,
         set.diagram_type.label()
     );
-    println!("  eps_min (roll over the top at kappa = 0) = {:.12}", set.energy_min);
+    println!(
+        "  eps_min (roll over the top at kappa = 0) = {:.12}",
+        set.energy_min
+    );
     if let Some(t) = set.theta_star {
         println!("  inclined equilibrium theta* = {t:.12}");
     }
@@ -229,50 +237,119 @@ fn write_diagram(out: &std::path::Path, set: &CriticalSet) -> Result<()> {
         }
     }
     let columns = [
-        Column { name: "segment", values: &cols[0], units: "1", long_name: "index of the run of one stability along a branch" },
-        Column { name: "branch", values: &cols[1], units: "1", long_name: "0 sigma_s0, 1 sigma_u, 2 sigma_spi, 3 sigma_pi2" },
-        Column { name: "theta0", values: &cols[2], units: "rad", long_name: "inclination of the permanent rotation" },
-        Column { name: "kappa", values: &cols[3], units: "sqrt(m g b3)", long_name: "integral F2 on the curve (kappa >= 0)" },
-        Column { name: "energy", values: &cols[4], units: "m g b3", long_name: "energy on the curve" },
-        Column { name: "stable", values: &cols[5], units: "1", long_name: "1 linearly stable (centre), 0 unstable" },
-        Column { name: "rho_c", values: &cols[6], units: "b3", long_name: "radius of the circle of the centre of mass" },
-        Column { name: "rho_p", values: &cols[7], units: "b3", long_name: "radius of the circle of the contact point" },
+        Column {
+            name: "segment",
+            values: &cols[0],
+            units: "1",
+            long_name: "index of the run of one stability along a branch",
+        },
+        Column {
+            name: "branch",
+            values: &cols[1],
+            units: "1",
+            long_name: "0 sigma_s0, 1 sigma_u, 2 sigma_spi, 3 sigma_pi2",
+        },
+        Column {
+            name: "theta0",
+            values: &cols[2],
+            units: "rad",
+            long_name: "inclination of the permanent rotation",
+        },
+        Column {
+            name: "kappa",
+            values: &cols[3],
+            units: "sqrt(m g b3)",
+            long_name: "integral F2 on the curve (kappa >= 0)",
+        },
+        Column {
+            name: "energy",
+            values: &cols[4],
+            units: "m g b3",
+            long_name: "energy on the curve",
+        },
+        Column {
+            name: "stable",
+            values: &cols[5],
+            units: "1",
+            long_name: "1 linearly stable (centre), 0 unstable",
+        },
+        Column {
+            name: "rho_c",
+            values: &cols[6],
+            units: "b3",
+            long_name: "radius of the circle of the centre of mass",
+        },
+        Column {
+            name: "rho_p",
+            values: &cols[7],
+            units: "b3",
+            long_name: "radius of the circle of the contact point",
+        },
     ];
     let summary = serde_json::to_string(set)?;
     write_table(
         out,
         &columns,
         &[
-            ("program", format!("rubber-atlas {}", env!("CARGO_PKG_VERSION"))),
+            (
+                "program",
+                format!("rubber-atlas {}", env!("CARGO_PKG_VERSION")),
+            ),
             ("command_line", command_line()),
             ("critical_set_json", summary),
         ],
     )
-    .with_context(|| format!("writing the diagram of alpha = {}, beta = {}", set.alpha, set.beta))?;
+    .with_context(|| {
+        format!(
+            "writing the diagram of alpha = {}, beta = {}",
+            set.alpha, set.beta
+        )
+    })?;
     Ok(())
 }
 
 fn trajectory(args: TrajectoryArgs) -> Result<()> {
     let body = EllipsoidBody::ellipsoid(args.shape.alpha, args.shape.beta, args.nu, args.eta)?;
     if !args.kappa.is_finite() {
-        return Err(AtlasError::InvalidParameter { name: "kappa", value: args.kappa, reason: "must be a finite number" }.into());
+        return Err(AtlasError::InvalidParameter {
+            name: "kappa",
+            value: args.kappa,
+            reason: "must be a finite number",
+        }
+        .into());
     }
     let tol = args.tol;
     if !(tol.is_finite() && tol > 0.0 && tol < 1.0) {
-        return Err(AtlasError::InvalidParameter { name: "tol", value: tol, reason: "must satisfy 0 < tol < 1" }.into());
+        return Err(AtlasError::InvalidParameter {
+            name: "tol",
+            value: tol,
+            reason: "must satisfy 0 < tol < 1",
+        }
+        .into());
     }
     if args.samples == 0 {
-        return Err(AtlasError::InvalidParameter { name: "samples", value: 0.0, reason: "must be >= 1" }.into());
+        return Err(AtlasError::InvalidParameter {
+            name: "samples",
+            value: 0.0,
+            reason: "must be >= 1",
+        }
+        .into());
     }
     let start = match (args.energy, args.theta0) {
         (Some(e), None) => {
             if !e.is_finite() {
-                return Err(AtlasError::InvalidParameter { name: "energy", value: e, reason: "must be a finite number" }.into());
+                return Err(AtlasError::InvalidParameter {
+                    name: "energy",
+                    value: e,
+                    reason: "must be a finite number",
+                }
+                .into());
             }
             Start::at_energy(&body, args.kappa, e, args.component)?
         }
         (None, Some(t)) => {
-            let valid = t.is_finite() && (args.kappa == 0.0 || (t > 0.0 && t < std::f64::consts::PI));
+            let valid =
+                t.is_finite() && (args.kappa == 0.0 || (t > 0.0 && t < std::f64::consts::PI));
             if !valid {
                 return Err(AtlasError::InvalidInitialAngle {
                     theta0: t,
@@ -281,9 +358,18 @@ fn trajectory(args: TrajectoryArgs) -> Result<()> {
                 .into());
             }
             if !args.theta_dot0.is_finite() {
-                return Err(AtlasError::InvalidParameter { name: "theta-dot0", value: args.theta_dot0, reason: "must be a finite number" }.into());
+                return Err(AtlasError::InvalidParameter {
+                    name: "theta-dot0",
+                    value: args.theta_dot0,
+                    reason: "must be a finite number",
+                }
+                .into());
             }
-            Start { kappa: args.kappa, theta0: t, theta_dot0: args.theta_dot0 }
+            Start {
+                kappa: args.kappa,
+                theta0: t,
+                theta_dot0: args.theta_dot0,
+            }
         }
         _ => unreachable!("clap requires exactly one of --energy, --theta0"),
     };
@@ -297,7 +383,18 @@ fn trajectory(args: TrajectoryArgs) -> Result<()> {
         ModelArg::Full => Model::Full,
     };
     let traj = integrate(&body, &start, model, t_end, args.samples, tol)?;
-    let units = ["sqrt(b3/g)", "rad", "rad/sqrt(b3/g)", "rad", "rad", "b3", "b3", "b3", "b3", "b3"];
+    let units = [
+        "sqrt(b3/g)",
+        "rad",
+        "rad/sqrt(b3/g)",
+        "rad",
+        "rad",
+        "b3",
+        "b3",
+        "b3",
+        "b3",
+        "b3",
+    ];
     let long = [
         "time",
         "inclination of the symmetry axis to the vertical",
@@ -314,10 +411,18 @@ fn trajectory(args: TrajectoryArgs) -> Result<()> {
         .columns()
         .into_iter()
         .zip(units.iter().zip(long.iter()))
-        .map(|((name, values), (u, l))| Column { name, values, units: u, long_name: l })
+        .map(|((name, values), (u, l))| Column {
+            name,
+            values,
+            units: u,
+            long_name: l,
+        })
         .collect();
     let attrs = [
-        ("program", format!("rubber-atlas {}", env!("CARGO_PKG_VERSION"))),
+        (
+            "program",
+            format!("rubber-atlas {}", env!("CARGO_PKG_VERSION")),
+        ),
         ("command_line", command_line()),
         ("model", format!("{:?}", model).to_lowercase()),
         ("alpha", args.shape.alpha.to_string()),

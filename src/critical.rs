@@ -326,7 +326,8 @@ impl CriticalSet {
             }
         }
 
-        let kappa_c_equator = (alpha == 0.0 && beta > 1.0).then(|| ((beta * beta - 1.0) / beta).sqrt());
+        let kappa_c_equator =
+            (alpha == 0.0 && beta > 1.0).then(|| ((beta * beta - 1.0) / beta).sqrt());
         if alpha == 0.0 {
             // σ_π/2: ε = κ²/2 + β (`s2`), stable where V″(π/2) = κ² − (β² − 1)/β > 0.
             let mut run: Vec<FixedPoint> = Vec::new();
@@ -384,9 +385,12 @@ fn make_branch(points: Vec<FixedPoint>, stable_name: &'static str) -> Branch {
         "sigma_u"
     };
     let range = |f: fn(&FixedPoint) -> f64| {
-        points.iter().map(f).fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], x| {
-            [lo.min(x), hi.max(x)]
-        })
+        points
+            .iter()
+            .map(f)
+            .fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], x| {
+                [lo.min(x), hi.max(x)]
+            })
     };
     Branch {
         name,

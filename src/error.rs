@@ -15,7 +15,9 @@ pub enum AtlasError {
         reason: &'static str,
     },
     /// The energy is below every value of the effective potential: no motion at all.
-    #[error("no motion: energy {energy} is below the minimum {minimum} of the effective potential")]
+    #[error(
+        "no motion: energy {energy} is below the minimum {minimum} of the effective potential"
+    )]
     NoMotion { energy: f64, minimum: f64 },
     /// An initial angle outside the allowed set (κ ≠ 0 needs 0 < θ < π).
     #[error("invalid theta0 = {theta0}: {reason}")]

@@ -92,8 +92,10 @@ impl<'a, S: Shape> FullSystem<'a, S> {
         let mut out = FullState::zeros();
         out.fixed_rows_mut::<3>(0).copy_from(&omega_dot);
         out.fixed_rows_mut::<3>(3).copy_from(&gamma_dot);
-        out.fixed_rows_mut::<3>(6).copy_from(&s.alpha.cross(&s.omega));
-        out.fixed_rows_mut::<3>(9).copy_from(&s.beta.cross(&s.omega));
+        out.fixed_rows_mut::<3>(6)
+            .copy_from(&s.alpha.cross(&s.omega));
+        out.fixed_rows_mut::<3>(9)
+            .copy_from(&s.beta.cross(&s.omega));
         out[12] = v.dot(&s.alpha);
         out[13] = v.dot(&s.beta);
         out

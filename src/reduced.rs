@@ -103,11 +103,7 @@ impl<'a, S: Shape> ReducedSystem<'a, S> {
             w3 * theta.cos() / theta.sin()
         };
         let (sf, cf) = phi.sin_cos();
-        Vector3::new(
-            theta_dot * cf - spin * sf,
-            -theta_dot * sf - spin * cf,
-            w3,
-        )
+        Vector3::new(theta_dot * cf - spin * sf, -theta_dot * sf - spin * cf, w3)
     }
 
     /// Velocity of the centre of mass on the plane, ζ̇ = ẋ_c + i ẏ_c:

@@ -16,7 +16,12 @@ pub enum TableFormat {
 impl TableFormat {
     /// The format named by a path's extension: `.csv`, or `.h5` / `.hdf5` / `.nc`.
     pub fn from_path(path: &Path) -> Result<Self> {
-        match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+        match path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .as_deref()
+        {
             Some("csv") => Ok(Self::Csv),
             Some("h5") | Some("hdf5") | Some("nc") => Ok(Self::Hdf5),
             _ => Err(AtlasError::Output {
@@ -44,7 +49,10 @@ fn output_error(path: &Path, e: impl std::fmt::Display) -> AtlasError {
 }
 
 fn temp_path(path: &Path) -> PathBuf {
-    let mut name = path.file_name().map(|n| n.to_os_string()).unwrap_or_default();
+    let mut name = path
+        .file_name()
+        .map(|n| n.to_os_string())
+        .unwrap_or_default();
     name.push(format!(".partial-{}", std::process::id()));
     path.with_file_name(name)
 }
@@ -52,7 +60,11 @@ fn temp_path(path: &Path) -> PathBuf {
 /// Writes equal-length columns to `path` (CSV: a header line, then rows with shortest
 /// round-trip decimals; HDF5: one 1-D dataset per column with `units` and `long_name`, plus the
 /// string attributes `attributes` on the root).
-pub fn write_table(path: &Path, columns: &[Column<'_>], attributes: &[(&str, String)]) -> Result<()> {
+pub fn write_table(
+    path: &Path,
+    columns: &[Column<'_>],
+    attributes: &[(&str, String)],
+) -> Result<()> {
     let format = TableFormat::from_path(path)?;
     let tmp = temp_path(path);
     let written = match format {
@@ -69,7 +81,11 @@ pub fn write_table(path: &Path, columns: &[Column<'_>], attributes: &[(&str, Str
     })
 }
 
-fn write_csv(path: &Path, columns: &[Column<'_>], attributes: &[(&str, String)]) -> std::result::Result<(), String> {
+fn write_csv(
+    path: &Path,
+    columns: &[Column<'_>],
+    attributes: &[(&str, String)],
+) -> std::result::Result<(), String> {
     let file = std::fs::File::create(path).map_err(|e| e.to_string())?;
     let mut w = std::io::BufWriter::new(file);
     let io = |e: std::io::Error| e.to_string();
@@ -93,17 +109,24 @@ fn write_csv(path: &Path, columns: &[Column<'_>], attributes: &[(&str, String)])
     w.flush().map_err(io)
 }
 
-fn write_hdf5(path: &Path, columns: &[Column<'_>], attributes: &[(&str, String)]) -> std::result::Result<(), String> {
+fn write_hdf5(
+    path: &Path,
+    columns: &[Column<'_>],
+    attributes: &[(&str, String)],
+) -> std::result::Result<(), String> {
     use hdf5::types::VarLenUnicode;
     let err = |e: hdf5::Error| e.to_string();
     let file = hdf5::File::create(path).map_err(err)?;
-    let string_attr = |loc: &hdf5::Location, name: &str, value: &str| -> std::result::Result<(), String> {
-        let v: VarLenUnicode = value.parse().map_err(|e: hdf5::types::StringError| e.to_string())?;
-        loc.new_attr::<VarLenUnicode>()
-            .create(name)
-            .and_then(|a| a.write_scalar(&v))
-            .map_err(err)
-    };
+    let string_attr =
+        |loc: &hdf5::Location, name: &str, value: &str| -> std::result::Result<(), String> {
+            let v: VarLenUnicode = value
+                .parse()
+                .map_err(|e: hdf5::types::StringError| e.to_string())?;
+            loc.new_attr::<VarLenUnicode>()
+                .create(name)
+                .and_then(|a| a.write_scalar(&v))
+                .map_err(err)
+        };
     for (k, v) in attributes {
         string_attr(&file, k, v)?;
     }

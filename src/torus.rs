@@ -288,7 +288,11 @@ pub fn period_integrals<S: Shape>(
                 reason: "a quadrature node fell outside the allowed set (ε ≤ V)",
             });
         };
-        let psi = if with_psi { system.psi_rate(theta) } else { 0.0 };
+        let psi = if with_psi {
+            system.psi_rate(theta)
+        } else {
+            0.0
+        };
         Ok((dt, psi * dt))
     };
     let u0 = if libration { -FRAC_PI_2 } else { 0.0 };

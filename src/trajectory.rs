@@ -30,7 +30,12 @@ pub struct Start {
 impl Start {
     /// The start at the lower turning point θ_min of component `index` of the level set
     /// (κ, ε), with θ̇ = 0 (the start of SPEC §2's drift).
-    pub fn at_energy<S: Shape>(body: &Body<S>, kappa: f64, energy: f64, index: usize) -> Result<Self> {
+    pub fn at_energy<S: Shape>(
+        body: &Body<S>,
+        kappa: f64,
+        energy: f64,
+        index: usize,
+    ) -> Result<Self> {
         let comps = components(body, kappa, energy)?;
         let count = comps.len();
         let c = comps.get(index).ok_or(AtlasError::InvalidParameter {
@@ -60,7 +65,9 @@ impl Start {
         let comps = components(body, self.kappa, energy)?;
         let nearest = comps.iter().min_by(|a, b| {
             let d = |c: &Component| {
-                (c.theta_min - self.theta0).max(self.theta0 - c.theta_max).max(0.0)
+                (c.theta_min - self.theta0)
+                    .max(self.theta0 - c.theta_max)
+                    .max(0.0)
             };
             d(a).total_cmp(&d(b))
         });
@@ -170,7 +177,15 @@ pub fn integrate<S: Shape>(
         }
         Model::Full => {
             let sys = FullSystem::new(body);
-            let y0 = sys.state_from_reduced(start.kappa, start.theta0, start.theta_dot0, 0.0, 0.0, 0.0, 0.0);
+            let y0 = sys.state_from_reduced(
+                start.kappa,
+                start.theta0,
+                start.theta_dot0,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+            );
             let sol = integrate_dense(&sys, y0, t_end, samples, tol)?;
             let mut prev: Option<(f64, f64)> = None;
             for (t, y) in sol.times.iter().zip(&sol.states) {

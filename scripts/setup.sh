@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Installs what rubber-atlas needs and is missing, saying what it does:
+#   - Debian's libhdf5-dev and pkg-config (the hdf5 crate links against the system HDF5),
+#   - a Python virtual environment in .venv with scripts/requirements.txt.
+# Sourced by scripts/quickstart.sh and scripts/test.sh; safe to run again.
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+
+need_apt=()
+command -v pkg-config >/dev/null 2>&1 || need_apt+=(pkg-config)
+if ! pkg-config --exists hdf5 2>/dev/null && [ ! -e /usr/include/hdf5/serial/hdf5.h ]; then
+  need_apt+=(libhdf5-dev)
+fi
+if [ ${#need_apt[@]} -gt 0 ]; then
+  echo "setup: installing Debian packages: ${need_apt[*]}"
+  sudo_cmd=""
+  [ "$(id -u)" -ne 0 ] && sudo_cmd="sudo"
+  $sudo_cmd apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq "${need_apt[@]}" >/dev/null
+else
+  echo "setup: libhdf5-dev and pkg-config already installed"
+fi
+
+venv="$root/.venv"
+stamp="$venv/.requirements.sha"
+want="$(sha256sum "$root/scripts/requirements.txt" | cut -d' ' -f1)"
+if [ ! -x "$venv/bin/python" ]; then
+  echo "setup: creating the Python virtual environment .venv"
+  python3 -m venv "$venv"
+fi
+if [ "$(cat "$stamp" 2>/dev/null || true)" != "$want" ]; then
+  echo "setup: installing Python packages from scripts/requirements.txt into .venv"
+  "$venv/bin/python" -m pip install --quiet --disable-pip-version-check -r "$root/scripts/requirements.txt"
+  echo "$want" > "$stamp"
+else
+  echo "setup: Python packages already installed in .venv"
+fi

@@ -1,0 +1,84 @@
+"""The files rubber-atlas writes, read from Python as a user would (h5py and the CSV), and the
+plot script on them."""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "scripts"))
+
+from plot_trajectory import plot  # noqa: E402
+from trajectory_io import critical_set, read_table  # noqa: E402
+
+BIN = os.environ.get("RUBBER_ATLAS_BIN", str(ROOT / "target" / "release" / "rubber-atlas"))
+BODY = ["--alpha", "0.5", "--beta", "3", "--nu", "0.5", "--eta", "0.5"]
+
+
+def run(*args: str) -> None:
+    subprocess.run([BIN, *args], check=True, capture_output=True, text=True)
+
+
+@pytest.fixture(scope="module")
+def trajectories(tmp_path_factory):
+    d = tmp_path_factory.mktemp("traj")
+    out = {}
+    for ext in ("csv", "h5"):
+        p = d / f"xy.{ext}"
+        run("trajectory", *BODY, "--kappa", "0.8", "--theta0", "0.4670288", "--periods", "7",
+            "--samples", "700", "--out", str(p))
+        out[ext] = p
+    return out
+
+
+def test_hdf5_and_csv_trajectories_hold_the_same_numbers(trajectories):
+    h5, h5_attrs = read_table(trajectories["h5"])
+    csv, csv_attrs = read_table(trajectories["csv"])
+    assert list(csv) == ["t", "theta", "theta_dot", "phi", "psi", "x_c", "y_c", "z_c", "x_p", "y_p"]
+    for name in csv:
+        # CSV holds shortest round-trip decimals: the same doubles.
+        np.testing.assert_array_equal(h5[name], csv[name])
+    assert float(h5_attrs["kappa"]) == 0.8
+    import h5py
+
+    with h5py.File(trajectories["h5"]) as f:
+        assert f["theta"].attrs["units"] == "rad"
+        assert "centre of mass" in f["x_c"].attrs["long_name"]
+
+
+def test_resonant_trajectory_closes(trajectories):
+    cols, _ = read_table(trajectories["h5"])
+    size = np.hypot(np.ptp(cols["x_c"]), np.ptp(cols["y_c"]))
+    gap = np.hypot(cols["x_c"][-1] - cols["x_c"][0], cols["y_c"][-1] - cols["y_c"][0])
+    # θ0 = 0.4670288 is N = -1/7 to 7 digits: the path closes to far better than 1e-4.
+    assert gap < 1e-4 * size
+    # The height of the centre of mass is U(θ) = Z + α cos θ.
+    z = np.sqrt(9 * np.sin(cols["theta"]) ** 2 + np.cos(cols["theta"]) ** 2) + 0.5 * np.cos(cols["theta"])
+    np.testing.assert_allclose(cols["z_c"], z, rtol=1e-14)
+
+
+def test_plot_script_writes_a_picture(trajectories, tmp_path):
+    png = plot(trajectories["h5"], tmp_path / "xy.png")
+    assert png.stat().st_size > 10_000
+    res = subprocess.run([sys.executable, str(ROOT / "scripts" / "plot_trajectory.py"), str(trajectories["csv"]),
+                          "--out", str(tmp_path / "xy2.png")], capture_output=True, text=True)
+    assert res.returncode == 0, res.stderr
+    assert (tmp_path / "xy2.png").stat().st_size > 10_000
+
+
+def test_diagram_file_opens_with_branches_and_summary(tmp_path):
+    p = tmp_path / "d.h5"
+    run("diagram", *BODY, "--out", str(p))
+    cols, _ = read_table(p)
+    summary = critical_set(p)
+    assert summary["diagram_type"] == "c"
+    assert set(np.unique(cols["branch"]).astype(int)) == {0, 1, 2}
+    # Along σ_u (code 1) every point is unstable; σ_s0 and σ_sπ are stable.
+    assert np.all(cols["stable"][cols["branch"] == 1] == 0)
+    assert np.all(cols["stable"][cols["branch"] != 1] == 1)
+    assert np.max(cols["kappa"][cols["branch"] == 1]) == pytest.approx(summary["cusp"]["kappa"], abs=1e-12)

@@ -1,0 +1,283 @@
+//! The `rubber-atlas` command end to end: `diagram` and `trajectory` as a user calls them, and
+//! bad input to every command (exit code 2, one line naming the bad value, no panic, no file).
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn run(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_rubber-atlas"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn diagram_json_gives_the_corrected_critical_set() {
+    let o = run(&["diagram", "--alpha", "0.5", "--beta", "3", "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["diagram_type"], "c");
+    assert!((v["theta_star"].as_f64().unwrap() - 1.385093587).abs() < 1e-8);
+    assert!((v["energy_min"].as_f64().unwrap() - 3.046514401).abs() < 1e-8);
+    assert!(v["cusp"]["kappa"].as_f64().unwrap() > 1.0);
+    let names: Vec<&str> = v["branches"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| b["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["sigma_s0", "sigma_u", "sigma_spi"]);
+    let eq = v["equilibria"].as_array().unwrap();
+    assert_eq!(eq[0]["name"], "sigma_0");
+    assert_eq!(eq[0]["stable"], true);
+    assert_eq!(eq[0]["isolated"], false);
+}
+
+#[test]
+fn diagram_and_trajectory_write_csv_and_hdf5() {
+    let dir = tempfile::tempdir().unwrap();
+    for ext in ["csv", "h5"] {
+        let out = dir.path().join(format!("d.{ext}"));
+        let o = run(&[
+            "diagram",
+            "--alpha",
+            "0",
+            "--beta",
+            "1.5",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(std::fs::metadata(&out).unwrap().len() > 1000);
+        for model in ["reduced", "full"] {
+            let out = dir.path().join(format!("t-{model}.{ext}"));
+            let o = run(&[
+                "trajectory",
+                "--alpha",
+                "0.5",
+                "--beta",
+                "3",
+                "--nu",
+                "0.5",
+                "--eta",
+                "0.5",
+                "--kappa",
+                "1",
+                "--theta0",
+                "2.1",
+                "--periods",
+                "2",
+                "--samples",
+                "100",
+                "--model",
+                model,
+                "--out",
+                out.to_str().unwrap(),
+            ]);
+            assert!(o.status.success(), "{}", stderr(&o));
+            assert!(std::fs::metadata(&out).unwrap().len() > 1000);
+        }
+    }
+    // The CSV trajectory returns to θ(0) = 2.1 after two periods, with θ̇ = 0.
+    let text = std::fs::read_to_string(dir.path().join("t-reduced.csv")).unwrap();
+    let rows: Vec<&str> = text.lines().filter(|l| !l.starts_with('#')).collect();
+    assert_eq!(rows[0], "t,theta,theta_dot,phi,psi,x_c,y_c,z_c,x_p,y_p");
+    assert_eq!(rows.len(), 102);
+    let last: Vec<f64> = rows[101].split(',').map(|x| x.parse().unwrap()).collect();
+    assert!(
+        (last[1] - 2.1).abs() < 1e-9 && last[2].abs() < 1e-9,
+        "{last:?}"
+    );
+}
+
+#[test]
+fn trajectory_from_an_energy_starts_at_the_lower_turning_point() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("e.csv");
+    let o = run(&[
+        "trajectory",
+        "--alpha",
+        "0.5",
+        "--beta",
+        "3",
+        "--nu",
+        "0.5",
+        "--eta",
+        "0.5",
+        "--kappa",
+        "0.9",
+        "--energy",
+        "3.44",
+        "--component",
+        "1",
+        "--periods",
+        "1",
+        "--samples",
+        "10",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&out).unwrap();
+    let first: Vec<f64> = text
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .map(|x| x.parse().unwrap())
+        .collect();
+    // Component 1 of the two tori lies beyond the local maximum of V at θ ≈ 1.29.
+    assert!(first[1] > 1.29 && first[2] == 0.0, "{first:?}");
+}
+
+/// Exit code 2, exactly one line on stderr that names `needle`, no panic, no output file.
+fn assert_refused(args: &[&str], needle: &str, out: Option<&Path>) {
+    let o = run(args);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+    assert!(
+        !err.contains("panicked") && !err.contains("RUST_BACKTRACE"),
+        "{args:?}: {err}"
+    );
+    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert!(
+        !lines.is_empty() && lines[0].contains(needle),
+        "{args:?}: expected '{needle}' in {err}"
+    );
+    if let Some(p) = out {
+        assert!(!p.exists(), "{args:?} left {}", p.display());
+        let leftovers = std::fs::read_dir(p.parent().unwrap()).unwrap().count();
+        assert_eq!(leftovers, 0, "{args:?} left a partial file");
+    }
+    assert_eq!(lines.len(), 1, "{args:?}: {err}");
+}
+
+#[test]
+fn bad_input_is_refused_with_one_clear_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.csv");
+    let o = out.to_str().unwrap();
+    let traj = |extra: &[&str]| -> Vec<String> {
+        let mut v: Vec<String> = [
+            "trajectory",
+            "--alpha",
+            "0.5",
+            "--beta",
+            "3",
+            "--nu",
+            "0.5",
+            "--eta",
+            "0.5",
+            "--kappa",
+            "1",
+            "--theta0",
+            "2.1",
+            "--periods",
+            "1",
+            "--out",
+            o,
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        for pair in extra.chunks(2) {
+            if let Some(i) = v.iter().position(|a| a == pair[0]) {
+                v[i + 1] = pair[1].to_string();
+            } else {
+                v.extend(pair.iter().map(|s| s.to_string()));
+            }
+        }
+        v
+    };
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (traj(&["--alpha", "NaN"]), "alpha = NaN"),
+        (traj(&["--alpha", "1.2"]), "alpha = 1.2"),
+        (traj(&["--beta", "-1"]), "beta = -1"),
+        (traj(&["--beta", "inf"]), "beta = inf"),
+        (traj(&["--nu", "3"]), "nu = 3"),
+        (traj(&["--eta", "0"]), "eta = 0"),
+        (traj(&["--kappa", "nan"]), "kappa = NaN"),
+        (traj(&["--theta0", "3.5"]), "theta0 = 3.5"),
+        (traj(&["--periods", "-2"]), "periods = -2"),
+        (traj(&["--tol", "0"]), "tol = 0"),
+        (traj(&["--model", "exact"]), "exact"),
+        (traj(&["--alpha", "abc"]), "abc"),
+    ];
+    for (args, needle) in &cases {
+        let a: Vec<&str> = args.iter().map(String::as_str).collect();
+        assert_refused(&a, needle, Some(&out));
+    }
+    // Energy below the potential: no motion; the unknown extension and unwritable path.
+    let no_motion = traj(&["--theta0", "x"]);
+    let mut a: Vec<&str> = no_motion
+        .iter()
+        .map(String::as_str)
+        .filter(|s| *s != "--theta0" && *s != "x")
+        .collect();
+    a.extend(["--energy", "0.1"]);
+    assert_refused(&a, "energy 0.1", Some(&out));
+    let bad_ext = dir.path().join("x.txt");
+    let t = traj(&["--out", bad_ext.to_str().unwrap()]);
+    assert_refused(
+        &t.iter().map(String::as_str).collect::<Vec<_>>(),
+        "x.txt",
+        Some(&bad_ext),
+    );
+    let t = traj(&["--out", "/nonexistent-dir/x.csv"]);
+    assert_refused(
+        &t.iter().map(String::as_str).collect::<Vec<_>>(),
+        "/nonexistent-dir/x.csv",
+        None,
+    );
+    // diagram
+    let d_out = dir.path().join("d.h5");
+    let d = d_out.to_str().unwrap();
+    assert_refused(
+        &["diagram", "--alpha", "-0.5", "--beta", "3", "--out", d],
+        "alpha = -0.5",
+        Some(&d_out),
+    );
+    assert_refused(
+        &["diagram", "--alpha", "0.5", "--beta", "0", "--out", d],
+        "beta = 0",
+        Some(&d_out),
+    );
+    assert_refused(
+        &["diagram", "--alpha", "0.5", "--beta", "NaN", "--json"],
+        "beta = NaN",
+        None,
+    );
+    assert_refused(
+        &[
+            "diagram",
+            "--alpha",
+            "0.5",
+            "--beta",
+            "3",
+            "--kappa-max",
+            "-1",
+        ],
+        "kappa-max = -1",
+        None,
+    );
+    assert_refused(&["diagram", "--alpha", "0.5"], "--beta", None);
+    assert_refused(
+        &[
+            "diagram",
+            "--alpha",
+            "0.5",
+            "--beta",
+            "3",
+            "--out",
+            "/nonexistent-dir/d.h5",
+        ],
+        "/nonexistent-dir/d.h5",
+        None,
+    );
+    assert_refused(&["nonsense"], "nonsense", None);
+}

@@ -1,0 +1,270 @@
+//! The corrected formulas of SPEC §1.5 and the analytic derivatives, each against a direct
+//! numerical search or finite differences, over many random bodies (proptest, failing cases kept in
+//! `tests/critical.proptest-regressions` and replayed first).
+
+use proptest::prelude::*;
+use rubber_atlas::body::{Ellipsoid, Shape};
+use rubber_atlas::critical::{
+    energy_min, fixed_point, inclined_equilibrium, CriticalSet, DiagramType,
+};
+use rubber_atlas::reduced::ReducedSystem;
+use rubber_atlas::EllipsoidBody;
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
+
+/// Central difference of f at x with step h (error O(h²) + O(ε/h)).
+fn diff(f: impl Fn(f64) -> f64, x: f64, h: f64) -> f64 {
+    (f(x + h) - f(x - h)) / (2.0 * h)
+}
+
+/// Maximum of f on [a, b]: a dense scan, then golden-section search around the best node.
+fn maximise(f: impl Fn(f64) -> f64, a: f64, b: f64) -> (f64, f64) {
+    let n = 4000;
+    let x = |i: usize| a + (b - a) * i as f64 / n as f64;
+    let best = (0..=n)
+        .max_by(|&i, &j| f(x(i)).total_cmp(&f(x(j))))
+        .unwrap();
+    let (mut lo, mut hi) = (x(best.saturating_sub(1)), x((best + 1).min(n)));
+    let g = (5f64.sqrt() - 1.0) / 2.0;
+    for _ in 0..200 {
+        let (m1, m2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+        if f(m1) < f(m2) {
+            lo = m1;
+        } else {
+            hi = m2;
+        }
+    }
+    let t = 0.5 * (lo + hi);
+    (t, f(t))
+}
+
+/// Interior extrema of U on (0, π), found from U's values alone (no derivative formula):
+/// sign changes of the centred difference, refined by bisection on it.
+fn interior_extrema_of_u(shape: &Ellipsoid) -> Vec<f64> {
+    let du = |t: f64| diff(|s| shape.potential(s), t, 1e-6);
+    let n = 4000;
+    let mut out = Vec::new();
+    for i in 1..n - 1 {
+        let (a, b) = (PI * i as f64 / n as f64, PI * (i + 1) as f64 / n as f64);
+        if du(a) * du(b) < 0.0 {
+            let (mut lo, mut hi) = (a, b);
+            for _ in 0..60 {
+                let m = 0.5 * (lo + hi);
+                if du(m) * du(lo) > 0.0 {
+                    lo = m;
+                } else {
+                    hi = m;
+                }
+            }
+            out.push(0.5 * (lo + hi));
+        }
+    }
+    out
+}
+
+/// Bodies away from the region boundaries (the classification there is a matter of one ulp).
+fn body_strategy() -> impl Strategy<Value = (f64, f64, f64, f64)> {
+    (0.02f64..0.95, 0.15f64..4.0, 0.1f64..2.0, 0.1f64..5.0).prop_filter(
+        "off the boundaries",
+        |(a, b, _, _)| {
+            let b2 = b * b;
+            (b2 - (1.0 - a)).abs() > 0.02 && (b2 - (1.0 + a)).abs() > 0.02 && (b - 1.0).abs() > 0.01
+        },
+    )
+}
+
+/// The linearisation of `eqsys` at (θ0, p = 0) by finite differences of θ̈(θ, p):
+/// the Jacobian is [[0, 1], [∂θ̈/∂θ, ∂θ̈/∂p]], a centre iff its eigenvalues are imaginary.
+fn is_centre_numerically(body: &EllipsoidBody, kappa: f64, theta0: f64) -> bool {
+    let sys = ReducedSystem::new(body, kappa);
+    let a_theta = diff(|t| sys.theta_acceleration(t, 0.0), theta0, 1e-6);
+    let a_p = diff(|p| sys.theta_acceleration(theta0, p), 0.0, 1e-6);
+    let jac = nalgebra::Matrix2::new(0.0, 1.0, a_theta, a_p);
+    let ev = jac.complex_eigenvalues();
+    ev.iter().all(|z| z.re.abs() < 1e-6 && z.im.abs() > 1e-6)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: 96,
+        // Failing cases are kept here and replayed first on the next run.
+        failure_persistence: Some(Box::new(
+            proptest::test_runner::FileFailurePersistence::Direct("tests/critical.proptest-regressions"),
+        )),
+        ..ProptestConfig::default()
+    })]
+
+    #[test]
+    fn analytic_derivatives_match_finite_differences(
+        (alpha, beta, nu, eta) in body_strategy(), theta in 0.05f64..3.09, kappa in -2.0f64..2.0
+    ) {
+        let b = EllipsoidBody::ellipsoid(alpha, beta, nu, eta).unwrap();
+        let s = &b.shape;
+        let h = 1e-5;
+        let tol = |x: f64| 1e-7 * x.abs().max(1.0);
+        let zp = diff(|t| s.centre_height(t), theta, h);
+        prop_assert!((s.centre_height_prime(theta) - zp).abs() < tol(zp));
+        let up = diff(|t| s.potential(t), theta, h);
+        prop_assert!((s.potential_prime(theta) - up).abs() < tol(up), "U' {} vs {}", s.potential_prime(theta), up);
+        let upp = diff(|t| s.potential_prime(t), theta, h);
+        prop_assert!((s.potential_second(theta) - upp).abs() < tol(upp), "U'' {} vs {}", s.potential_second(theta), upp);
+        let bp = diff(|t| b.reduced_inertia(t), theta, h);
+        prop_assert!((b.reduced_inertia_prime(theta) - bp).abs() < tol(bp), "B' {} vs {}", b.reduced_inertia_prime(theta), bp);
+        let sys = ReducedSystem::new(&b, kappa);
+        let vp = diff(|t| sys.effective_potential(t), theta, h);
+        prop_assert!((sys.effective_potential_prime(theta) - vp).abs() < tol(vp));
+        let vpp = diff(|t| sys.effective_potential_prime(t), theta, h);
+        prop_assert!((sys.effective_potential_second(theta) - vpp).abs() < 1e-6 * vpp.abs().max(1.0));
+    }
+
+    #[test]
+    fn closed_forms_agree_with_the_vector_contact_point(
+        (alpha, beta, nu, eta) in body_strategy(), theta in 0.0f64..PI, phi in 0.0f64..TAU
+    ) {
+        // B = 1/η + |r|² (SPEC's corrected B) and U = −(r, γ) from r(γ) of paper `r`.
+        let b = EllipsoidBody::ellipsoid(alpha, beta, nu, eta).unwrap();
+        let gamma = nalgebra::Vector3::new(theta.sin() * phi.sin(), theta.sin() * phi.cos(), theta.cos());
+        let r = b.shape.contact_point(&gamma);
+        prop_assert!((b.reduced_inertia(theta) - (1.0 / eta + r.norm_squared())).abs() < 1e-13 * b.reduced_inertia(theta));
+        prop_assert!((b.shape.potential(theta) + r.dot(&gamma)).abs() < 1e-14 * 4.0);
+        // r is the point of the surface whose normal is −γ: on the ellipsoid, normal ∥ 𝐁⁻¹(r + α e3).
+        let q = r + nalgebra::Vector3::new(0.0, 0.0, alpha);
+        prop_assert!(((q.x / beta).powi(2) + (q.y / beta).powi(2) + q.z * q.z - 1.0).abs() < 1e-13);
+        let n = nalgebra::Vector3::new(q.x / (beta * beta), q.y / (beta * beta), q.z).normalize();
+        prop_assert!((n + gamma).norm() < 1e-12);
+        // The generic χ-formulas of the trait agree with the ellipsoid's closed forms.
+        let (c1, c2) = b.shape.chi(theta);
+        let (s, c) = theta.sin_cos();
+        prop_assert!((-(c1 * s * s + c2 * c) - b.shape.potential(theta)).abs() < 1e-13);
+        prop_assert!((s * (c2 - c1 * c) - b.shape.potential_prime(theta)).abs() < 1e-13);
+        prop_assert!((c1 * c1 * s * s + c2 * c2 - b.shape.contact_distance_sq(theta)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn contact_point_rate_matches_finite_difference(
+        (alpha, beta, _nu, _eta) in body_strategy(), theta in 0.01f64..3.13, phi in 0.0f64..TAU,
+        w in prop::array::uniform3(-2.0f64..2.0)
+    ) {
+        let shape = Ellipsoid::new(alpha, beta).unwrap();
+        let gamma = nalgebra::Vector3::new(theta.sin() * phi.sin(), theta.sin() * phi.cos(), theta.cos());
+        let omega = nalgebra::Vector3::from(w);
+        let gdot = gamma.cross(&omega);
+        let h = 1e-6;
+        let fd = (shape.contact_point(&(gamma + gdot * h)) - shape.contact_point(&(gamma - gdot * h))) / (2.0 * h);
+        prop_assert!((shape.contact_point_rate(&gamma, &gdot) - fd).norm() < 1e-7 * fd.norm().max(1.0));
+    }
+
+    #[test]
+    fn inclined_equilibrium_and_energy_min_match_direct_search(
+        (alpha, beta, nu, eta) in body_strategy()
+    ) {
+        let b = EllipsoidBody::ellipsoid(alpha, beta, nu, eta).unwrap();
+        let extrema = interior_extrema_of_u(&b.shape);
+        match inclined_equilibrium(alpha, beta) {
+            Some(ts) => {
+                prop_assert_eq!(extrema.len(), 1, "theta* = {} but extrema {:?}", ts, extrema);
+                prop_assert!((ts - extrema[0]).abs() < 1e-7, "theta* {} vs search {}", ts, extrema[0]);
+            }
+            None => prop_assert!(extrema.is_empty(), "no theta* but U has extrema at {:?}", extrema),
+        }
+        let (_, u_max) = maximise(|t| b.shape.potential(t), 0.0, PI);
+        prop_assert!((energy_min(alpha, beta) - u_max).abs() < 1e-10, "eps_min {} vs max U {}", energy_min(alpha, beta), u_max);
+    }
+
+    #[test]
+    fn diagram_regions_and_isolated_equilibria_match_the_sign_of_kappa_squared(
+        (alpha, beta, nu, eta) in body_strategy()
+    ) {
+        // From U's values only: κ²(θ0) = sin³θ0 U′(θ0) / cosθ0 with U′ by finite differences.
+        let b = EllipsoidBody::ellipsoid(alpha, beta, nu, eta).unwrap();
+        let k2 = |t: f64| t.sin().powi(3) * diff(|s| b.shape.potential(s), t, 1e-6) / t.cos();
+        let upper_half_has_rotations = (1..400).any(|i| k2(FRAC_PI_2 * i as f64 / 400.0) > 0.0);
+        let ty = DiagramType::of(alpha, beta);
+        prop_assert_eq!(upper_half_has_rotations, ty == DiagramType::C, "type {:?}", ty);
+        let set = CriticalSet::of(&b, 400, 3.0).unwrap();
+        let near_0 = k2(0.05) > 0.0;
+        let near_pi = k2(PI - 0.05) > 0.0;
+        prop_assert_eq!(set.equilibria[0].isolated, !near_0);
+        prop_assert_eq!(set.equilibria[1].isolated, !near_pi);
+        // Paper: σ0 isolated iff β² < 1 + α, σπ iff β² < 1 − α.
+        prop_assert_eq!(set.equilibria[0].isolated, beta * beta < 1.0 + alpha);
+        prop_assert_eq!(set.equilibria[1].isolated, beta * beta < 1.0 - alpha);
+    }
+
+    #[test]
+    fn sampled_fixed_point_curves_are_fixed_points_with_the_right_stability(
+        (alpha, beta, nu, eta) in body_strategy()
+    ) {
+        let b = EllipsoidBody::ellipsoid(alpha, beta, nu, eta).unwrap();
+        let set = CriticalSet::of(&b, 300, 3.0).unwrap();
+        for br in &set.branches {
+            for p in br.points.iter().step_by(17) {
+                if p.theta0 < 1e-3 || p.theta0 > PI - 1e-3 || p.kappa < 1e-3 {
+                    continue; // equilibria at the poles and θ*: checked elsewhere
+                }
+                let sys = ReducedSystem::new(&b, p.kappa);
+                // V′(θ0) = 0 from values of V, and ε = V(θ0).
+                let vp = diff(|t| sys.effective_potential(t), p.theta0, 1e-6);
+                prop_assert!(vp.abs() < 1e-6 * (1.0 + p.kappa * p.kappa / p.theta0.sin().powi(3)), "V'({}) = {}", p.theta0, vp);
+                prop_assert!((sys.effective_potential(p.theta0) - p.energy).abs() < 1e-11 * p.energy.abs().max(1.0));
+                // Stability from the eigenvalues of the finite-difference linearisation,
+                // away from the cusp where V″ crosses zero.
+                if sys.effective_potential_second(p.theta0).abs() > 1e-3 {
+                    prop_assert_eq!(p.stable, is_centre_numerically(&b, p.kappa, p.theta0), "theta0 = {}", p.theta0);
+                }
+            }
+        }
+        // Type (c): the cusp is where κ along the left half peaks (a direct maximisation).
+        if set.diagram_type == DiagramType::C {
+            let cusp = set.cusp.expect("type (c) has a cusp");
+            let ts = set.theta_star.unwrap();
+            let (t_peak, k2_peak) = maximise(|t| t.sin().powi(3) * diff(|s| b.shape.potential(s), t, 1e-6) / t.cos(), 1e-3, ts);
+            prop_assert!((cusp.theta - t_peak).abs() < 1e-4, "cusp {} vs peak {}", cusp.theta, t_peak);
+            prop_assert!((cusp.kappa - k2_peak.sqrt()).abs() < 1e-8, "kappa_c {} vs {}", cusp.kappa, k2_peak.sqrt());
+        } else {
+            prop_assert!(set.cusp.is_none());
+        }
+    }
+
+    #[test]
+    fn equator_stability_for_alpha_zero_matches_the_linearisation(
+        beta in 0.2f64..4.0, kappa in 0.0f64..3.0, nu in 0.1f64..2.0, eta in 0.1f64..5.0
+    ) {
+        // SPEC §1.5: V″(π/2) = κ² − (β² − 1)/β; stable iff |κ| > κ_c (β > 1), always (β < 1).
+        // The paper's `a0usl` has the inequality reversed.
+        prop_assume!((beta - 1.0).abs() > 0.01);
+        let b = EllipsoidBody::ellipsoid(0.0, beta, nu, eta).unwrap();
+        let v2 = kappa * kappa - (beta * beta - 1.0) / beta;
+        prop_assume!(v2.abs() > 1e-3);
+        let sys = ReducedSystem::new(&b, kappa);
+        prop_assert!((sys.effective_potential_second(FRAC_PI_2) - v2).abs() < 1e-12);
+        prop_assert_eq!(v2 > 0.0, is_centre_numerically(&b, kappa, FRAC_PI_2));
+        let set = CriticalSet::of(&b, 200, 3.0).unwrap();
+        let eq = set.branches.iter().filter(|br| br.name == "sigma_pi2");
+        let on = eq.flat_map(|br| br.points.iter()).find(|p| (p.kappa - kappa).abs() < 0.02 && (p.kappa * p.kappa - (beta * beta - 1.0) / beta).abs() > 0.1);
+        if let Some(p) = on {
+            prop_assert_eq!(p.stable, p.kappa * p.kappa > (beta * beta - 1.0) / beta);
+        }
+    }
+}
+
+#[test]
+fn paper_type_c_values_and_misprints() {
+    // α = 0.5, β = 3 (SPEC §1.5): θ* = 1.38509 (the paper's root gives 1.37912), ε_min =
+    // 3.04651 (the paper's gives 2.95275).
+    let ts = inclined_equilibrium(0.5, 3.0).unwrap();
+    assert!((ts - 1.38509).abs() < 5e-6, "theta* = {ts}");
+    let printed = (0.5f64 * 3.0 / ((1.0f64 - 9.0) * (1.0 + 0.25 - 9.0)).sqrt()).acos();
+    assert!((printed - 1.37912).abs() < 5e-6 && (printed - ts).abs() > 5e-3);
+    assert!((energy_min(0.5, 3.0) - 3.04651).abs() < 5e-6);
+    let b = EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 0.5).unwrap();
+    // The fixed-point curve ends at σ0 (θ0 = 0) and at θ* (κ = 0).
+    assert_eq!(fixed_point(&b, 0.0).energy, 1.5);
+    assert!(fixed_point(&b, ts).kappa < 1e-6);
+    assert_eq!(DiagramType::of(0.5, 3.0), DiagramType::C);
+    // β² = 1.2 with α = 0.5 lies between 1 − α and 1 + α: type (b) (the paper's list says
+    // 1 − α for the (c) boundary).
+    assert_eq!(DiagramType::of(0.5, 1.2f64.sqrt()), DiagramType::B);
+    assert_eq!(DiagramType::of(0.5, 0.5), DiagramType::A);
+    assert_eq!(DiagramType::of(0.0, 0.5), DiagramType::D);
+    assert_eq!(DiagramType::of(0.0, 1.5), DiagramType::E);
+}
