@@ -216,6 +216,30 @@ fn print_diagram(set: &CriticalSet) {
     }
 }
 
+/// (name, units, long_name) of the columns `diagram --out` writes, in order.
+const DIAGRAM_COLUMNS: [(&str, &str, &str); 8] = [
+    (
+        "segment",
+        "1",
+        "index of the run of one stability along a branch",
+    ),
+    (
+        "branch",
+        "1",
+        "0 sigma_s0, 1 sigma_u, 2 sigma_spi, 3 sigma_pi2",
+    ),
+    ("theta0", "rad", "inclination of the permanent rotation"),
+    (
+        "kappa",
+        "sqrt(m g b3)",
+        "integral F2 on the curve (kappa >= 0)",
+    ),
+    ("energy", "m g b3", "energy on the curve"),
+    ("stable", "1", "1 linearly stable (centre), 0 unstable"),
+    ("rho_c", "b3", "radius of the circle of the centre of mass"),
+    ("rho_p", "b3", "radius of the circle of the contact point"),
+];
+
 fn write_diagram(out: &std::path::Path, set: &CriticalSet) -> Result<()> {
     let names = ["sigma_s0", "sigma_u", "sigma_spi", "sigma_pi2"];
     let mut cols: [Vec<f64>; 8] = Default::default();
@@ -236,56 +260,16 @@ fn write_diagram(out: &std::path::Path, set: &CriticalSet) -> Result<()> {
             }
         }
     }
-    let columns = [
-        Column {
-            name: "segment",
-            values: &cols[0],
-            units: "1",
-            long_name: "index of the run of one stability along a branch",
-        },
-        Column {
-            name: "branch",
-            values: &cols[1],
-            units: "1",
-            long_name: "0 sigma_s0, 1 sigma_u, 2 sigma_spi, 3 sigma_pi2",
-        },
-        Column {
-            name: "theta0",
-            values: &cols[2],
-            units: "rad",
-            long_name: "inclination of the permanent rotation",
-        },
-        Column {
-            name: "kappa",
-            values: &cols[3],
-            units: "sqrt(m g b3)",
-            long_name: "integral F2 on the curve (kappa >= 0)",
-        },
-        Column {
-            name: "energy",
-            values: &cols[4],
-            units: "m g b3",
-            long_name: "energy on the curve",
-        },
-        Column {
-            name: "stable",
-            values: &cols[5],
-            units: "1",
-            long_name: "1 linearly stable (centre), 0 unstable",
-        },
-        Column {
-            name: "rho_c",
-            values: &cols[6],
-            units: "b3",
-            long_name: "radius of the circle of the centre of mass",
-        },
-        Column {
-            name: "rho_p",
-            values: &cols[7],
-            units: "b3",
-            long_name: "radius of the circle of the contact point",
-        },
-    ];
+    let columns: Vec<Column> = DIAGRAM_COLUMNS
+        .iter()
+        .zip(&cols)
+        .map(|(&(name, units, long_name), values)| Column {
+            name,
+            values,
+            units,
+            long_name,
+        })
+        .collect();
     let summary = serde_json::to_string(set)?;
     write_table(
         out,

@@ -4,6 +4,20 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
+/// The paper's type (c) body.
+const BODY: [&str; 8] = [
+    "--alpha", "0.5", "--beta", "3", "--nu", "0.5", "--eta", "0.5",
+];
+
+/// `trajectory` of the paper's Fig. `res` quasi-periodic case, plus `extra`.
+fn trajectory_args<'a>(extra: &[&'a str]) -> Vec<&'a str> {
+    let mut v = vec!["trajectory"];
+    v.extend(BODY);
+    v.extend(["--kappa", "1", "--theta0", "2.1"]);
+    v.extend(extra);
+    v
+}
+
 fn run(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_rubber-atlas"))
         .args(args)
@@ -55,20 +69,7 @@ fn diagram_and_trajectory_write_csv_and_hdf5() {
         assert!(std::fs::metadata(&out).unwrap().len() > 1000);
         for model in ["reduced", "full"] {
             let out = dir.path().join(format!("t-{model}.{ext}"));
-            let o = run(&[
-                "trajectory",
-                "--alpha",
-                "0.5",
-                "--beta",
-                "3",
-                "--nu",
-                "0.5",
-                "--eta",
-                "0.5",
-                "--kappa",
-                "1",
-                "--theta0",
-                "2.1",
+            let o = run(&trajectory_args(&[
                 "--periods",
                 "2",
                 "--samples",
@@ -77,7 +78,7 @@ fn diagram_and_trajectory_write_csv_and_hdf5() {
                 model,
                 "--out",
                 out.to_str().unwrap(),
-            ]);
+            ]));
             assert!(o.status.success(), "{}", stderr(&o));
             assert!(std::fs::metadata(&out).unwrap().len() > 1000);
         }
@@ -98,16 +99,9 @@ fn diagram_and_trajectory_write_csv_and_hdf5() {
 fn trajectory_from_an_energy_starts_at_the_lower_turning_point() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("e.csv");
-    let o = run(&[
-        "trajectory",
-        "--alpha",
-        "0.5",
-        "--beta",
-        "3",
-        "--nu",
-        "0.5",
-        "--eta",
-        "0.5",
+    let mut args = vec!["trajectory"];
+    args.extend(BODY);
+    args.extend([
         "--kappa",
         "0.9",
         "--energy",
@@ -121,6 +115,7 @@ fn trajectory_from_an_energy_starts_at_the_lower_turning_point() {
         "--out",
         out.to_str().unwrap(),
     ]);
+    let o = run(&args);
     assert!(o.status.success(), "{}", stderr(&o));
     let text = std::fs::read_to_string(&out).unwrap();
     let first: Vec<f64> = text
@@ -163,28 +158,10 @@ fn bad_input_is_refused_with_one_clear_line() {
     let out = dir.path().join("x.csv");
     let o = out.to_str().unwrap();
     let traj = |extra: &[&str]| -> Vec<String> {
-        let mut v: Vec<String> = [
-            "trajectory",
-            "--alpha",
-            "0.5",
-            "--beta",
-            "3",
-            "--nu",
-            "0.5",
-            "--eta",
-            "0.5",
-            "--kappa",
-            "1",
-            "--theta0",
-            "2.1",
-            "--periods",
-            "1",
-            "--out",
-            o,
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
+        let mut v: Vec<String> = trajectory_args(&["--periods", "1", "--out", o])
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
         for pair in extra.chunks(2) {
             if let Some(i) = v.iter().position(|a| a == pair[0]) {
                 v[i + 1] = pair[1].to_string();
