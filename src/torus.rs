@@ -35,30 +35,6 @@ pub struct Component {
     pub kind: MotionKind,
 }
 
-impl Component {
-    /// Whether θ lies in this component (for κ = 0, modulo 2π on the circle).
-    pub fn contains(&self, theta: f64) -> bool {
-        match self.kind {
-            MotionKind::Rotation => true,
-            _ => {
-                let lift = |t: f64| {
-                    let mut t = t;
-                    while t < self.theta_min - PI {
-                        t += TAU;
-                    }
-                    while t > self.theta_min + PI {
-                        t -= TAU;
-                    }
-                    t
-                };
-                let t = lift(theta);
-                t >= self.theta_min && t <= self.theta_max
-                    || (theta >= self.theta_min && theta <= self.theta_max)
-            }
-        }
-    }
-}
-
 /// Critical points of V(θ) = κ²/(2 sin²θ) + U(θ) in (0, π) for κ ≠ 0, found as the roots of
 /// the pole-free function sin³θ V′(θ) = −κ² cosθ + sin³θ U′(θ), sorted.
 pub fn critical_points<S: Shape>(system: &ReducedSystem<'_, S>) -> Vec<f64> {
