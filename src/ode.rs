@@ -1,4 +1,4 @@
-//! A thin wrapper around the DOP853 integrator of the `ode_solvers` crate: dense output on a
+//! A thin wrapper around the DOP853 integrator of the `ode_solvers` crate: samples on a
 //! uniform time grid, tolerances as one knob, failures as typed errors.
 
 use crate::error::{AtlasError, Result};
@@ -21,7 +21,7 @@ impl<const N: usize, R: Rate<N>> System<f64, SVector<f64, N>> for Adapter<'_, R>
 
 /// Samples of a solution on the grid t = 0, dt, 2 dt, …, t_end.
 #[derive(Debug, Clone)]
-pub struct DenseSolution<const N: usize> {
+pub struct SampledSolution<const N: usize> {
     pub times: Vec<f64>,
     pub states: Vec<SVector<f64, N>>,
 }
@@ -32,13 +32,13 @@ pub struct DenseSolution<const N: usize> {
 /// Each output interval is integrated on its own, ending exactly at its sample time, rather
 /// than read from the method's dense output: the interpolant of `ode_solvers` 0.6 was measured
 /// off by 6e-7 at the end of a long step (tol 1e-13), far above the step error.
-pub fn integrate_dense<const N: usize, R: Rate<N>>(
+pub fn integrate_sampled<const N: usize, R: Rate<N>>(
     rate: &R,
     y0: SVector<f64, N>,
     t_end: f64,
     samples: usize,
     tol: f64,
-) -> Result<DenseSolution<N>> {
+) -> Result<SampledSolution<N>> {
     let samples = samples.max(1);
     let mut times = Vec::with_capacity(samples + 1);
     let mut states = Vec::with_capacity(samples + 1);
@@ -92,5 +92,5 @@ pub fn integrate_dense<const N: usize, R: Rate<N>>(
         times.push(t1);
         states.push(y);
     }
-    Ok(DenseSolution { times, states })
+    Ok(SampledSolution { times, states })
 }

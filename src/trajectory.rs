@@ -5,7 +5,7 @@
 use crate::body::{Body, Shape};
 use crate::error::{AtlasError, Result};
 use crate::full::{FullState, FullSystem, FULL_STATE_LEN};
-use crate::ode::{integrate_dense, Rate};
+use crate::ode::{integrate_sampled, Rate};
 use crate::reduced::ReducedSystem;
 use crate::torus::{components, period_integrals, Component, MotionKind};
 use nalgebra::SVector;
@@ -160,7 +160,7 @@ pub fn integrate<S: Shape>(
         Model::Reduced => {
             let sys = ReducedSystem::new(body, start.kappa);
             let y0 = ReducedState::from([start.theta0, start.theta_dot0, 0.0, 0.0, 0.0, 0.0]);
-            let sol = integrate_dense(&sys, y0, t_end, samples, tol)?;
+            let sol = integrate_sampled(&sys, y0, t_end, samples, tol)?;
             for (t, y) in sol.times.iter().zip(&sol.states) {
                 let (dx, dy) = sys.contact_offset(y[0], y[3]);
                 out.t.push(*t);
@@ -186,7 +186,7 @@ pub fn integrate<S: Shape>(
                 0.0,
                 0.0,
             );
-            let sol = integrate_dense(&sys, y0, t_end, samples, tol)?;
+            let sol = integrate_sampled(&sys, y0, t_end, samples, tol)?;
             let mut prev: Option<(f64, f64)> = None;
             for (t, y) in sol.times.iter().zip(&sol.states) {
                 let (theta, phi, psi) = FullSystem::<S>::euler_angles(y);
