@@ -10,6 +10,39 @@
 use crate::error::{check_range, Result};
 use nalgebra::Vector3;
 
+/// An angle θ given by its sine and cosine, both to full relative precision. Near θ = π a
+/// double holds θ only to an absolute 4e-16, so callers build the pair from π − θ there
+/// (SPEC §2.3); on the κ = 0 circle θ may be any real number.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Angle {
+    /// sin θ.
+    pub sin: f64,
+    /// cos θ.
+    pub cos: f64,
+}
+
+impl Angle {
+    /// The angle θ itself.
+    #[inline]
+    pub fn new(theta: f64) -> Self {
+        let (sin, cos) = theta.sin_cos();
+        Self { sin, cos }
+    }
+
+    /// The angle π − φ, from its distance φ to the pole θ = π.
+    #[inline]
+    pub fn from_pi(phi: f64) -> Self {
+        let (sin, cos) = phi.sin_cos();
+        Self { sin, cos: -cos }
+    }
+
+    /// θ in [0, π] (only for the generic fallbacks; loses precision near the poles).
+    #[inline]
+    pub fn theta(self) -> f64 {
+        self.sin.atan2(self.cos)
+    }
+}
+
 /// A convex surface of revolution about e3, with the centre of mass on the axis.
 ///
 /// Units: the semi-axis b3 (or any length the shape chooses) is the unit of length. Angles:
@@ -66,6 +99,49 @@ pub trait Shape: Send + Sync {
         let (s, c) = theta.sin_cos();
         2.0 * (c1 * d1 * s * s + c1 * c1 * s * c + c2 * d2)
     }
+
+    /// U at an angle given by its sine and cosine (the cell solver's form).
+    #[inline]
+    fn potential_at(&self, a: Angle) -> f64 {
+        self.potential(a.theta())
+    }
+
+    /// U′ at an angle given by its sine and cosine.
+    #[inline]
+    fn potential_prime_at(&self, a: Angle) -> f64 {
+        self.potential_prime(a.theta())
+    }
+
+    /// |r|² at an angle given by its sine and cosine.
+    #[inline]
+    fn contact_distance_sq_at(&self, a: Angle) -> f64 {
+        self.contact_distance_sq(a.theta())
+    }
+
+    /// The divided difference (U(x) − U(y)) / sin(x − y), which tends to U′(y) as x → y.
+    /// `sin_diff` = sin(x − y) and `cos_diff` = cos(x − y) come from the caller, who knows
+    /// x − y exactly. Shapes override this with a form free of cancellation; this default
+    /// subtracts and is only as good as U's rounding allows.
+    /// Returns the value and its rounding scale (the sum of the magnitudes of the terms that
+    /// were added, so that its absolute rounding error is a few ulps of that scale).
+    #[inline]
+    fn potential_divided_difference(
+        &self,
+        x: Angle,
+        y: Angle,
+        sin_diff: f64,
+        cos_diff: f64,
+    ) -> (f64, f64) {
+        let _ = cos_diff;
+        let (ux, uy) = (self.potential_at(x), self.potential_at(y));
+        ((ux - uy) / sin_diff, (ux.abs() + uy.abs()) / sin_diff.abs())
+    }
+
+    /// U and |r|² together (shapes override this to share work between the two).
+    #[inline]
+    fn potential_and_contact_distance_sq_at(&self, a: Angle) -> (f64, f64) {
+        (self.potential_at(a), self.contact_distance_sq_at(a))
+    }
 }
 
 /// An ellipsoid of revolution with semi-axes b1 = β (equatorial) and b3 = 1 (axial), its
@@ -97,6 +173,12 @@ impl Ellipsoid {
     pub fn centre_height(&self, theta: f64) -> f64 {
         let (s, c) = theta.sin_cos();
         (self.beta * self.beta * s * s + c * c).sqrt()
+    }
+
+    /// Z at an angle given by its sine and cosine.
+    #[inline]
+    pub fn centre_height_at(&self, a: Angle) -> f64 {
+        (self.beta * self.beta * a.sin * a.sin + a.cos * a.cos).sqrt()
     }
 
     /// Z′(θ) = (β² − 1) sinθ cosθ / Z.
@@ -169,11 +251,54 @@ impl Shape for Ellipsoid {
     /// (αZ − cosθ)², a misprint).
     #[inline]
     fn contact_distance_sq(&self, theta: f64) -> f64 {
-        let (s, c) = theta.sin_cos();
-        let z = self.centre_height(theta);
+        self.contact_distance_sq_at(Angle::new(theta))
+    }
+
+    #[inline]
+    fn potential_at(&self, a: Angle) -> f64 {
+        self.centre_height_at(a) + self.alpha * a.cos
+    }
+
+    #[inline]
+    fn potential_prime_at(&self, a: Angle) -> f64 {
+        a.sin * ((self.beta * self.beta - 1.0) * a.cos / self.centre_height_at(a) - self.alpha)
+    }
+
+    #[inline]
+    fn contact_distance_sq_at(&self, a: Angle) -> f64 {
+        let z = self.centre_height_at(a);
         let b2 = self.beta * self.beta;
-        let w = c + self.alpha * z;
-        (b2 * b2 * s * s + w * w) / (z * z)
+        let w = a.cos + self.alpha * z;
+        (b2 * b2 * a.sin * a.sin + w * w) / (z * z)
+    }
+
+    /// (U(x) − U(y)) / sin(x − y) without cancellation, from Z(x)² − Z(y)² = (β² − 1)
+    /// sin(x − y) sin(x + y) and cos x − cos y = −sin(x − y) (sin x + sin y) / (1 + cos(x − y)):
+    /// (β² − 1) sin(x + y) / (Z(x) + Z(y)) − α (sin x + sin y) / (1 + cos(x − y)).
+    #[inline]
+    fn potential_divided_difference(
+        &self,
+        x: Angle,
+        y: Angle,
+        _sin_diff: f64,
+        cos_diff: f64,
+    ) -> (f64, f64) {
+        let sin_sum = x.sin * y.cos + x.cos * y.sin;
+        let shape = (self.beta * self.beta - 1.0) * sin_sum
+            / (self.centre_height_at(x) + self.centre_height_at(y));
+        let offset = self.alpha * (x.sin + y.sin) / (1.0 + cos_diff);
+        (shape - offset, shape.abs() + offset.abs())
+    }
+
+    #[inline]
+    fn potential_and_contact_distance_sq_at(&self, a: Angle) -> (f64, f64) {
+        let z = self.centre_height_at(a);
+        let b2 = self.beta * self.beta;
+        let w = a.cos + self.alpha * z;
+        (
+            z + self.alpha * a.cos,
+            (b2 * b2 * a.sin * a.sin + w * w) / (z * z),
+        )
     }
 }
 
@@ -187,6 +312,17 @@ pub struct Body<S: Shape> {
     pub nu: f64,
     /// η = m b3² / i1 > 0.
     pub eta: f64,
+}
+
+/// U, B and J at one angle: everything the reduction takes from the body.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Reduction {
+    /// U, the height of the centre of mass.
+    pub potential: f64,
+    /// B = 1/η + |r|².
+    pub reduced_inertia: f64,
+    /// J = √((cos²θ + ν sin²θ)/η + U²).
+    pub integral_factor: f64,
 }
 
 /// The paper's body: an ellipsoid of revolution.
@@ -228,6 +364,24 @@ impl<S: Shape> Body<S> {
     #[inline]
     pub fn reduced_inertia_prime(&self, theta: f64) -> f64 {
         self.shape.contact_distance_sq_prime(theta)
+    }
+
+    /// B at an angle given by its sine and cosine.
+    #[inline]
+    pub fn reduced_inertia_at(&self, a: Angle) -> f64 {
+        1.0 / self.eta + self.shape.contact_distance_sq_at(a)
+    }
+
+    /// U, B and J at one angle, sharing the work (the cell solver's inner loop).
+    #[inline]
+    pub fn reduction_at(&self, a: Angle) -> Reduction {
+        let (potential, r2) = self.shape.potential_and_contact_distance_sq_at(a);
+        let j2 = (a.cos * a.cos + self.nu * a.sin * a.sin) / self.eta + potential * potential;
+        Reduction {
+            potential,
+            reduced_inertia: 1.0 / self.eta + r2,
+            integral_factor: j2.sqrt(),
+        }
     }
 
     /// J(θ) = √((cos²θ + ν sin²θ)/η + U²): the integral F2 = J ω3 (paper §2.3 `sec_inv`,

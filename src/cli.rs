@@ -2,6 +2,7 @@
 
 use anyhow::{Context, Result};
 use clap::{ArgGroup, Args, Parser, Subcommand, ValueEnum};
+use rubber_atlas::cell::{solve_cell, CellOptions, ComponentResult, Method};
 use rubber_atlas::critical::CriticalSet;
 use rubber_atlas::error::AtlasError;
 use rubber_atlas::store::{write_table, Column};
@@ -24,6 +25,50 @@ pub enum Command {
     Diagram(DiagramArgs),
     /// θ, ψ, φ, centre of mass and contact point over time, from the reduced or the full model.
     Trajectory(TrajectoryArgs),
+    /// One cell (κ, ε): per component of the allowed set ω_θ, ω_ψ, the rotation number N, the
+    /// drift |Δζ| and radius R, bounded or not, status and error estimates.
+    Cell(CellArgs),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum MethodArg {
+    /// Tanh-sinh quadrature between the turning points (fast).
+    Quadrature,
+    /// DOP853 over one θ-period with event location (the independent check).
+    Ode,
+}
+
+#[derive(Debug, Args)]
+#[command(group(ArgGroup::new("start").required(true).args(["energy", "theta0"])))]
+pub struct CellArgs {
+    #[command(flatten)]
+    pub level: LevelArgs,
+    /// Energy ε: every component of the level set.
+    #[arg(long, allow_negative_numbers = true)]
+    pub energy: Option<f64>,
+    /// Initial inclination θ(0): only the component that holds it (ε = V(θ0) + B θ̇0²/2).
+    #[arg(long, allow_negative_numbers = true)]
+    pub theta0: Option<f64>,
+    /// Initial θ̇(0) (with --theta0).
+    #[arg(
+        long,
+        default_value_t = 0.0,
+        requires = "theta0",
+        allow_negative_numbers = true
+    )]
+    pub theta_dot0: f64,
+    /// Accuracy: relative for T, ω, drift; absolute for N. 1e-15 <= TOL <= 0.1.
+    #[arg(long, default_value_t = 1e-10, allow_negative_numbers = true)]
+    pub tol: f64,
+    /// How to compute the period integrals.
+    #[arg(long, value_enum, default_value_t = MethodArg::Quadrature)]
+    pub method: MethodArg,
+    /// |N − round(N)| at or below this (or N's error estimate) counts as a resonance.
+    #[arg(long, default_value_t = 1e-9, allow_negative_numbers = true)]
+    pub resonance_tol: f64,
+    /// Print one JSON object (keys of SPEC §3.1).
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// α and β of the ellipsoid.
@@ -35,6 +80,34 @@ pub struct ShapeArgs {
     /// β = b1/b3: < 1 prolate, > 1 oblate, 1 sphere.
     #[arg(long, allow_negative_numbers = true)]
     pub beta: f64,
+}
+
+/// The body (α, β, ν, η) and κ: what a level set of the reduced system needs besides ε.
+#[derive(Debug, Args)]
+pub struct LevelArgs {
+    #[command(flatten)]
+    pub shape: ShapeArgs,
+    /// ν = i3/i1, 0 < ν <= 2.
+    #[arg(long, allow_negative_numbers = true)]
+    pub nu: f64,
+    /// η = m b3²/i1 > 0.
+    #[arg(long, allow_negative_numbers = true)]
+    pub eta: f64,
+    /// κ, the value of the integral F2 = J ω3.
+    #[arg(long, allow_negative_numbers = true)]
+    pub kappa: f64,
+}
+
+impl LevelArgs {
+    /// The validated body.
+    fn body(&self) -> Result<EllipsoidBody> {
+        Ok(EllipsoidBody::ellipsoid(
+            self.shape.alpha,
+            self.shape.beta,
+            self.nu,
+            self.eta,
+        )?)
+    }
 }
 
 #[derive(Debug, Args)]
@@ -74,16 +147,7 @@ pub enum ModelArg {
 #[command(group(ArgGroup::new("length").required(true).args(["periods", "t_end"])))]
 pub struct TrajectoryArgs {
     #[command(flatten)]
-    pub shape: ShapeArgs,
-    /// ν = i3/i1, 0 < ν <= 2.
-    #[arg(long, allow_negative_numbers = true)]
-    pub nu: f64,
-    /// η = m b3²/i1 > 0.
-    #[arg(long, allow_negative_numbers = true)]
-    pub eta: f64,
-    /// κ, the value of the integral F2 = J ω3.
-    #[arg(long, allow_negative_numbers = true)]
-    pub kappa: f64,
+    pub level: LevelArgs,
     /// Energy ε: start at the lower turning point of component --component, θ̇ = 0.
     #[arg(long, allow_negative_numbers = true)]
     pub energy: Option<f64>,
@@ -126,7 +190,103 @@ pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Diagram(args) => diagram(args),
         Command::Trajectory(args) => trajectory(args),
+        Command::Cell(args) => cell(args),
     }
+}
+
+fn cell(args: CellArgs) -> Result<()> {
+    let body = args.level.body()?;
+    let options = CellOptions {
+        tol: args.tol,
+        method: match args.method {
+            MethodArg::Quadrature => Method::Quadrature,
+            MethodArg::Ode => Method::Ode,
+        },
+        drift: true,
+        resonance_tol: args.resonance_tol,
+    };
+    let (energy, theta0) = match (args.energy, args.theta0) {
+        (Some(e), _) => (e, None),
+        (None, Some(t)) => {
+            let start = Start {
+                kappa: args.level.kappa,
+                theta0: t,
+                theta_dot0: args.theta_dot0,
+            };
+            start.check()?;
+            (start.energy(&body), Some(t))
+        }
+        (None, None) => unreachable!("clap requires --energy or --theta0"),
+    };
+    let mut result = solve_cell(&body, args.level.kappa, energy, &options)?;
+    if let Some(t) = theta0 {
+        // Only the component that holds θ(0) (the nearest, against rounding at its ends).
+        let distance = |c: &ComponentResult| (c.theta_min - t).max(t - c.theta_max).max(0.0);
+        let nearest = result
+            .components
+            .iter()
+            .min_by(|a, b| distance(a).total_cmp(&distance(b)))
+            .cloned();
+        result.components = nearest.into_iter().collect();
+    }
+    if args.json {
+        let value = serde_json::json!({
+            "alpha": args.level.shape.alpha,
+            "beta": args.level.shape.beta,
+            "nu": args.level.nu,
+            "eta": args.level.eta,
+            "kappa": args.level.kappa,
+            "energy": energy,
+            "tol": args.tol,
+            "method": options.method,
+            "status": result.status,
+            "components": result.components,
+        });
+        println!("{}", serde_json::to_string_pretty(&value)?);
+        return Ok(());
+    }
+    println!(
+        "cell alpha={} beta={} nu={} eta={} kappa={} energy={} ({:?}, tol {:e}): {}",
+        args.level.shape.alpha,
+        args.level.shape.beta,
+        args.level.nu,
+        args.level.eta,
+        args.level.kappa,
+        energy,
+        options.method,
+        args.tol,
+        if result.components.is_empty() {
+            "no motion (energy below the minimum of V)".to_string()
+        } else {
+            format!("{} component(s)", result.components.len())
+        }
+    );
+    for (i, c) in result.components.iter().enumerate() {
+        println!(
+            "[{i}] {:?} on [{:.12}, {:.12}], status {:?}",
+            c.motion, c.theta_min, c.theta_max, c.status
+        );
+        let rows = [
+            ("period T", c.period, c.errors.period),
+            ("omega_theta", c.omega_theta, c.errors.omega_theta),
+            ("omega_psi", c.omega_psi, c.errors.omega_psi),
+            (
+                "rotation number N",
+                c.rotation_number,
+                c.errors.rotation_number,
+            ),
+            ("drift |dzeta|", c.drift, c.errors.drift),
+            ("drift radius R", c.drift_radius, c.errors.drift_radius),
+        ];
+        for (name, value, error) in rows {
+            println!("    {name:<18} {value:>22.15e}  ± {error:.1e}");
+        }
+        match c.bounded {
+            Some(b) => println!("    bounded            {b}"),
+            None => println!("    bounded            (not computed)"),
+        }
+    }
+    Ok(())
 }
 
 fn command_line() -> String {
@@ -293,11 +453,11 @@ fn write_diagram(out: &std::path::Path, set: &CriticalSet) -> Result<()> {
 }
 
 fn trajectory(args: TrajectoryArgs) -> Result<()> {
-    let body = EllipsoidBody::ellipsoid(args.shape.alpha, args.shape.beta, args.nu, args.eta)?;
-    if !args.kappa.is_finite() {
+    let body = args.level.body()?;
+    if !args.level.kappa.is_finite() {
         return Err(AtlasError::InvalidParameter {
             name: "kappa",
-            value: args.kappa,
+            value: args.level.kappa,
             reason: "must be a finite number",
         }
         .into());
@@ -329,31 +489,16 @@ fn trajectory(args: TrajectoryArgs) -> Result<()> {
                 }
                 .into());
             }
-            Start::at_energy(&body, args.kappa, e, args.component)?
+            Start::at_energy(&body, args.level.kappa, e, args.component)?
         }
         (None, Some(t)) => {
-            let valid =
-                t.is_finite() && (args.kappa == 0.0 || (t > 0.0 && t < std::f64::consts::PI));
-            if !valid {
-                return Err(AtlasError::InvalidInitialAngle {
-                    theta0: t,
-                    reason: "must be finite, and 0 < theta0 < pi when kappa != 0",
-                }
-                .into());
-            }
-            if !args.theta_dot0.is_finite() {
-                return Err(AtlasError::InvalidParameter {
-                    name: "theta-dot0",
-                    value: args.theta_dot0,
-                    reason: "must be a finite number",
-                }
-                .into());
-            }
-            Start {
-                kappa: args.kappa,
+            let start = Start {
+                kappa: args.level.kappa,
                 theta0: t,
                 theta_dot0: args.theta_dot0,
-            }
+            };
+            start.check()?;
+            start
         }
         _ => unreachable!("clap requires exactly one of --energy, --theta0"),
     };
@@ -409,10 +554,10 @@ fn trajectory(args: TrajectoryArgs) -> Result<()> {
         ),
         ("command_line", command_line()),
         ("model", format!("{:?}", model).to_lowercase()),
-        ("alpha", args.shape.alpha.to_string()),
-        ("beta", args.shape.beta.to_string()),
-        ("nu", args.nu.to_string()),
-        ("eta", args.eta.to_string()),
+        ("alpha", args.level.shape.alpha.to_string()),
+        ("beta", args.level.shape.beta.to_string()),
+        ("nu", args.level.nu.to_string()),
+        ("eta", args.level.eta.to_string()),
         ("kappa", start.kappa.to_string()),
         ("energy", start.energy(&body).to_string()),
         ("theta0", start.theta0.to_string()),

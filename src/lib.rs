@@ -24,14 +24,17 @@
 //! equations or a direct numerical search.
 
 pub mod body;
+pub mod cell;
 pub mod critical;
 pub mod error;
 pub mod full;
 pub mod ode;
+pub mod period_ode;
+pub mod quadrature;
 pub mod reduced;
 pub mod store;
 pub mod torus;
 pub mod trajectory;
 
-pub use body::{Body, Ellipsoid, EllipsoidBody, Shape};
+pub use body::{Angle, Body, Ellipsoid, EllipsoidBody, Shape};
 pub use error::{AtlasError, Result};

@@ -26,6 +26,49 @@ pub struct SampledSolution<const N: usize> {
     pub states: Vec<SVector<f64, N>>,
 }
 
+/// Runs DOP853 on `system` from (t0, y0) towards t1 (it may stop earlier when the system's
+/// `solout` asks to) at relative and absolute tolerance `tol`, first step `h0` (0: automatic).
+/// Returns the last time and state and the number of accepted steps.
+pub fn run_dop853<const N: usize, F: System<f64, SVector<f64, N>>>(
+    system: F,
+    t0: f64,
+    t1: f64,
+    y0: SVector<f64, N>,
+    tol: f64,
+    h0: f64,
+) -> Result<(f64, SVector<f64, N>, usize)> {
+    let mut solver = Dop853::from_param(
+        system,
+        t0,
+        t1,
+        t1 - t0,
+        y0,
+        tol,
+        tol,
+        0.9,
+        0.0,
+        0.333,
+        6.0,
+        t1 - t0,
+        h0,
+        u32::MAX,
+        1000,
+        OutputType::Sparse,
+    );
+    let stats = solver.integrate().map_err(|e| AtlasError::Integration {
+        time: t0,
+        reason: e.to_string(),
+    })?;
+    let (ts, ys) = (solver.x_out(), solver.y_out());
+    let (Some(&t_last), Some(y_last)) = (ts.last(), ys.last()) else {
+        return Err(AtlasError::Integration {
+            time: t0,
+            reason: "the integrator returned no step".into(),
+        });
+    };
+    Ok((t_last, *y_last, stats.accepted_steps as usize))
+}
+
 /// Integrates ẏ = f(y) from y(0) = `y0` to `t_end` with DOP853 at relative and absolute
 /// tolerance `tol`, returning the solution at `samples + 1` equally spaced times.
 ///
@@ -51,44 +94,16 @@ pub fn integrate_sampled<const N: usize, R: Rate<N>>(
             t_end * (i - 1) as f64 / samples as f64,
             t_end * i as f64 / samples as f64,
         );
-        let mut solver = Dop853::from_param(
-            Adapter(rate),
-            t0,
-            t1,
-            t1 - t0,
-            y,
-            tol,
-            tol,
-            0.9,
-            0.0,
-            0.333,
-            6.0,
-            t1 - t0,
-            // The previous interval's typical step seeds this one (0 = automatic choice).
-            h_last,
-            u32::MAX,
-            1000,
-            OutputType::Sparse,
-        );
-        let stats = solver.integrate().map_err(|e| AtlasError::Integration {
-            time: t0,
-            reason: e.to_string(),
-        })?;
-        let (ts, ys) = (solver.x_out(), solver.y_out());
-        let (Some(&t_last), Some(y_last)) = (ts.last(), ys.last()) else {
-            return Err(AtlasError::Integration {
-                time: t0,
-                reason: "the integrator returned no step".into(),
-            });
-        };
+        // The previous interval's typical step seeds this one (0 = automatic choice).
+        let (t_last, y_last, steps) = run_dop853(Adapter(rate), t0, t1, y, tol, h_last)?;
         if (t_last - t1).abs() > 1e-12 * t1.abs().max(1.0) {
             return Err(AtlasError::Integration {
                 time: t_last,
                 reason: format!("stopped before t = {t1}"),
             });
         }
-        h_last = (t1 - t0) / f64::from(stats.accepted_steps.max(1));
-        y = *y_last;
+        h_last = (t1 - t0) / steps.max(1) as f64;
+        y = y_last;
         times.push(t1);
         states.push(y);
     }

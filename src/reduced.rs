@@ -7,13 +7,21 @@ use crate::body::{Body, Shape};
 use nalgebra::Vector3;
 
 /// The θ-motion of a body at a fixed value κ of the linear integral F2 = J(θ) ω3.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug)]
 pub struct ReducedSystem<'a, S: Shape> {
     /// The body.
     pub body: &'a Body<S>,
     /// κ, the value of F2 (its sign is the direction of rolling).
     pub kappa: f64,
 }
+
+impl<S: Shape> Clone for ReducedSystem<'_, S> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<S: Shape> Copy for ReducedSystem<'_, S> {}
 
 impl<'a, S: Shape> ReducedSystem<'a, S> {
     /// The reduced system of `body` at F2 = `kappa`.

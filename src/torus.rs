@@ -1,20 +1,90 @@
-//! One level set (κ, ε) of the reduced system: its connected components (each an invariant
-//! torus of the full system), their turning points, and the integrals over one θ-period:
-//! the period T and the precession Δψ per period, hence ω_θ = 2π/T, ω_ψ = Δψ/T and the
-//! rotation number N = −Δψ/2π (paper §5, `fourier`, `dpsi`; SPEC §2).
+//! One level set (κ, ε) of the reduced system, computed by quadrature: the critical points of
+//! V (found once per (body, κ) and reused for every ε), the components of {V ≤ ε} (each an
+//! invariant torus), their turning points, and the integrals over one θ-period — the period
+//! T, the precession Δψ and the drift Δζ of the centre of mass (paper §5, `dpsi`; SPEC §2).
 //!
-//! The period integrals use θ = c + h sin u over a full turn of u (SPEC §2.3): the
-//! inverse-square-root singularity at the turning points disappears, the integrand is smooth
-//! and periodic, and the trapezoid rule converges exponentially. Nodes are doubled until two
-//! successive sums agree to the requested tolerance; their difference is the error estimate.
+//! Each component is cut at its turning points and at every critical point inside it; each
+//! piece is integrated in θ by the tanh-sinh rule, whose nodes crowd double-exponentially at
+//! the piece's ends, where the 1/√ singularity of a turning point, the near-logarithmic one of
+//! a nearby saddle and the narrow ψ̇ peak near a pole at small κ all sit. The gap ε − V(θ) is
+//! evaluated from the nearer end of the piece with the divided difference of V, so it keeps
+//! full relative precision right up to the turning points (SPEC §2.3).
 
-use crate::body::{Body, Shape};
+use crate::body::{Angle, Body, Shape};
 use crate::error::{AtlasError, Result};
+use crate::quadrature::{spectral_antiderivative, TanhSinhLevel, TanhSinhNode, FINEST_LEVEL};
 use crate::reduced::ReducedSystem;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
-/// How the θ-motion on a component looks.
+const EPS: f64 = f64::EPSILON;
+
+/// A point of the θ-axis, kept with its distance to the pole θ = π so that sin θ and cos θ
+/// have full relative precision near both poles. On the κ = 0 circle θ is the lifted angle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Site {
+    /// θ (for points near π, π − `from_pi` rounded).
+    pub theta: f64,
+    /// π − θ, exact for points that were found in this form.
+    pub from_pi: f64,
+}
+
+impl Site {
+    /// The point θ.
+    #[inline]
+    pub fn at(theta: f64) -> Self {
+        Self {
+            theta,
+            from_pi: PI - theta,
+        }
+    }
+
+    /// The point π − φ.
+    #[inline]
+    pub fn from_pi(phi: f64) -> Self {
+        Self {
+            theta: PI - phi,
+            from_pi: phi,
+        }
+    }
+
+    /// sin θ and cos θ, from whichever of θ and π − θ is held exactly.
+    #[inline]
+    pub fn angle(&self) -> Angle {
+        if self.theta <= FRAC_PI_2 {
+            Angle::new(self.theta)
+        } else {
+            Angle::from_pi(self.from_pi)
+        }
+    }
+}
+
+/// What kind of critical point of V a point is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CriticalKind {
+    /// A local minimum: a stable permanent rotation (κ ≠ 0) or equilibrium (κ = 0).
+    Minimum,
+    /// A local maximum: an unstable one; its level is a separatrix.
+    Maximum,
+    /// A degenerate critical point with V increasing or decreasing through it (a tangency).
+    Inflection,
+}
+
+/// A critical point of V.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CriticalPoint {
+    /// Where it is.
+    pub site: Site,
+    /// V there.
+    pub value: f64,
+    /// V″ there.
+    pub curvature: f64,
+    /// Minimum, maximum or inflection.
+    pub kind: CriticalKind,
+}
+
+/// How the θ-motion on a component looks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum MotionKind {
     /// θ oscillates between two turning points.
     Libration,
@@ -25,43 +95,896 @@ pub enum MotionKind {
 }
 
 /// A connected component {θ : V(θ) ≤ ε} of the allowed set.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Component {
-    /// Lower turning point (for κ = 0 it may be negative: θ is continued on the circle).
-    pub theta_min: f64,
-    /// Upper turning point.
-    pub theta_max: f64,
+    /// Lower turning point (for κ = 0 it may be negative: θ is continued on the circle; for a
+    /// rotation it is the top of U where the circle is cut).
+    pub lower: Site,
+    /// Upper turning point (for a rotation, `lower` + 2π).
+    pub upper: Site,
     /// Libration, fixed point or rotation.
     pub kind: MotionKind,
+    /// The critical points strictly inside, in order (lifted on the κ = 0 circle).
+    pub interior: Vec<CriticalPoint>,
+    /// The critical points at or just outside the lower and the upper end (none at a pole).
+    pub neighbours: [Option<CriticalPoint>; 2],
 }
 
-/// Critical points of V(θ) = κ²/(2 sin²θ) + U(θ) in (0, π) for κ ≠ 0, found as the roots of
-/// the pole-free function sin³θ V′(θ) = −κ² cosθ + sin³θ U′(θ), sorted.
-pub fn critical_points<S: Shape>(system: &ReducedSystem<'_, S>) -> Vec<f64> {
-    let k2 = system.kappa * system.kappa;
-    let g = |t: f64| {
-        let (s, c) = t.sin_cos();
-        -k2 * c + s * s * s * system.body.shape.potential_prime(t)
-    };
-    roots_by_scan(g, 0.0, PI, 2048)
-        .into_iter()
-        .filter(|&t| t > 0.0 && t < PI)
-        .collect()
-}
-
-/// Critical points of U on the circle [0, 2π): θ = 0, π, and the roots of U′ inside.
-pub fn potential_critical_points_on_circle<S: Shape>(body: &Body<S>) -> Vec<f64> {
-    let inner: Vec<f64> = roots_by_scan(|t| body.shape.potential_prime(t), 0.0, PI, 2048)
-        .into_iter()
-        .filter(|&t| t > 1e-12 && t < PI - 1e-12)
-        .collect();
-    let mut pts = vec![0.0, PI];
-    for &t in &inner {
-        pts.push(t);
-        pts.push(TAU - t);
+impl Component {
+    /// θ_min.
+    pub fn theta_min(&self) -> f64 {
+        self.lower.theta
     }
-    pts.sort_by(f64::total_cmp);
-    pts
+
+    /// θ_max.
+    pub fn theta_max(&self) -> f64 {
+        self.upper.theta
+    }
+
+    /// The lowest critical point inside (the centre of a libration).
+    pub fn minimum(&self) -> Option<&CriticalPoint> {
+        self.interior
+            .iter()
+            .filter(|c| c.kind == CriticalKind::Minimum)
+            .min_by(|a, b| a.value.total_cmp(&b.value))
+    }
+
+    /// Whether `theta` lies in [θ_min, θ_max].
+    pub fn contains(&self, theta: f64) -> bool {
+        self.lower.theta <= theta && theta <= self.upper.theta
+    }
+}
+
+/// V(θ) = κ²/(2 sin²θ) + U(θ) at one (body, κ) with its critical points: what every cell of a
+/// row of the atlas (fixed α, β, κ; varying ε) shares.
+#[derive(Debug, Clone)]
+pub struct EffectivePotential<'a, S: Shape> {
+    /// The body.
+    pub body: &'a Body<S>,
+    /// κ.
+    pub kappa: f64,
+    critical: Vec<CriticalPoint>,
+}
+
+/// Number of scan cells for critical points; between scan nodes the pole-free function
+/// sin³θ V′ is monotone unless its own derivative changes sign, and those roots are scanned too.
+const SCAN_CELLS: usize = 1024;
+
+impl<'a, S: Shape> EffectivePotential<'a, S> {
+    /// V of `body` at F2 = `kappa`, with its critical points in (0, π) (κ ≠ 0) or on the
+    /// circle [0, 2π) (κ = 0).
+    pub fn new(body: &'a Body<S>, kappa: f64) -> Self {
+        let mut v = Self {
+            body,
+            kappa,
+            critical: Vec::new(),
+        };
+        v.critical = v.find_critical_points();
+        v
+    }
+
+    /// The critical points, sorted by θ.
+    pub fn critical_points(&self) -> &[CriticalPoint] {
+        &self.critical
+    }
+
+    /// V at an angle.
+    #[inline]
+    pub fn value(&self, a: Angle) -> f64 {
+        let u = self.body.shape.potential_at(a);
+        if self.kappa == 0.0 {
+            u
+        } else {
+            0.5 * self.kappa * self.kappa / (a.sin * a.sin) + u
+        }
+    }
+
+    /// V′ at an angle: −κ² cosθ / sin³θ + U′.
+    #[inline]
+    pub fn slope(&self, a: Angle) -> f64 {
+        let up = self.body.shape.potential_prime_at(a);
+        if self.kappa == 0.0 {
+            up
+        } else {
+            -self.kappa * self.kappa * a.cos / (a.sin * a.sin * a.sin) + up
+        }
+    }
+
+    /// V″ at θ (away from the poles).
+    pub fn curvature(&self, theta: f64) -> f64 {
+        ReducedSystem::new(self.body, self.kappa).effective_potential_second(theta)
+    }
+
+    /// ψ̇ = −κ cosθ / (J sin²θ) at an angle (0 for κ = 0).
+    pub fn psi_rate(&self, a: Angle) -> f64 {
+        if self.kappa == 0.0 {
+            return 0.0;
+        }
+        let j = self.body.reduction_at(a).integral_factor;
+        -self.kappa * a.cos / (j * a.sin * a.sin)
+    }
+
+    fn find_critical_points(&self) -> Vec<CriticalPoint> {
+        let shape = &self.body.shape;
+        let k2 = self.kappa * self.kappa;
+        let (end, thetas) = if self.kappa != 0.0 {
+            // Roots of g = sin³θ V′ = −κ² cosθ + sin³θ U′ (no pole), bracketed between the
+            // roots of g′ = κ² sinθ + 3 sin²θ cosθ U′ + sin³θ U″ so that close pairs
+            // (near the cusp, tangencies) are not lost between scan nodes.
+            let g = |t: f64| {
+                let (s, c) = t.sin_cos();
+                -k2 * c + s * s * s * shape.potential_prime(t)
+            };
+            let dg = |t: f64| {
+                let (s, c) = t.sin_cos();
+                k2 * s
+                    + 3.0 * s * s * c * shape.potential_prime(t)
+                    + s * s * s * shape.potential_second(t)
+            };
+            (PI, roots_between_extrema(g, dg, PI))
+        } else {
+            // On the circle: roots of U′ on [0, 2π), with θ = 0 and π always among them.
+            let g = |t: f64| shape.potential_prime(t);
+            let dg = |t: f64| shape.potential_second(t);
+            let mut t: Vec<f64> = roots_between_extrema(g, dg, PI)
+                .into_iter()
+                .filter(|&t| t > 1e-9 && t < PI - 1e-9)
+                .collect();
+            let mirrored: Vec<f64> = t.iter().rev().map(|x| TAU - x).collect();
+            t.insert(0, 0.0);
+            t.push(PI);
+            t.extend(mirrored);
+            (TAU, t)
+        };
+        let mut points: Vec<CriticalPoint> = thetas
+            .into_iter()
+            .filter(|&t| self.kappa == 0.0 || (t > 0.0 && t < end))
+            .map(|t| {
+                let site = if self.kappa != 0.0 && t > FRAC_PI_2 {
+                    Site::from_pi(PI - t)
+                } else {
+                    Site::at(t)
+                };
+                CriticalPoint {
+                    site,
+                    value: self.value(site.angle()),
+                    curvature: self.curvature(t),
+                    kind: CriticalKind::Inflection,
+                }
+            })
+            .collect();
+        // Classify by comparing with the neighbours (poles count as +∞ for κ ≠ 0; on the
+        // circle the neighbours wrap around).
+        let n = points.len();
+        let values: Vec<f64> = points.iter().map(|p| p.value).collect();
+        for (i, p) in points.iter_mut().enumerate() {
+            let (left, right) = if self.kappa != 0.0 {
+                (
+                    if i == 0 { f64::INFINITY } else { values[i - 1] },
+                    if i + 1 == n {
+                        f64::INFINITY
+                    } else {
+                        values[i + 1]
+                    },
+                )
+            } else {
+                (values[(i + n - 1) % n], values[(i + 1) % n])
+            };
+            p.kind = if p.value < left && p.value < right {
+                CriticalKind::Minimum
+            } else if p.value > left && p.value > right {
+                CriticalKind::Maximum
+            } else if p.curvature > 0.0 {
+                CriticalKind::Minimum
+            } else if p.curvature < 0.0 && (p.value >= left || p.value >= right) {
+                CriticalKind::Maximum
+            } else {
+                CriticalKind::Inflection
+            };
+        }
+        points
+    }
+
+    /// The components of {V ≤ ε}, sorted by θ_min. For κ ≠ 0 they lie in (0, π); for κ = 0
+    /// the motion lives on the circle and a component may straddle θ = 0 (then θ_min < 0) or
+    /// be the whole circle (rolling over the top, [`MotionKind::Rotation`]).
+    pub fn components(&self, energy: f64) -> Result<Vec<Component>> {
+        if !energy.is_finite() {
+            return Err(AtlasError::InvalidParameter {
+                name: "energy",
+                value: energy,
+                reason: "must be finite",
+            });
+        }
+        // Nodes: the critical points between the two poles (κ ≠ 0), or around the circle
+        // starting and ending at the highest one (κ = 0); V is monotone between nodes.
+        let mut nodes: Vec<Option<CriticalPoint>> = Vec::with_capacity(self.critical.len() + 2);
+        if self.kappa != 0.0 {
+            nodes.push(None);
+            nodes.extend(self.critical.iter().copied().map(Some));
+            nodes.push(None);
+        } else {
+            let (top, peak) = self
+                .critical
+                .iter()
+                .enumerate()
+                .max_by(|a, b| a.1.value.total_cmp(&b.1.value))
+                .expect("θ = 0 and π are always critical on the circle");
+            let lift = |p: &CriticalPoint, by: f64| CriticalPoint {
+                site: Site::at(p.site.theta + by),
+                ..*p
+            };
+            // Keep lifted angles near [−π, π] so that components around θ = 0 straddle it.
+            let shift = if peak.site.theta > PI - 1e-9 {
+                -TAU
+            } else {
+                0.0
+            };
+            nodes.extend(self.critical[top..].iter().map(|p| Some(lift(p, shift))));
+            nodes.extend(
+                self.critical[..top]
+                    .iter()
+                    .map(|p| Some(lift(p, shift + TAU))),
+            );
+            nodes.push(Some(lift(peak, shift + TAU)));
+            if energy > peak.value {
+                let (first, last) = (nodes[0].unwrap(), nodes[nodes.len() - 1].unwrap());
+                return Ok(vec![Component {
+                    lower: first.site,
+                    upper: last.site,
+                    kind: MotionKind::Rotation,
+                    interior: nodes[1..nodes.len() - 1]
+                        .iter()
+                        .flatten()
+                        .copied()
+                        .collect(),
+                    neighbours: [None, None],
+                }]);
+            }
+        }
+        let value = |n: &Option<CriticalPoint>| n.map_or(f64::INFINITY, |p| p.value);
+        let minimum = nodes.iter().map(value).fold(f64::INFINITY, f64::min);
+        if energy < minimum {
+            return Err(AtlasError::NoMotion { energy, minimum });
+        }
+        let inside = |i: usize| value(&nodes[i]) <= energy;
+        let mut comps = Vec::new();
+        let mut start: Option<(Site, usize)> = inside(0).then(|| (nodes[0].unwrap().site, 0));
+        for i in 0..nodes.len() - 1 {
+            if inside(i) == inside(i + 1) {
+                continue;
+            }
+            let crossing = self.turning_point(&nodes[i], &nodes[i + 1], energy);
+            if inside(i) {
+                let (lower, first) = start.take().unwrap_or((nodes[i].unwrap().site, i));
+                comps.push(self.make_component(&nodes, lower, first, crossing, i, energy));
+            } else {
+                start = Some((crossing, i + 1));
+            }
+        }
+        if let Some((lower, first)) = start {
+            // Only on the circle: the level reaches the top itself (a separatrix).
+            let last = nodes.len() - 1;
+            let upper = nodes[last].unwrap().site;
+            comps.push(self.make_component(&nodes, lower, first, upper, last, energy));
+        }
+        Ok(comps)
+    }
+
+    /// The component between `lower` and `upper`, whose interior holds nodes first..=last
+    /// (the nodes equal to an end are not interior).
+    fn make_component(
+        &self,
+        nodes: &[Option<CriticalPoint>],
+        lower: Site,
+        first: usize,
+        upper: Site,
+        last: usize,
+        energy: f64,
+    ) -> Component {
+        let interior: Vec<CriticalPoint> = nodes[first..=last]
+            .iter()
+            .flatten()
+            .filter(|p| p.site.theta > lower.theta && p.site.theta < upper.theta)
+            .copied()
+            .collect();
+        // The critical point at or just beyond each end (a separatrix level touches it).
+        let at = |i: usize, site: Site| nodes[i].filter(|p| p.site.theta == site.theta);
+        let neighbours = [
+            at(first, lower).or_else(|| first.checked_sub(1).and_then(|i| nodes[i])),
+            at(last, upper).or_else(|| nodes.get(last + 1).copied().flatten()),
+        ];
+        let at_minimum = interior.len() == 1
+            && interior[0].kind == CriticalKind::Minimum
+            && energy - interior[0].value <= 4.0 * EPS * interior[0].value.abs().max(1.0);
+        if at_minimum {
+            let m = interior[0];
+            return Component {
+                lower: m.site,
+                upper: m.site,
+                kind: MotionKind::FixedPoint,
+                interior: vec![m],
+                neighbours,
+            };
+        }
+        Component {
+            lower,
+            upper,
+            kind: MotionKind::Libration,
+            interior,
+            neighbours,
+        }
+    }
+
+    /// The root of V = ε between two adjacent nodes (V monotone between them; `None` is a
+    /// pole), by Newton's method safeguarded with bisection, in θ on (0, π/2] and in π − θ on
+    /// [π/2, π) so that turning points near θ = π keep their relative precision.
+    fn turning_point(
+        &self,
+        a: &Option<CriticalPoint>,
+        b: &Option<CriticalPoint>,
+        energy: f64,
+    ) -> Site {
+        let lo = a.map_or(0.0, |p| p.site.theta);
+        let hi = b.map_or(PI, |p| p.site.theta);
+        let f_left = |x: f64| {
+            let s = Site::at(x);
+            let a = s.angle();
+            (self.value(a) - energy, self.slope(a))
+        };
+        if self.kappa == 0.0 || hi <= FRAC_PI_2 {
+            return Site::at(safe_newton(f_left, lo, hi));
+        }
+        let f_right = |phi: f64| {
+            let a = Angle::from_pi(phi);
+            (self.value(a) - energy, -self.slope(a))
+        };
+        let phi_lo = b.map_or(0.0, |p| p.site.from_pi);
+        if lo >= FRAC_PI_2 {
+            let phi_hi = a.map_or(PI, |p| p.site.from_pi);
+            return Site::from_pi(safe_newton(f_right, phi_lo, phi_hi));
+        }
+        // The bracket straddles π/2: pick the half with the sign change.
+        let mid = f_left(FRAC_PI_2).0;
+        let lo_val = a.map_or(f64::INFINITY, |p| p.value) - energy;
+        if mid == 0.0 {
+            Site::at(FRAC_PI_2)
+        } else if (mid < 0.0) != (lo_val < 0.0) {
+            Site::at(safe_newton(f_left, lo, FRAC_PI_2))
+        } else {
+            Site::from_pi(safe_newton(f_right, phi_lo, FRAC_PI_2))
+        }
+    }
+
+    /// T, Δψ and (if `with_drift`) Δζ of a libration or rotation by tanh-sinh quadrature,
+    /// refined until the level-to-level change is within `tol` (relative for T and Δζ,
+    /// absolute for N = −Δψ/2π); the error estimates add a bound on the rounding errors of
+    /// the gap ε − V.
+    pub fn integrate(
+        &self,
+        energy: f64,
+        component: &Component,
+        tol: f64,
+        with_drift: bool,
+    ) -> Result<QuadratureIntegrals> {
+        if component.kind == MotionKind::FixedPoint {
+            return Err(AtlasError::NotPeriodic {
+                reason: "the component is a fixed point",
+            });
+        }
+        let pieces = self.pieces(energy, component);
+        let mut samples: Vec<PieceSamples> = pieces
+            .iter()
+            .map(|p| PieceSamples::new(self, p, energy, START_LEVEL))
+            .collect::<Result<_>>()?;
+        let double = if component.kind == MotionKind::Rotation {
+            1.0
+        } else {
+            2.0
+        };
+        let share = 1.0 / pieces.len() as f64;
+        let mut converged = true;
+        for (piece, sample) in pieces.iter().zip(samples.iter_mut()) {
+            // Half of the tolerance for the quadrature, half left for rounding.
+            while sample.period_error() > 0.5 * tol * sample.period(0)
+                || double * sample.psi_error() / TAU > 0.5 * tol * share
+            {
+                if sample.level >= MAX_LEVEL {
+                    converged = false;
+                    break;
+                }
+                sample.refine(self, piece, energy)?;
+            }
+        }
+        let sum = |f: &dyn Fn(&PieceSamples) -> f64| samples.iter().map(f).sum::<f64>();
+        let period = double * sum(&|s| s.period(0));
+        let psi_advance = double * sum(&|s| s.psi(0));
+        let mut period_error = double * sum(&|s| s.period_error());
+        let mut psi_advance_error = double * sum(&|s| s.psi_error());
+        let period_rounding = double * sum(&|s| s.period_rounding());
+        let psi_rounding = double * sum(&|s| s.psi_rounding());
+        // Sensitivity to the energy near a saddle (inside the component or just beyond an
+        // end): T grows like −log|ε − V_s| / λ there, so a rounding-level error in the gap
+        // moves T by about ulp(V_s) / (λ |ε − V_s|) per passage.
+        let (mut saddle_t, mut saddle_psi) = (0.0, 0.0);
+        for (p, passes) in component
+            .interior
+            .iter()
+            .map(|p| (p, double))
+            .chain(component.neighbours.iter().flatten().map(|p| (p, 1.0)))
+        {
+            if p.kind == CriticalKind::Minimum {
+                continue;
+            }
+            let a = p.site.angle();
+            let b = self.body.reduction_at(a).reduced_inertia;
+            let lambda = (p.curvature.abs() / b).sqrt().max(1e-300);
+            let gap = (energy - p.value).abs().max(EPS * p.value.abs().max(1.0));
+            let dt = passes * 4.0 * EPS * p.value.abs().max(1.0) / (lambda * gap);
+            saddle_t += dt;
+            saddle_psi += dt * self.psi_rate(a).abs();
+        }
+        period_error += period_rounding + saddle_t;
+        psi_advance_error += psi_rounding + saddle_psi;
+        let mut drift = None;
+        if with_drift {
+            let mut result = drift_estimate(&samples, psi_advance, double);
+            for _ in 0..(MAX_LEVEL - START_LEVEL) {
+                if result.error <= tol * result.scale
+                    || samples.iter().any(|s| s.level >= MAX_LEVEL)
+                {
+                    break;
+                }
+                for (piece, sample) in pieces.iter().zip(samples.iter_mut()) {
+                    sample.refine(self, piece, energy)?;
+                }
+                let psi = double * samples.iter().map(|s| s.psi(0)).sum::<f64>();
+                result = drift_estimate(&samples, psi, double);
+            }
+            converged &= result.error <= tol * result.scale;
+            // Rounding in T and Δψ enters the drift through the phases and the weights.
+            let phase = period_rounding / period.max(1e-300) + psi_rounding + saddle_psi;
+            result.error += phase * result.scale;
+            drift = Some(result);
+        }
+        converged &= period_error <= tol * period && psi_advance_error / TAU <= tol;
+        Ok(QuadratureIntegrals {
+            period,
+            psi_advance,
+            period_error,
+            psi_advance_error,
+            drift,
+            evaluations: samples.iter().map(|s| s.evaluations).sum(),
+            converged,
+        })
+    }
+
+    /// The pieces of a component: cut at the ends and at every interior maximum or tangency.
+    fn pieces(&self, energy: f64, component: &Component) -> Vec<Piece> {
+        let end = |site: Site, turning: bool| PieceEnd {
+            site,
+            angle: site.angle(),
+            excess: if turning {
+                0.0
+            } else {
+                energy - self.value(site.angle())
+            },
+        };
+        let turning = component.kind == MotionKind::Libration;
+        let mut ends = vec![end(component.lower, turning)];
+        // Minima are harmless inside a piece; maxima and tangencies are near-singular points.
+        ends.extend(
+            component
+                .interior
+                .iter()
+                .filter(|p| p.kind != CriticalKind::Minimum)
+                .map(|p| end(p.site, false)),
+        );
+        ends.push(end(component.upper, turning));
+        ends.windows(2)
+            .map(|w| {
+                let (l, r) = (w[0], w[1]);
+                let length = if self.kappa != 0.0 && l.site.theta > FRAC_PI_2 {
+                    l.site.from_pi - r.site.from_pi
+                } else {
+                    r.site.theta - l.site.theta
+                };
+                Piece {
+                    left: l,
+                    right: r,
+                    length,
+                }
+            })
+            .collect()
+    }
+}
+
+/// Δζ over one θ-period from θ_min (ψ = 0 there), on the current levels, and again on the
+/// levels below for the error estimate. For a libration the way back is the way out
+/// mirrored: at θ on the way back ψ = Δψ − ψ_out(θ) and p dt = −dθ, so
+/// Δζ = −∫ U [a t′ (e^{iψ} + e^{i(Δψ−ψ)}) + i (e^{iψ} − e^{i(Δψ−ψ)})] dθ over [θ_min, θ_max]
+/// with a = κ/(J sinθ), t′ = dt/dθ (from ζ̇ = −U e^{iψ}(a + i p), see
+/// [`crate::reduced::ReducedSystem::centre_velocity`]).
+fn drift_estimate(samples: &[PieceSamples], psi_advance: f64, double: f64) -> DriftEstimate {
+    let level = |stride_exp: u32| {
+        let psi = if stride_exp == 0 {
+            psi_advance
+        } else {
+            double * samples.iter().map(|s| s.psi(stride_exp)).sum::<f64>()
+        };
+        drift_sum(samples, psi, double, 1 << stride_exp)
+    };
+    let (fine, mid, coarse) = (level(0), level(1), level(2));
+    let (d1, d2) = (
+        (fine.0[0] - mid.0[0]).hypot(fine.0[1] - mid.0[1]),
+        (mid.0[0] - coarse.0[0]).hypot(mid.0[1] - coarse.0[1]),
+    );
+    // The geometric model of [`level_error`], on the complex sums.
+    let error = if d2 > 0.0 && d1 <= 0.1 * d2 {
+        d1 * d1 / d2
+    } else {
+        d1
+    };
+    DriftEstimate {
+        value: fine.0,
+        error: error.max(8.0 * EPS * fine.1),
+        scale: fine.1,
+    }
+}
+
+/// Δζ and the L1 size of its integrand from every `stride`-th node of each piece's samples.
+fn drift_sum(
+    samples: &[PieceSamples],
+    psi_advance: f64,
+    double: f64,
+    stride: usize,
+) -> ([f64; 2], f64) {
+    let (sa, ca) = psi_advance.sin_cos();
+    let (mut re, mut im, mut scale) = (0.0, 0.0, 0.0);
+    let mut psi_offset = 0.0;
+    for s in samples {
+        let step = s.step() * stride as f64;
+        let nodes: Vec<&NodeSample> = s.nodes.iter().step_by(stride).collect();
+        let rates: Vec<f64> = nodes.iter().map(|n| n.dpsi).collect();
+        let psi = spectral_antiderivative(&rates, step);
+        for (n, &p) in nodes.iter().zip(&psi) {
+            let (sp, cp) = (psi_offset + p).sin_cos();
+            // E = e^{iψ}, F = e^{i(Δψ − ψ)} = e^{iΔψ} conj(E).
+            let (fr, fi) = (ca * cp + sa * sp, sa * cp - ca * sp);
+            let (along, across) = (n.along, n.across);
+            if double == 2.0 {
+                // −[along (E + F) + i across (E − F)]
+                re -= step * (along * (cp + fr) - across * (sp - fi));
+                im -= step * (along * (sp + fi) + across * (cp - fr));
+            } else {
+                // Rotation: one way round, −[along + i across] E.
+                re -= step * (along * cp - across * sp);
+                im -= step * (along * sp + across * cp);
+            }
+            scale += step * double * (along.abs() + across.abs());
+        }
+        psi_offset += psi.last().copied().unwrap_or(0.0);
+    }
+    ([re, im], scale)
+}
+
+/// Δζ with its error estimate and the scale the tolerance is relative to.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DriftEstimate {
+    /// Δζ = (Δx_c, Δy_c) over one θ-period from θ_min, in the frame where ψ = 0 there.
+    pub value: [f64; 2],
+    /// Estimated absolute error of Δζ.
+    pub error: f64,
+    /// ∫ |integrand|: the size of the path over one period, the scale of the tolerance.
+    pub scale: f64,
+}
+
+/// Integrals over one θ-period of a component.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct QuadratureIntegrals {
+    /// T = 2 ∫ √(B / (2(ε − V))) dθ over [θ_min, θ_max] (a rotation: ∫ over the circle).
+    pub period: f64,
+    /// Δψ = ∫ ψ̇ dt over one period.
+    pub psi_advance: f64,
+    /// Estimated absolute error of T.
+    pub period_error: f64,
+    /// Estimated absolute error of Δψ.
+    pub psi_advance_error: f64,
+    /// Δζ, when asked for.
+    pub drift: Option<DriftEstimate>,
+    /// Integrand evaluations used.
+    pub evaluations: usize,
+    /// Whether every estimate is within the tolerance.
+    pub converged: bool,
+}
+
+const START_LEVEL: u32 = 2;
+const MAX_LEVEL: u32 = FINEST_LEVEL;
+
+#[derive(Debug, Clone, Copy)]
+struct PieceEnd {
+    site: Site,
+    angle: Angle,
+    /// ε − V at the end: 0 at a turning point (by definition of the end), > 0 at a saddle.
+    excess: f64,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Piece {
+    left: PieceEnd,
+    right: PieceEnd,
+    length: f64,
+}
+
+/// What one node contributes, already multiplied by dθ/dτ (not by the τ-step).
+#[derive(Debug, Clone, Copy, Default)]
+struct NodeSample {
+    /// dt/dτ = t′ dθ/dτ.
+    dt: f64,
+    /// ψ̇ dt/dτ.
+    dpsi: f64,
+    /// U a t′ dθ/dτ with a = κ/(J sinθ).
+    along: f64,
+    /// U dθ/dτ.
+    across: f64,
+    /// Bound on the relative rounding error of the gap ε − V at the node.
+    rounding: f64,
+}
+
+/// The samples of one piece on its current tanh-sinh level (the level below is every other
+/// node).
+struct PieceSamples {
+    level: u32,
+    nodes: Vec<NodeSample>,
+    evaluations: usize,
+}
+
+impl PieceSamples {
+    fn new<S: Shape>(
+        v: &EffectivePotential<'_, S>,
+        piece: &Piece,
+        energy: f64,
+        level: u32,
+    ) -> Result<Self> {
+        let lv = TanhSinhLevel::new(level);
+        let nodes = (0..lv.count)
+            .map(|j| {
+                sample(
+                    v,
+                    piece,
+                    energy,
+                    TanhSinhNode::tabulated(level, j, piece.length),
+                )
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Self {
+            level,
+            evaluations: nodes.len(),
+            nodes,
+        })
+    }
+
+    fn step(&self) -> f64 {
+        TanhSinhLevel::new(self.level).step
+    }
+
+    /// The T-sum over every 2^`stride_exp`-th node (0: this level; 1: the level below).
+    fn period(&self, stride_exp: u32) -> f64 {
+        let stride = 1usize << stride_exp;
+        self.step() * stride as f64 * self.nodes.iter().step_by(stride).map(|n| n.dt).sum::<f64>()
+    }
+
+    fn psi(&self, stride_exp: u32) -> f64 {
+        let stride = 1usize << stride_exp;
+        self.step()
+            * stride as f64
+            * self
+                .nodes
+                .iter()
+                .step_by(stride)
+                .map(|n| n.dpsi)
+                .sum::<f64>()
+    }
+
+    /// Error of the T-sum: see [`level_error`].
+    fn period_error(&self) -> f64 {
+        let tail = self.step() * (self.nodes[0].dt.abs() + self.nodes.last().unwrap().dt.abs());
+        level_error([self.period(0), self.period(1), self.period(2)]) + tail
+    }
+
+    fn psi_error(&self) -> f64 {
+        let tail = self.step() * (self.nodes[0].dpsi.abs() + self.nodes.last().unwrap().dpsi.abs());
+        level_error([self.psi(0), self.psi(1), self.psi(2)]) + tail
+    }
+
+    /// Σ ½ (relative gap error) |dt| step: the gap enters t′ as (ε − V)^{−1/2}.
+    fn period_rounding(&self) -> f64 {
+        self.step()
+            * self
+                .nodes
+                .iter()
+                .map(|n| 0.5 * n.rounding * n.dt.abs())
+                .sum::<f64>()
+    }
+
+    fn psi_rounding(&self) -> f64 {
+        self.step()
+            * self
+                .nodes
+                .iter()
+                .map(|n| 0.5 * n.rounding * n.dpsi.abs())
+                .sum::<f64>()
+    }
+
+    /// Halve the step: keep the old nodes (now the even ones) and add the odd ones.
+    fn refine<S: Shape>(
+        &mut self,
+        v: &EffectivePotential<'_, S>,
+        piece: &Piece,
+        energy: f64,
+    ) -> Result<()> {
+        self.level += 1;
+        let lv = TanhSinhLevel::new(self.level);
+        let mut nodes = Vec::with_capacity(lv.count);
+        for (j, old) in self.nodes.iter().enumerate() {
+            if j > 0 {
+                let node = TanhSinhNode::tabulated(self.level, 2 * j - 1, piece.length);
+                nodes.push(sample(v, piece, energy, node)?);
+            }
+            nodes.push(*old);
+        }
+        self.evaluations += self.nodes.len() - 1;
+        self.nodes = nodes;
+        Ok(())
+    }
+}
+
+/// The error of the finest of three successive tanh-sinh sums (finest first). The level
+/// differences d₁ = |I₀ − I₁| and d₂ = |I₁ − I₂| measure the errors of I₁ and I₂; once they
+/// shrink by a factor of at least 10 per level the error of I₀ is bounded by d₁²/d₂, the
+/// next term of a geometric decay (tanh-sinh errors in fact square from level to level, so
+/// this overestimates). Before that, d₁ itself is taken.
+fn level_error(sums: [f64; 3]) -> f64 {
+    let (d1, d2) = ((sums[0] - sums[1]).abs(), (sums[1] - sums[2]).abs());
+    let floor = 8.0 * EPS * sums[0].abs();
+    if d2 > 0.0 && d1 <= 0.1 * d2 {
+        (d1 * d1 / d2).max(floor)
+    } else {
+        d1.max(floor)
+    }
+}
+
+/// The integrands at one tanh-sinh node of a piece.
+#[inline]
+fn sample<S: Shape>(
+    v: &EffectivePotential<'_, S>,
+    piece: &Piece,
+    energy: f64,
+    node: TanhSinhNode,
+) -> Result<NodeSample> {
+    // Measure from the nearer end: offset x ≥ 0 and the end's angle.
+    let (end, signed) = if node.from_left <= node.from_right {
+        (&piece.left, node.from_left)
+    } else {
+        (&piece.right, -node.from_right)
+    };
+    let (sx, cx) = signed.sin_cos();
+    let e = end.angle;
+    let a = Angle {
+        sin: e.sin * cx + e.cos * sx,
+        cos: e.cos * cx - e.sin * sx,
+    };
+    let red = v.body.reduction_at(a);
+    let k2 = v.kappa * v.kappa;
+    let v_t = if k2 == 0.0 {
+        red.potential
+    } else {
+        0.5 * k2 / (a.sin * a.sin) + red.potential
+    };
+    let direct = energy - v_t;
+    let direct_err = 4.0 * EPS * (energy.abs() + v_t.abs());
+    let (gap, abs_err) = if 16.0 * direct > energy.abs() + v_t.abs() || cx <= -0.4 {
+        // Far from the ends and from saddles the plain difference loses at most 4 bits.
+        (direct, direct_err)
+    } else {
+        // ε − V(t) = excess − sin(t − e) D(t, e) with D the divided difference of V:
+        // κ² part −κ² sin(t + e) / (2 sin²e sin²t), U part from the shape.
+        let (du, du_scale) = v.body.shape.potential_divided_difference(a, e, sx, cx);
+        let dk = if k2 == 0.0 {
+            0.0
+        } else {
+            let sin_sum = a.sin * e.cos + a.cos * e.sin;
+            -k2 * sin_sum / (2.0 * e.sin * e.sin * a.sin * a.sin)
+        };
+        let d = dk + du;
+        (
+            end.excess - sx * d,
+            4.0 * EPS * (end.excess.abs() + sx.abs() * (dk.abs() + du_scale)),
+        )
+    };
+    if gap <= 0.0 || !gap.is_finite() {
+        return Err(AtlasError::NotPeriodic {
+            reason: "a quadrature node fell outside the allowed set (ε ≤ V there)",
+        });
+    }
+    let t_prime = (red.reduced_inertia / (2.0 * gap)).sqrt();
+    let dt = t_prime * node.jacobian;
+    let (dpsi, along) = if k2 == 0.0 {
+        (0.0, 0.0)
+    } else {
+        let w3 = v.kappa / red.integral_factor;
+        (
+            -w3 * a.cos / (a.sin * a.sin) * dt,
+            red.potential * w3 / a.sin * dt,
+        )
+    };
+    Ok(NodeSample {
+        dt,
+        dpsi,
+        along,
+        across: red.potential * node.jacobian,
+        rounding: abs_err / gap,
+    })
+}
+
+/// A root of f on [lo, hi] (f changes sign there), by Newton steps that stay in the bracket,
+/// bisection otherwise; `f` returns (value, derivative).
+fn safe_newton(f: impl Fn(f64) -> (f64, f64), mut lo: f64, mut hi: f64) -> f64 {
+    let (flo, _) = f(lo);
+    let lo_negative = flo < 0.0 || (flo.is_nan() && f(hi).0 > 0.0);
+    let mut x = 0.5 * (lo + hi);
+    let mut step_before = hi - lo;
+    for _ in 0..200 {
+        let (fx, dfx) = f(x);
+        if fx == 0.0 {
+            return x;
+        }
+        if (fx < 0.0) == lo_negative {
+            lo = x;
+        } else {
+            hi = x;
+        }
+        let newton = x - fx / dfx;
+        let next =
+            if dfx != 0.0 && newton > lo && newton < hi && (newton - x).abs() < 0.5 * step_before {
+                newton
+            } else {
+                0.5 * (lo + hi)
+            };
+        step_before = (next - x).abs();
+        if next <= lo.min(hi) || next >= hi.max(lo) || next == x {
+            return x;
+        }
+        if step_before <= 2.0 * EPS * x.abs() {
+            return next;
+        }
+        x = next;
+    }
+    x
+}
+
+/// Roots of a smooth g on [0, end]: the roots of g′ (scan plus bisection) cut the interval
+/// into pieces where g is monotone, and each piece with a sign change has one root, found by
+/// bisection to the last bit; g = 0 at a cut (a double root) is kept.
+fn roots_between_extrema(g: impl Fn(f64) -> f64, dg: impl Fn(f64) -> f64, end: f64) -> Vec<f64> {
+    let mut cuts = vec![0.0];
+    cuts.extend(roots_by_scan(&dg, 0.0, end, SCAN_CELLS));
+    cuts.push(end);
+    cuts.dedup();
+    let mut roots = Vec::new();
+    for w in cuts.windows(2) {
+        let (ga, gb) = (g(w[0]), g(w[1]));
+        if ga == 0.0 {
+            roots.push(w[0]);
+        } else if gb != 0.0 && (ga < 0.0) != (gb < 0.0) {
+            roots.push(bisect(&g, w[0], w[1], ga < 0.0));
+        }
+    }
+    if g(end) == 0.0 {
+        roots.push(end);
+    }
+    roots.dedup();
+    roots
 }
 
 /// All roots of a continuous `f` on [a, b] where it changes sign between `n` scan cells, each
@@ -102,210 +1025,5 @@ pub fn bisect(f: &impl Fn(f64) -> f64, mut lo: f64, mut hi: f64, lo_negative: bo
         } else {
             hi = mid;
         }
-    }
-}
-
-/// The components of {V ≤ ε}, sorted by θ_min. For κ ≠ 0 they lie in (0, π); for κ = 0 the
-/// motion lives on the circle and a component may straddle θ = 0 (then θ_min < 0) or be the
-/// whole circle (rolling over the top, [`MotionKind::Rotation`]).
-pub fn components<S: Shape>(body: &Body<S>, kappa: f64, energy: f64) -> Result<Vec<Component>> {
-    let system = ReducedSystem::new(body, kappa);
-    let v = |t: f64| system.effective_potential(t);
-    let (nodes, values) = if kappa != 0.0 {
-        let mut nodes = vec![0.0];
-        nodes.extend(critical_points(&system));
-        nodes.push(PI);
-        let values: Vec<f64> = nodes
-            .iter()
-            .enumerate()
-            .map(|(i, &t)| {
-                if i == 0 || i == nodes.len() - 1 {
-                    f64::INFINITY
-                } else {
-                    v(t)
-                }
-            })
-            .collect();
-        (nodes, values)
-    } else {
-        // Start the circle at the global maximum of U.
-        let crit = potential_critical_points_on_circle(body);
-        let (i_max, &t_max) = crit
-            .iter()
-            .enumerate()
-            .max_by(|a, b| v(*a.1).total_cmp(&v(*b.1)))
-            .expect("θ = 0 and π are always critical");
-        if energy > v(t_max) {
-            return Ok(vec![Component {
-                theta_min: t_max - PI,
-                theta_max: t_max + PI,
-                kind: MotionKind::Rotation,
-            }]);
-        }
-        let mut nodes: Vec<f64> = crit[i_max..].to_vec();
-        nodes.extend(crit[..i_max].iter().map(|t| t + TAU));
-        nodes.push(t_max + TAU);
-        // Keep the lifted angles near [−π, π] so that components around the top straddle 0.
-        let shift = if t_max > PI - 1e-9 { -TAU } else { 0.0 };
-        let nodes: Vec<f64> = nodes.iter().map(|t| t + shift).collect();
-        let values = nodes.iter().map(|&t| v(t)).collect();
-        (nodes, values)
-    };
-
-    let minimum = values.iter().copied().fold(f64::INFINITY, f64::min);
-    if energy < minimum {
-        return Err(AtlasError::NoMotion { energy, minimum });
-    }
-    let inside = |i: usize| values[i] <= energy;
-    let mut comps = Vec::new();
-    let mut start: Option<f64> = if inside(0) { Some(nodes[0]) } else { None };
-    for i in 0..nodes.len() - 1 {
-        if inside(i) == inside(i + 1) {
-            continue;
-        }
-        // V is monotone between consecutive critical points: one crossing, found by bisection
-        // on V − ε with the sign known at the ends (V = +∞ at the poles for κ ≠ 0).
-        let f = |t: f64| v(t) - energy;
-        let crossing = bisect(&f, nodes[i], nodes[i + 1], inside(i));
-        if inside(i) {
-            let lo = start.take().unwrap_or(nodes[i]);
-            comps.push((lo, crossing));
-        } else {
-            start = Some(crossing);
-        }
-    }
-    Ok(comps
-        .into_iter()
-        .map(|(lo, hi)| Component {
-            theta_min: lo,
-            theta_max: hi,
-            kind: if hi - lo <= 4.0 * f64::EPSILON * hi.abs().max(1.0) {
-                MotionKind::FixedPoint
-            } else {
-                MotionKind::Libration
-            },
-        })
-        .collect())
-}
-
-/// Integrals over one θ-period of a component.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PeriodIntegrals {
-    /// T = 2 ∫ √(B / (2(ε − V))) dθ over [θ_min, θ_max] (for a rotation: ∫ over the circle).
-    pub period: f64,
-    /// Δψ = ∫ ψ̇ dt over one period.
-    pub psi_advance: f64,
-    /// Estimated absolute error of T.
-    pub period_error: f64,
-    /// Estimated absolute error of Δψ.
-    pub psi_advance_error: f64,
-    /// Trapezoid nodes used on the last level.
-    pub nodes: usize,
-    /// Whether both integrals reached the tolerance.
-    pub converged: bool,
-}
-
-impl PeriodIntegrals {
-    /// ω_θ = 2π / T.
-    pub fn omega_theta(&self) -> f64 {
-        TAU / self.period
-    }
-    /// ω_ψ = Δψ / T, the mean precession rate.
-    pub fn omega_psi(&self) -> f64 {
-        self.psi_advance / self.period
-    }
-    /// N = −ω_ψ / ω_θ = −Δψ / 2π.
-    pub fn rotation_number(&self) -> f64 {
-        -self.psi_advance / TAU
-    }
-}
-
-/// T and Δψ of a component by the trapezoid rule in u (θ = c + h sin u for a libration, θ
-/// itself for a rotation), doubling the nodes until successive values of T (relative) and of
-/// N = −Δψ/2π (absolute) agree within `tol`.
-pub fn period_integrals<S: Shape>(
-    body: &Body<S>,
-    kappa: f64,
-    energy: f64,
-    component: &Component,
-    tol: f64,
-) -> Result<PeriodIntegrals> {
-    let system = ReducedSystem::new(body, kappa);
-    let with_psi = kappa != 0.0;
-    // dt/du and ψ̇ dt/du at one node; the turning points (u = ±π/2) take their limits
-    // h |cos u| / √(2(ε − V)) → √(h / |V′(θ_turn)|).
-    let (c, h) = (
-        0.5 * (component.theta_min + component.theta_max),
-        0.5 * (component.theta_max - component.theta_min),
-    );
-    let libration = component.kind == MotionKind::Libration;
-    if component.kind == MotionKind::FixedPoint {
-        return Err(AtlasError::NotPeriodic {
-            reason: "the component is a fixed point",
-        });
-    }
-    let eval = |u: f64| -> Result<(f64, f64)> {
-        let (theta, jac) = if libration {
-            let (su, cu) = u.sin_cos();
-            (c + h * su, h * cu.abs())
-        } else {
-            (component.theta_min + u, 1.0)
-        };
-        let b = body.reduced_inertia(theta);
-        let gap = energy - system.effective_potential(theta);
-        let dt = if libration && (u - FRAC_PI_2).abs() < 1e-15 {
-            (b * h / system.effective_potential_prime(component.theta_max).abs()).sqrt()
-        } else if libration && (u + FRAC_PI_2).abs() < 1e-15 {
-            (b * h / system.effective_potential_prime(component.theta_min).abs()).sqrt()
-        } else if gap > 0.0 {
-            jac * (b / (2.0 * gap)).sqrt()
-        } else {
-            return Err(AtlasError::NotPeriodic {
-                reason: "a quadrature node fell outside the allowed set (ε ≤ V)",
-            });
-        };
-        let psi = if with_psi {
-            system.psi_rate(theta)
-        } else {
-            0.0
-        };
-        Ok((dt, psi * dt))
-    };
-    let u0 = if libration { -FRAC_PI_2 } else { 0.0 };
-    let mut n = 8usize;
-    let mut sum_t = 0.0;
-    let mut sum_psi = 0.0;
-    for j in 0..n {
-        let (a, b) = eval(u0 + TAU * j as f64 / n as f64)?;
-        sum_t += a;
-        sum_psi += b;
-    }
-    let mut t_prev = sum_t * TAU / n as f64;
-    let mut psi_prev = sum_psi * TAU / n as f64;
-    const MAX_NODES: usize = 1 << 20;
-    loop {
-        // Doubling: the new nodes are the midpoints of the old ones.
-        for j in 0..n {
-            let (a, b) = eval(u0 + TAU * (j as f64 + 0.5) / n as f64)?;
-            sum_t += a;
-            sum_psi += b;
-        }
-        n *= 2;
-        let t = sum_t * TAU / n as f64;
-        let psi = sum_psi * TAU / n as f64;
-        let (dt, dpsi) = ((t - t_prev).abs(), (psi - psi_prev).abs());
-        let converged = dt <= tol * t && dpsi / TAU <= tol;
-        if converged || n >= MAX_NODES {
-            return Ok(PeriodIntegrals {
-                period: t,
-                psi_advance: psi,
-                period_error: dt,
-                psi_advance_error: dpsi,
-                nodes: n,
-                converged,
-            });
-        }
-        t_prev = t;
-        psi_prev = psi;
     }
 }

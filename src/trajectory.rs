@@ -7,7 +7,7 @@ use crate::error::{AtlasError, Result};
 use crate::full::{FullState, FullSystem, FULL_STATE_LEN};
 use crate::ode::{integrate_sampled, Rate};
 use crate::reduced::ReducedSystem;
-use crate::torus::{components, period_integrals, Component, MotionKind};
+use crate::torus::{Component, EffectivePotential, MotionKind};
 use nalgebra::SVector;
 
 /// Which equations are integrated.
@@ -36,7 +36,7 @@ impl Start {
         energy: f64,
         index: usize,
     ) -> Result<Self> {
-        let comps = components(body, kappa, energy)?;
+        let comps = EffectivePotential::new(body, kappa).components(energy)?;
         let count = comps.len();
         let c = comps.get(index).ok_or(AtlasError::InvalidParameter {
             name: "component",
@@ -49,9 +49,28 @@ impl Start {
         })?;
         Ok(Self {
             kappa,
-            theta0: c.theta_min,
+            theta0: c.theta_min(),
             theta_dot0: 0.0,
         })
+    }
+
+    /// Checks that θ(0) and θ̇(0) are finite, with 0 < θ(0) < π when κ ≠ 0.
+    pub fn check(&self) -> Result<()> {
+        let t = self.theta0;
+        if !(t.is_finite() && (self.kappa == 0.0 || (t > 0.0 && t < std::f64::consts::PI))) {
+            return Err(AtlasError::InvalidInitialAngle {
+                theta0: t,
+                reason: "must be finite, and 0 < theta0 < pi when kappa != 0",
+            });
+        }
+        if !self.theta_dot0.is_finite() {
+            return Err(AtlasError::InvalidParameter {
+                name: "theta-dot0",
+                value: self.theta_dot0,
+                reason: "must be a finite number",
+            });
+        }
+        Ok(())
     }
 
     /// The energy of this start.
@@ -62,16 +81,16 @@ impl Start {
     /// The component of the level set that holds θ(0).
     pub fn component<S: Shape>(&self, body: &Body<S>) -> Result<Component> {
         let energy = self.energy(body);
-        let comps = components(body, self.kappa, energy)?;
+        let comps = EffectivePotential::new(body, self.kappa).components(energy)?;
         let nearest = comps.iter().min_by(|a, b| {
             let d = |c: &Component| {
-                (c.theta_min - self.theta0)
-                    .max(self.theta0 - c.theta_max)
+                (c.theta_min() - self.theta0)
+                    .max(self.theta0 - c.theta_max())
                     .max(0.0)
             };
             d(a).total_cmp(&d(b))
         });
-        nearest.copied().ok_or(AtlasError::NotPeriodic {
+        nearest.cloned().ok_or(AtlasError::NotPeriodic {
             reason: "no component holds theta0",
         })
     }
@@ -84,7 +103,10 @@ impl Start {
                 reason: "the start is a fixed point (a permanent rotation); give --t-end",
             });
         }
-        Ok(period_integrals(body, self.kappa, self.energy(body), &comp, tol)?.period)
+        let potential = EffectivePotential::new(body, self.kappa);
+        Ok(potential
+            .integrate(self.energy(body), &comp, tol, false)?
+            .period)
     }
 }
 

@@ -1,0 +1,201 @@
+//! The independent method for one cell: integrate the reduced system (`eqsys` with `dpsi` and
+//! the velocity of the centre of mass) with DOP853 from θ_min, p = 0, ψ = 0 over one θ-period,
+//! located as the event "p crosses zero upwards" (for a rotation: θ advances by 2π) and refined
+//! by Newton's method on the event function. It shares nothing with the quadrature but the
+//! model's formulas, and serves as the reference for every test of [`crate::torus`].
+
+use crate::body::Shape;
+use crate::cell::RawIntegrals;
+use crate::error::{AtlasError, Result};
+use crate::ode::run_dop853;
+use crate::reduced::ReducedSystem;
+use crate::torus::{Component, DriftEstimate, EffectivePotential, MotionKind};
+use nalgebra::SVector;
+use ode_solvers::System;
+use std::cell::RefCell;
+use std::f64::consts::TAU;
+
+/// State [θ, p, ψ, x_c, y_c, ∫ U (|a| + |p|) dt] with a = κ/(J sinθ).
+type State = SVector<f64, 6>;
+
+#[derive(Clone, Copy)]
+enum EventKind {
+    /// g = p (a libration returns to θ_min when p crosses 0 upwards).
+    Momentum,
+    /// g = θ − target (a rotation has turned once).
+    Angle(f64),
+}
+
+/// What the step observer saw: the previous accepted step with its event value, and the
+/// steps just before and just after the first upward crossing of g.
+#[derive(Default)]
+struct EventRecord {
+    previous: Option<(f64, State, f64)>,
+    crossing: Option<((f64, State), (f64, State))>,
+}
+
+struct PeriodSystem<'a, 'r, S: Shape> {
+    system: ReducedSystem<'a, S>,
+    event: EventKind,
+    /// Where the observer writes (None: plain integration, no event watching).
+    record: Option<&'r RefCell<EventRecord>>,
+}
+
+impl<S: Shape> PeriodSystem<'_, '_, S> {
+    fn rate(&self, y: &State) -> State {
+        let (theta, p, psi) = (y[0], y[1], y[2]);
+        let (vx, vy) = self.system.centre_velocity(theta, p, psi);
+        let u = self.system.body.shape.potential(theta);
+        let along = if self.system.kappa == 0.0 {
+            0.0
+        } else {
+            self.system.kappa / (self.system.body.integral_factor(theta) * theta.sin())
+        };
+        State::from([
+            p,
+            self.system.theta_acceleration(theta, p),
+            self.system.psi_rate(theta),
+            vx,
+            vy,
+            u * (along.abs() + p.abs()),
+        ])
+    }
+
+    /// g(y) and dg/dt.
+    fn event(&self, y: &State) -> (f64, f64) {
+        match self.event {
+            EventKind::Momentum => (y[1], self.system.theta_acceleration(y[0], y[1])),
+            EventKind::Angle(target) => (y[0] - target, y[1]),
+        }
+    }
+}
+
+impl<S: Shape> System<f64, State> for PeriodSystem<'_, '_, S> {
+    fn system(&self, _t: f64, y: &State, dy: &mut State) {
+        *dy = self.rate(y);
+    }
+
+    fn solout(&mut self, t: f64, y: &State, _dy: &State) -> bool {
+        let Some(record) = self.record else {
+            return false;
+        };
+        let g = self.event(y).0;
+        let mut r = record.borrow_mut();
+        if let Some((t0, y0, g0)) = r.previous {
+            // g0 < 0 strictly: the start itself (p = 0 at θ_min) is not an event.
+            if g0 < 0.0 && g >= 0.0 {
+                r.crossing = Some(((t0, y0), (t, *y)));
+                return true;
+            }
+        }
+        r.previous = Some((t, *y, g));
+        false
+    }
+}
+
+/// Integrates from (t0, y0) to at most t1 at tolerance `tol`; returns the last state and
+/// the number of accepted steps.
+fn run<S: Shape>(
+    system: PeriodSystem<'_, '_, S>,
+    t0: f64,
+    y0: State,
+    t1: f64,
+    tol: f64,
+) -> Result<(State, usize)> {
+    let (_, y, steps) = run_dop853(system, t0, t1, y0, tol, 0.0)?;
+    Ok((y, steps))
+}
+
+/// One run at tolerance `tol`: [T, Δψ, Δx_c, Δy_c, path scale] and the steps taken.
+fn one_period<S: Shape>(
+    potential: &EffectivePotential<'_, S>,
+    energy: f64,
+    component: &Component,
+    tol: f64,
+) -> Result<([f64; 5], usize)> {
+    let system = ReducedSystem::new(potential.body, potential.kappa);
+    let theta0 = component.theta_min();
+    let (p0, event) = match component.kind {
+        MotionKind::Rotation => {
+            let gap = energy - system.effective_potential(theta0);
+            let b = potential.body.reduced_inertia(theta0);
+            ((2.0 * gap / b).sqrt(), EventKind::Angle(theta0 + TAU))
+        }
+        _ => (0.0, EventKind::Momentum),
+    };
+    let plain = PeriodSystem {
+        system,
+        event,
+        record: None,
+    };
+    let record = RefCell::new(EventRecord::default());
+    let watched = PeriodSystem {
+        system,
+        event,
+        record: Some(&record),
+    };
+    let y0 = State::from([theta0, p0, 0.0, 0.0, 0.0, 0.0]);
+    // Run until the event fires; the horizon is only a safeguard.
+    let (_, mut steps) = run(watched, 0.0, y0, 1e7, tol)?;
+    let ((ta, ya), (tb, yb)) = record
+        .into_inner()
+        .crossing
+        .ok_or(AtlasError::NotPeriodic {
+            reason: "the ODE run found no return to theta_min",
+        })?;
+    // Newton on g(y(ta + s)) for the offset s, each probe a fresh run from the step before.
+    let (ga, gb) = (plain.event(&ya).0, plain.event(&yb).0);
+    let mut s = (tb - ta) * ga / (ga - gb);
+    let mut y = yb;
+    for _ in 0..60 {
+        let (y_s, n) = run(
+            PeriodSystem {
+                record: None,
+                ..plain
+            },
+            ta,
+            ya,
+            ta + s,
+            tol,
+        )?;
+        steps += n;
+        y = y_s;
+        let (g, dg) = plain.event(&y);
+        let correction = g / dg;
+        if !correction.is_finite() || correction.abs() <= 2.0 * f64::EPSILON * (ta + s) {
+            break;
+        }
+        s -= correction;
+    }
+    Ok(([ta + s, y[2], y[3], y[4], y[5]], steps))
+}
+
+/// T, Δψ and Δζ of a libration or rotation by two ODE runs, at `tol` and at tol/100; the
+/// values are the tighter run's and the error estimates the difference between the two.
+pub fn integrate<S: Shape>(
+    potential: &EffectivePotential<'_, S>,
+    energy: f64,
+    component: &Component,
+    tol: f64,
+    with_drift: bool,
+) -> Result<RawIntegrals> {
+    let (loose, n1) = one_period(potential, energy, component, tol)?;
+    let (tight, n2) = one_period(potential, energy, component, (tol * 1e-2).max(1e-15))?;
+    let eps = 8.0 * f64::EPSILON;
+    let period_error = (tight[0] - loose[0]).abs() + eps * tight[0];
+    let psi_advance_error = (tight[1] - loose[1]).abs() + eps * tight[1].abs();
+    let drift = with_drift.then(|| DriftEstimate {
+        value: [tight[2], tight[3]],
+        error: (tight[2] - loose[2]).hypot(tight[3] - loose[3]) + eps * tight[4],
+        scale: tight[4],
+    });
+    Ok(RawIntegrals {
+        period: tight[0],
+        psi_advance: tight[1],
+        period_error,
+        psi_advance_error,
+        drift,
+        work: n1 + n2,
+        converged: period_error <= tol * tight[0] && psi_advance_error / TAU <= tol,
+    })
+}
