@@ -106,13 +106,14 @@ fn run<S: Shape>(
     Ok((y, steps))
 }
 
-/// One run at tolerance `tol`: [T, Δψ, Δx_c, Δy_c, path scale] and the steps taken.
+/// One run at tolerance `tol`: [T, Δψ, Δx_c, Δy_c, path scale, timing error of the event]
+/// and the steps taken.
 fn one_period<S: Shape>(
     potential: &EffectivePotential<'_, S>,
     energy: f64,
     component: &Component,
     tol: f64,
-) -> Result<([f64; 5], usize)> {
+) -> Result<([f64; 6], usize)> {
     let system = ReducedSystem::new(potential.body, potential.kappa);
     let theta0 = component.theta_min();
     let (p0, event) = match component.kind {
@@ -167,7 +168,10 @@ fn one_period<S: Shape>(
         }
         s -= correction;
     }
-    Ok(([ta + s, y[2], y[3], y[4], y[5]], steps))
+    // The event time is only as good as g's absolute accuracy (~ tol) over its rate.
+    let (_, rate) = plain.event(&y);
+    let timing = tol * y[1].abs().max(1.0) / rate.abs().max(f64::MIN_POSITIVE);
+    Ok(([ta + s, y[2], y[3], y[4], y[5], timing], steps))
 }
 
 /// T, Δψ and Δζ of a libration or rotation by two ODE runs, at `tol` and at tol/100; the
@@ -181,12 +185,22 @@ pub fn integrate<S: Shape>(
 ) -> Result<RawIntegrals> {
     let (loose, n1) = one_period(potential, energy, component, tol)?;
     let (tight, n2) = one_period(potential, energy, component, (tol * 1e-2).max(1e-15))?;
-    let eps = 8.0 * f64::EPSILON;
-    let period_error = (tight[0] - loose[0]).abs() + eps * tight[0];
-    let psi_advance_error = (tight[1] - loose[1]).abs() + eps * tight[1].abs();
+    // Rounding accumulates over the steps of a run: a few ulps per step.
+    let eps = 8.0 * f64::EPSILON * (n2 as f64).max(1.0);
+    // The event's timing error moves the end of the period by dt: T by dt, Δψ by |ψ̇| dt,
+    // Δζ by |ζ̇| dt (bounded by the path scale's mean rate).
+    let timing = tight[5];
+    let theta0 = component.theta_min();
+    let psi_rate = potential
+        .psi_rate(crate::torus::Site::at(theta0).angle())
+        .abs();
+    let period_error = (tight[0] - loose[0]).abs() + eps * tight[0] + timing;
+    let psi_advance_error = (tight[1] - loose[1]).abs() + eps * tight[1].abs() + psi_rate * timing;
     let drift = with_drift.then(|| DriftEstimate {
         value: [tight[2], tight[3]],
-        error: (tight[2] - loose[2]).hypot(tight[3] - loose[3]) + eps * tight[4],
+        error: (tight[2] - loose[2]).hypot(tight[3] - loose[3])
+            + eps * tight[4]
+            + tight[4] / tight[0] * timing,
         scale: tight[4],
     });
     Ok(RawIntegrals {

@@ -226,10 +226,17 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             // On the circle: roots of U′ on [0, 2π), with θ = 0 and π always among them.
             let g = |t: f64| shape.potential_prime(t);
             let dg = |t: f64| shape.potential_second(t);
-            let mut t: Vec<f64> = roots_between_extrema(g, dg, PI)
-                .into_iter()
-                .filter(|&t| t > 1e-9 && t < PI - 1e-9)
-                .collect();
+            // A flat U (the homogeneous sphere) has no isolated critical points: every energy
+            // above U is uniform rolling; only θ = 0 and π are kept as reference points.
+            let flat = (0..=SCAN_CELLS).all(|i| g(PI * i as f64 / SCAN_CELLS as f64) == 0.0);
+            let mut t: Vec<f64> = if flat {
+                Vec::new()
+            } else {
+                roots_between_extrema(g, dg, PI)
+                    .into_iter()
+                    .filter(|&t| t > 1e-9 && t < PI - 1e-9)
+                    .collect()
+            };
             let mirrored: Vec<f64> = t.iter().rev().map(|x| TAU - x).collect();
             t.insert(0, 0.0);
             t.push(PI);
@@ -394,11 +401,18 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             at(first, lower).or_else(|| first.checked_sub(1).and_then(|i| nodes[i])),
             at(last, upper).or_else(|| nodes.get(last + 1).copied().flatten()),
         ];
-        let at_minimum = interior.len() == 1
-            && interior[0].kind == CriticalKind::Minimum
-            && energy - interior[0].value <= 4.0 * EPS * interior[0].value.abs().max(1.0);
+        // ε at a minimum to rounding: the turning points may have met on the minimum itself.
+        let closed: Vec<CriticalPoint> = nodes[first..=last]
+            .iter()
+            .flatten()
+            .filter(|p| p.site.theta >= lower.theta && p.site.theta <= upper.theta)
+            .copied()
+            .collect();
+        let at_minimum = closed.len() == 1
+            && closed[0].kind == CriticalKind::Minimum
+            && energy - closed[0].value <= 4.0 * EPS * closed[0].value.abs().max(1.0);
         if at_minimum {
-            let m = interior[0];
+            let m = closed[0];
             return Component {
                 lower: m.site,
                 upper: m.site,
@@ -427,17 +441,42 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
     ) -> Site {
         let lo = a.map_or(0.0, |p| p.site.theta);
         let hi = b.map_or(PI, |p| p.site.theta);
+        // V − ε measured from the critical point inside the level set, as
+        // sin(θ − c) D(θ, c) − (ε − V(c)): both turning points of a libration are then roots
+        // of one cancellation-free function, so their levels agree far below an ulp of ε
+        // (near a flat minimum an ulp of mismatch would shift the orbit visibly).
+        let inside = [a, b]
+            .into_iter()
+            .flatten()
+            .find(|p| p.value <= energy)
+            .copied();
+        let level = |site: Site| -> f64 {
+            let t = site.angle();
+            if let Some(c) = inside {
+                let diff =
+                    if self.kappa != 0.0 && site.theta > FRAC_PI_2 && c.site.theta > FRAC_PI_2 {
+                        c.site.from_pi - site.from_pi
+                    } else {
+                        site.theta - c.site.theta
+                    };
+                let (sd, cd) = diff.sin_cos();
+                if cd > -0.4 {
+                    let d = divided_difference(self, t, c.site.angle(), sd, cd).0;
+                    return sd * d - (energy - c.value);
+                }
+            }
+            self.value(t) - energy
+        };
         let f_left = |x: f64| {
             let s = Site::at(x);
-            let a = s.angle();
-            (self.value(a) - energy, self.slope(a))
+            (level(s), self.slope(s.angle()))
         };
         if self.kappa == 0.0 || hi <= FRAC_PI_2 {
             return Site::at(safe_newton(f_left, lo, hi));
         }
         let f_right = |phi: f64| {
-            let a = Angle::from_pi(phi);
-            (self.value(a) - energy, -self.slope(a))
+            let s = Site::from_pi(phi);
+            (level(s), -self.slope(s.angle()))
         };
         let phi_lo = b.map_or(0.0, |p| p.site.from_pi);
         if lo >= FRAC_PI_2 {
@@ -518,9 +557,12 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             }
             let a = p.site.angle();
             let b = self.body.reduction_at(a).reduced_inertia;
-            let lambda = (p.curvature.abs() / b).sqrt().max(1e-300);
+            // dT/dε ≈ 1/(λ |ε − V_s|) per passage; never more than T/|ε − V_s| (a flat or
+            // degenerate point, λ = 0, has no logarithm).
+            let lambda = (p.curvature.abs() / b).sqrt();
             let gap = (energy - p.value).abs().max(EPS * p.value.abs().max(1.0));
-            let dt = passes * 4.0 * EPS * p.value.abs().max(1.0) / (lambda * gap);
+            let sensitivity = (1.0 / lambda).min(period) / gap;
+            let dt = passes * 4.0 * EPS * p.value.abs().max(1.0) * sensitivity;
             saddle_t += dt;
             saddle_psi += dt * self.psi_rate(a).abs();
         }
@@ -589,10 +631,21 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 } else {
                     r.site.theta - l.site.theta
                 };
+                // The levels V(e) + excess of the two ends differ by rounding (a turning point
+                // is only a root to the last bit); the gap is measured from the nearer end, so
+                // without a correction it would jump at the middle by that difference, which
+                // near a minimum is not small against ε − V.
+                let (sl, cl) = length.sin_cos();
+                let rise = if cl > -0.4 {
+                    sl * divided_difference(self, r.angle, l.angle, sl, cl).0
+                } else {
+                    self.value(r.angle) - self.value(l.angle)
+                };
                 Piece {
                     left: l,
                     right: r,
                     length,
+                    tilt: rise + r.excess - l.excess,
                 }
             })
             .collect()
@@ -714,6 +767,10 @@ struct Piece {
     left: PieceEnd,
     right: PieceEnd,
     length: f64,
+    /// m = (V + excess)(right) − (V + excess)(left): the gap is taken against the level that
+    /// runs linearly from one end's to the other's, so it vanishes at both turning points
+    /// and is continuous in between.
+    tilt: f64,
 }
 
 /// What one node contributes, already multiplied by dθ/dτ (not by the τ-step).
@@ -887,19 +944,15 @@ fn sample<S: Shape>(
         // Far from the ends and from saddles the plain difference loses at most 4 bits.
         (direct, direct_err)
     } else {
-        // ε − V(t) = excess − sin(t − e) D(t, e) with D the divided difference of V:
-        // κ² part −κ² sin(t + e) / (2 sin²e sin²t), U part from the shape.
-        let (du, du_scale) = v.body.shape.potential_divided_difference(a, e, sx, cx);
-        let dk = if k2 == 0.0 {
-            0.0
-        } else {
-            let sin_sum = a.sin * e.cos + a.cos * e.sin;
-            -k2 * sin_sum / (2.0 * e.sin * e.sin * a.sin * a.sin)
-        };
-        let d = dk + du;
+        // ε − V(t) = excess − sin(t − e) D(t, e) + tilt, with D the divided difference of V
+        // and the tilt m·(t − e)/L that makes the two ends' levels meet (see `Piece::tilt`).
+        let (d, scale) = divided_difference(v, a, e, sx, cx);
         (
-            end.excess - sx * d,
-            4.0 * EPS * (end.excess.abs() + sx.abs() * (dk.abs() + du_scale)),
+            end.excess - sx * d + piece.tilt * signed / piece.length,
+            4.0 * EPS
+                * (end.excess.abs()
+                    + sx.abs() * scale
+                    + (piece.tilt * signed / piece.length).abs()),
         )
     };
     if gap <= 0.0 || !gap.is_finite() {
@@ -925,6 +978,31 @@ fn sample<S: Shape>(
         across: red.potential * node.jacobian,
         rounding: abs_err / gap,
     })
+}
+
+/// The divided difference D(t, e) = (V(t) − V(e)) / sin(t − e) without cancellation, from
+/// sin(t − e) = `sin_diff` and cos(t − e) = `cos_diff`: the κ² part is
+/// −κ² sin(t + e) / (2 sin²e sin²t), the U part the shape's. Returns D and its rounding scale.
+#[inline]
+fn divided_difference<S: Shape>(
+    v: &EffectivePotential<'_, S>,
+    t: Angle,
+    e: Angle,
+    sin_diff: f64,
+    cos_diff: f64,
+) -> (f64, f64) {
+    let (du, du_scale) = v
+        .body
+        .shape
+        .potential_divided_difference(t, e, sin_diff, cos_diff);
+    let k2 = v.kappa * v.kappa;
+    let dk = if k2 == 0.0 {
+        0.0
+    } else {
+        let sin_sum = t.sin * e.cos + t.cos * e.sin;
+        -k2 * sin_sum / (2.0 * e.sin * e.sin * t.sin * t.sin)
+    };
+    (dk + du, dk.abs() + du_scale)
 }
 
 /// A root of f on [lo, hi] (f changes sign there), by Newton steps that stay in the bracket,

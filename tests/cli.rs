@@ -258,3 +258,77 @@ fn bad_input_is_refused_with_one_clear_line() {
     );
     assert_refused(&["nonsense"], "nonsense", None);
 }
+
+#[test]
+fn cell_json_has_the_contract_keys_and_both_methods_agree() {
+    let cell = |extra: &[&str]| -> serde_json::Value {
+        let mut args = vec!["cell"];
+        args.extend(BODY);
+        args.extend(extra);
+        args.push("--json");
+        let o = run(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    // Two tori at κ = 0.9, ε = 3.44; sorted by θ_min, every contract key present.
+    let v = cell(&["--kappa", "0.9", "--energy", "3.44"]);
+    let comps = v["components"].as_array().unwrap();
+    assert_eq!(comps.len(), 2);
+    assert!(comps[0]["theta_min"].as_f64() < comps[1]["theta_min"].as_f64());
+    for c in comps {
+        for key in [
+            "theta_min",
+            "theta_max",
+            "period",
+            "omega_theta",
+            "omega_psi",
+            "rotation_number",
+            "drift",
+            "drift_radius",
+            "bounded",
+            "motion",
+            "status",
+            "error_estimate",
+        ] {
+            assert!(!c[key].is_null(), "missing {key} in {c}");
+        }
+        assert_eq!(c["status"], "ok");
+    }
+    // --theta0 keeps only the component that holds θ(0); the ODE method agrees.
+    let q = cell(&["--kappa", "1", "--theta0", "2.1"]);
+    let o = cell(&["--kappa", "1", "--theta0", "2.1", "--method", "ode"]);
+    assert_eq!(q["components"].as_array().unwrap().len(), 1);
+    let n = |v: &serde_json::Value| v["components"][0]["rotation_number"].as_f64().unwrap();
+    assert!((n(&q) + 0.759).abs() < 5e-4);
+    assert!((n(&q) - n(&o)).abs() < 1e-10);
+    // Below the minimum of V: no motion, no components.
+    let none = cell(&["--kappa", "1", "--energy", "0.1"]);
+    assert_eq!(none["status"], "no_motion");
+    assert!(none["components"].as_array().unwrap().is_empty());
+}
+
+#[test]
+fn cell_refuses_bad_input() {
+    for (flag, value, needle) in [
+        ("--tol", "0", "tol"),
+        ("--tol", "NaN", "tol"),
+        ("--energy", "inf", "energy"),
+        ("--kappa", "nan", "kappa"),
+    ] {
+        let mut args = vec!["cell"];
+        args.extend(BODY);
+        if flag != "--kappa" {
+            args.extend(["--kappa", "1"]);
+        }
+        if flag != "--energy" {
+            args.extend(["--energy", "3.2"]);
+        }
+        args.extend([flag, value]);
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        let err = stderr(&o);
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.contains(needle), "{err}");
+        assert!(!err.contains("panicked"));
+    }
+}

@@ -1,0 +1,447 @@
+//! The cell solver against the independent ODE method on the hard cases of SPEC §2.2, its
+//! limits (linearised frequency, logarithmic growth near a saddle, κ → 0⁺), symmetries, and
+//! random cells.
+
+use proptest::prelude::*;
+use rubber_atlas::cell::{
+    solve_cell, solve_level, CellOptions, CellResult, ComponentResult, Method, Status,
+};
+use rubber_atlas::torus::{CriticalKind, EffectivePotential, MotionKind};
+use rubber_atlas::EllipsoidBody;
+use std::f64::consts::{PI, TAU};
+
+fn body(alpha: f64, beta: f64) -> EllipsoidBody {
+    EllipsoidBody::ellipsoid(alpha, beta, 0.5, 0.5).unwrap()
+}
+
+fn solve(b: &EllipsoidBody, kappa: f64, energy: f64, method: Method, tol: f64) -> CellResult {
+    let options = CellOptions {
+        tol,
+        method,
+        ..CellOptions::default()
+    };
+    solve_cell(b, kappa, energy, &options).unwrap()
+}
+
+/// Quadrature at 1e-12 against the ODE at 1e-13 (each with its own estimate): the two agree
+/// within the sum of their estimates, and the quadrature's estimate is honest against the
+/// ODE (its error is below its estimate plus the ODE's). Returns the quadrature's result.
+fn agree_with_ode(b: &EllipsoidBody, kappa: f64, energy: f64) -> CellResult {
+    let q = solve(b, kappa, energy, Method::Quadrature, 1e-12);
+    let o = solve(b, kappa, energy, Method::Ode, 1e-13);
+    assert_eq!(q.components.len(), o.components.len());
+    for (cq, co) in q.components.iter().zip(&o.components) {
+        assert!(cq.status == Status::Ok || cq.status == Status::ToleranceNotReached);
+        let close = |name: &str, a: f64, ea: f64, b: f64, eb: f64| {
+            assert!(
+                (a - b).abs() <= ea + eb + 1e-14 * a.abs().max(1.0),
+                "kappa {kappa} energy {energy}: {name} quadrature {a} ± {ea:e}, ode {b} ± {eb:e}"
+            );
+        };
+        close(
+            "T",
+            cq.period,
+            cq.errors.period,
+            co.period,
+            co.errors.period,
+        );
+        close(
+            "N",
+            cq.rotation_number,
+            cq.errors.rotation_number,
+            co.rotation_number,
+            co.errors.rotation_number,
+        );
+        close(
+            "drift",
+            cq.drift,
+            cq.errors.drift,
+            co.drift,
+            co.errors.drift,
+        );
+        for v in [
+            cq.period,
+            cq.omega_theta,
+            cq.omega_psi,
+            cq.rotation_number,
+            cq.drift,
+        ] {
+            assert!(v.is_finite());
+        }
+    }
+    q
+}
+
+fn minimum_of_v(b: &EllipsoidBody, kappa: f64) -> (f64, f64, f64) {
+    let v = EffectivePotential::new(b, kappa);
+    let m = v
+        .critical_points()
+        .iter()
+        .filter(|p| p.kind == CriticalKind::Minimum)
+        .min_by(|a, b| a.value.total_cmp(&b.value))
+        .copied()
+        .unwrap();
+    (m.site.theta, m.value, m.curvature)
+}
+
+fn saddle_of_v(b: &EllipsoidBody, kappa: f64) -> (f64, f64, f64) {
+    let v = EffectivePotential::new(b, kappa);
+    let s = v
+        .critical_points()
+        .iter()
+        .find(|p| p.kind == CriticalKind::Maximum)
+        .copied()
+        .unwrap();
+    (s.site.theta, s.value, s.curvature)
+}
+
+#[test]
+fn paper_figure_cases() {
+    let b = body(0.5, 3.0);
+    let v = |kappa: f64, t: f64| {
+        rubber_atlas::reduced::ReducedSystem::new(&b, kappa).effective_potential(t)
+    };
+    let holding = |r: &CellResult, t: f64| -> ComponentResult {
+        r.components
+            .iter()
+            .find(|c| c.theta_min <= t + 1e-12 && t - 1e-12 <= c.theta_max)
+            .cloned()
+            .unwrap()
+    };
+    let xy = agree_with_ode(&b, 0.8, v(0.8, 0.4678));
+    let n = holding(&xy, 0.4678).rotation_number;
+    assert!((n + 0.14248).abs() < 5e-6, "Fig. xy: N = {n}");
+    let res = agree_with_ode(&b, 1.0, v(1.0, 2.1));
+    let n = holding(&res, 2.1).rotation_number;
+    assert!((n + 0.759).abs() < 5e-4, "Fig. res: N = {n}");
+}
+
+#[test]
+fn near_a_separatrix_period_grows_like_log_with_slope_one_over_lambda() {
+    let b = body(0.5, 3.0);
+    let kappa = 0.9;
+    let (theta_s, v_s, v2) = saddle_of_v(&b, kappa);
+    let lambda = (v2.abs() / b.reduced_inertia(theta_s)).sqrt();
+    // Both sides, against the ODE, down to 1e-9 relative.
+    for rel in [1e-3, 1e-6, 1e-9] {
+        for side in [1.0, -1.0] {
+            agree_with_ode(&b, kappa, v_s * (1.0 + side * rel));
+        }
+    }
+    // Down to 1e-12: above the saddle one torus passes it twice per period (slope 2/λ);
+    // below, each of the two tori turns back near it once (slope 1/λ).
+    let period = |rel: f64, side: f64| -> Vec<ComponentResult> {
+        solve(
+            &b,
+            kappa,
+            v_s * (1.0 + side * rel),
+            Method::Quadrature,
+            1e-10,
+        )
+        .components
+    };
+    let decades = (1e4f64).ln();
+    let above = (period(1e-12, 1.0)[0].period - period(1e-8, 1.0)[0].period) / decades;
+    assert!(
+        (above * lambda / 2.0 - 1.0).abs() < 1e-3,
+        "slope above {above}, 2/λ = {}",
+        2.0 / lambda
+    );
+    let (lo8, lo12) = (period(1e-8, -1.0), period(1e-12, -1.0));
+    assert_eq!(lo12.len(), 2);
+    for i in 0..2 {
+        let below = (lo12[i].period - lo8[i].period) / decades;
+        assert!((below * lambda - 1.0).abs() < 1e-3, "slope below {below}");
+        // The estimate grows with the conditioning but stays honest and finite.
+        // ε − V_s is known only to a few ulps of V_s: 1e-12 relative leaves ~1e-4 of it.
+        assert!(lo12[i].errors.period.is_finite() && lo12[i].errors.period < 1e-2);
+    }
+    // Exactly on the separatrix: status, T = ∞, ω_θ = 0, no NaN in N's sign.
+    let on = solve(&b, kappa, v_s, Method::Quadrature, 1e-10);
+    let c = &on.components[0];
+    assert_eq!(c.status, Status::Separatrix);
+    assert!(c.period.is_infinite() && c.omega_theta == 0.0);
+}
+
+#[test]
+fn near_a_minimum_the_frequency_tends_to_the_linearised_one() {
+    let b = body(0.5, 3.0);
+    for kappa in [1.0, 0.3, -0.7] {
+        let (theta_m, v_m, v2) = minimum_of_v(&b, kappa);
+        let omega0 = (v2 / b.reduced_inertia(theta_m)).sqrt();
+        for delta in [1e-4, 1e-8] {
+            agree_with_ode(&b, kappa, v_m + delta);
+        }
+        let mut previous = f64::INFINITY;
+        for delta in [1e-4, 1e-6, 1e-8, 1e-10, 1e-12] {
+            let r = solve(&b, kappa, v_m + delta, Method::Quadrature, 1e-10);
+            let c = &r.components[0];
+            let gap = (c.omega_theta - omega0).abs();
+            // ω(δ) = ω0 + O(δ): the distance shrinks with δ, within the estimate.
+            assert!(
+                gap <= 10.0 * delta + c.errors.omega_theta,
+                "δ {delta}: {gap:e}"
+            );
+            assert!(gap <= previous + c.errors.omega_theta);
+            previous = gap;
+        }
+        // At the minimum itself: the fixed point with the linearised values.
+        let r = solve(&b, kappa, v_m, Method::Quadrature, 1e-10);
+        assert_eq!(r.components[0].status, Status::FixedPoint);
+        assert!((r.components[0].omega_theta - omega0).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn small_kappa_tends_to_the_one_sided_limit() {
+    // κ = 0 at this energy librates through θ = 0 (U(0) = 1.5 is a minimum for β² > 1 + α):
+    // for small κ > 0 the orbit swings past the pole once per θ-period and ψ turns by −π
+    // there, so N → +1/2; at κ = 0 itself N = 0.
+    let b = body(0.5, 3.0);
+    let energy = 2.0;
+    for kappa in [1e-2, 1e-4] {
+        agree_with_ode(&b, kappa, energy);
+    }
+    let mut previous = f64::INFINITY;
+    for kappa in [1e-2, 1e-4, 1e-6, 1e-8] {
+        let r = solve(&b, kappa, energy, Method::Quadrature, 1e-10);
+        let near_pole = r
+            .components
+            .iter()
+            .find(|c| c.theta_min < 0.1)
+            .expect("a component reaching the pole");
+        assert_eq!(near_pole.status, Status::Ok, "kappa {kappa}");
+        let off = (near_pole.rotation_number - 0.5).abs();
+        assert!(
+            off < previous,
+            "kappa {kappa}: N = {}",
+            near_pole.rotation_number
+        );
+        previous = off;
+        // Mirror: κ → −κ.
+        let m = solve(&b, -kappa, energy, Method::Quadrature, 1e-10);
+        let mirror = m.components.iter().find(|c| c.theta_min < 0.1).unwrap();
+        assert!((mirror.rotation_number + near_pole.rotation_number).abs() < 1e-10);
+    }
+    assert!(previous < 1e-6, "N(1e-8) − 1/2 = {previous:e}");
+    let zero = solve(&b, 0.0, energy, Method::Quadrature, 1e-10);
+    assert!(zero.components.iter().all(|c| c.rotation_number == 0.0));
+}
+
+/// Perimeter of the meridian ellipse (semi-axes β and 1), which rolling over the top advances
+/// the centre of mass by per turn (Cauchy: the perimeter is ∫ Z dθ over a turn), from the
+/// arithmetic-geometric mean: P = 2π/AGM(a, b) · (a² − Σ_{n≥0} 2^{n−1} c_n²).
+fn ellipse_perimeter(beta: f64) -> f64 {
+    let (a, b) = (beta.max(1.0), beta.min(1.0));
+    let (mut x, mut y) = (a, b);
+    let mut sum = 0.5 * (a * a - b * b);
+    let mut pow = 1.0;
+    for _ in 0..8 {
+        let c = 0.5 * (x - y);
+        let (nx, ny) = (0.5 * (x + y), (x * y).sqrt());
+        x = nx;
+        y = ny;
+        sum += pow * c * c;
+        pow *= 2.0;
+    }
+    TAU / x * (a * a - sum)
+}
+
+#[test]
+fn kappa_zero_librates_below_the_top_and_rolls_away_above() {
+    for (alpha, beta) in [(0.5, 3.0), (0.2, 0.5), (0.0, 1.0), (0.0, 2.0)] {
+        let b = body(alpha, beta);
+        let v = EffectivePotential::new(&b, 0.0);
+        let top = v
+            .critical_points()
+            .iter()
+            .map(|p| p.value)
+            .fold(f64::NEG_INFINITY, f64::max);
+        let bottom = v
+            .critical_points()
+            .iter()
+            .map(|p| p.value)
+            .fold(f64::INFINITY, f64::min);
+        if top > bottom {
+            for energy in [bottom + 0.3 * (top - bottom), top * (1.0 - 1e-9)] {
+                let r = agree_with_ode(&b, 0.0, energy);
+                for c in &r.components {
+                    assert_eq!(c.rotation_number, 0.0);
+                    assert_eq!(c.bounded, Some(true));
+                    assert_eq!(c.drift, 0.0);
+                }
+            }
+        }
+        for energy in [top * (1.0 + 1e-9), top + 1.0, 1e3] {
+            let r = agree_with_ode(&b, 0.0, energy);
+            let c = &r.components[0];
+            assert_eq!(c.motion, MotionKind::Rotation);
+            assert_eq!(c.bounded, Some(false));
+            assert_eq!(c.rotation_number, 0.0);
+            let perimeter = ellipse_perimeter(beta);
+            assert!(
+                (c.drift - perimeter).abs() < 1e-10 * perimeter,
+                "drift {} vs perimeter {perimeter}",
+                c.drift
+            );
+        }
+        if top > bottom {
+            let on = solve(&b, 0.0, top, Method::Quadrature, 1e-10);
+            assert!(on.components.iter().any(|c| c.status == Status::Separatrix));
+        }
+    }
+}
+
+#[test]
+fn cusp_tangency_and_bifurcation_curves() {
+    // Type (c) cusp (κ_c, ε_c) = (1.0802206, 3.6731984): just below κ_c two critical points
+    // are close; cells around their levels.
+    let b = body(0.5, 3.0);
+    let kappa = 1.0802206 * (1.0 - 1e-3);
+    let v = EffectivePotential::new(&b, kappa);
+    let levels: Vec<f64> = v.critical_points().iter().map(|p| p.value).collect();
+    for &l in &levels {
+        for rel in [1e-6, -1e-6, 1e-3] {
+            let e = l * (1.0 + rel);
+            if v.components(e).is_ok() {
+                agree_with_ode(&b, kappa, e);
+            }
+        }
+    }
+    // Type (e) (α = 0, β = 2): at κ = √((β² − 1)/β) the equator is a degenerate (quartic)
+    // minimum; ω_θ → 0 like δ^{1/4} there.
+    let b = body(0.0, 2.0);
+    let kappa = (3.0f64 / 2.0).sqrt();
+    let v_eq = 0.5 * kappa * kappa + 2.0;
+    for delta in [1e-2, 1e-4, 1e-6] {
+        agree_with_ode(&b, kappa, v_eq + delta);
+    }
+    // On the fixed-point curve of a stable permanent rotation: a fixed point.
+    let b = body(0.5, 3.0);
+    let (_, v_m, _) = minimum_of_v(&b, 1.5);
+    let r = solve(&b, 1.5, v_m, Method::Quadrature, 1e-10);
+    assert_eq!(r.components[0].status, Status::FixedPoint);
+}
+
+#[test]
+fn extreme_shapes_sphere_and_huge_energies() {
+    for (alpha, beta) in [(0.3, 0.05), (0.3, 20.0), (0.0, 1.0), (0.4, 1.0), (0.0, 0.5)] {
+        let b = body(alpha, beta);
+        for kappa in [0.5, -1.3] {
+            let (_, v_m, _) = minimum_of_v(&b, kappa);
+            for energy in [v_m + 1e-3, v_m + 0.5, v_m + 5.0] {
+                agree_with_ode(&b, kappa, energy);
+            }
+            let r = solve(&b, kappa, 1e6, Method::Quadrature, 1e-10);
+            for c in &r.components {
+                assert_eq!(
+                    c.status,
+                    Status::Ok,
+                    "alpha {alpha} beta {beta} kappa {kappa}"
+                );
+                assert!(c.rotation_number.is_finite() && c.drift.is_finite());
+            }
+        }
+    }
+    // ε = 1e6 against the ODE for one body.
+    agree_with_ode(&body(0.5, 3.0), 0.7, 1e6);
+}
+
+#[test]
+fn energy_exactly_at_a_grid_of_turning_points() {
+    // ε = V(θ_j) computed in double precision: θ_j is a turning point to rounding.
+    let b = body(0.5, 3.0);
+    let red = rubber_atlas::reduced::ReducedSystem::new(&b, 0.8);
+    for j in 1..12 {
+        let theta = PI * j as f64 / 12.0;
+        let energy = red.effective_potential(theta);
+        let r = solve(&b, 0.8, energy, Method::Quadrature, 1e-10);
+        assert!(!r.components.is_empty());
+        let c = r
+            .components
+            .iter()
+            .find(|c| c.theta_min <= theta + 1e-9 && theta - 1e-9 <= c.theta_max)
+            .unwrap();
+        assert!(
+            (c.theta_min - theta).abs() < 1e-9 || (c.theta_max - theta).abs() < 1e-9,
+            "θ_j = {theta} not an end of [{}, {}]",
+            c.theta_min,
+            c.theta_max
+        );
+        assert!(matches!(c.status, Status::Ok | Status::FixedPoint));
+        assert!(c.rotation_number.is_finite());
+    }
+}
+
+#[test]
+fn mirror_symmetry_alpha_to_minus_alpha() {
+    // α → −α with θ → π − θ: the same components mirrored, the same ω_θ, and N unchanged up to
+    // the orientation (cos θ → −cos θ flips ψ̇, so N → −N).
+    let (plus, minus) = (body(0.5, 3.0), body(-0.5, 3.0));
+    for (kappa, energy) in [(1.0, 3.2), (0.9, 3.44), (0.3, 2.5)] {
+        let a = solve(&plus, kappa, energy, Method::Quadrature, 1e-12);
+        let m = solve(&minus, kappa, energy, Method::Quadrature, 1e-12);
+        assert_eq!(a.components.len(), m.components.len());
+        for (ca, cm) in a.components.iter().zip(m.components.iter().rev()) {
+            assert!((ca.theta_min - (PI - cm.theta_max)).abs() < 1e-12);
+            assert!((ca.theta_max - (PI - cm.theta_min)).abs() < 1e-12);
+            assert!((ca.omega_theta - cm.omega_theta).abs() < 1e-11 * ca.omega_theta);
+            assert!((ca.rotation_number + cm.rotation_number).abs() < 1e-11);
+            // (|Δζ| is not mirrored: it is measured from θ_min, which maps to θ_max.)
+        }
+    }
+}
+
+#[test]
+fn one_row_reuses_its_critical_points() {
+    // solve_level on a shared EffectivePotential gives the same as solve_cell.
+    let b = body(0.5, 3.0);
+    let v = EffectivePotential::new(&b, 0.9);
+    let options = CellOptions::default();
+    for energy in [3.0, 3.44, 3.6, 5.0] {
+        let shared = solve_level(&v, energy, &options).unwrap();
+        let fresh = solve_cell(&b, 0.9, energy, &options).unwrap();
+        assert_eq!(shared, fresh);
+    }
+    assert_eq!(
+        solve_level(&v, 0.1, &options).unwrap().status,
+        Status::NoMotion
+    );
+}
+
+fn random_body() -> impl Strategy<Value = (f64, f64)> {
+    (0.0f64..0.9, 0.2f64..5.0)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    /// Random cells: quadrature (tol 1e-9) and ODE (tol 1e-12) agree within the requested
+    /// tolerance, nothing is NaN or infinite, and status ok never comes with a wrong value.
+    #[test]
+    fn random_cells_agree_with_the_ode((alpha, beta) in random_body(),
+                                       kappa in -2.0f64..2.0,
+                                       lift in 0.001f64..3.0) {
+        let b = body(alpha, beta);
+        let (_, v_m, _) = minimum_of_v(&b, kappa);
+        let energy = v_m + lift;
+        let q = solve(&b, kappa, energy, Method::Quadrature, 1e-9);
+        let o = solve(&b, kappa, energy, Method::Ode, 1e-12);
+        prop_assert_eq!(q.components.len(), o.components.len());
+        for (cq, co) in q.components.iter().zip(&o.components) {
+            for v in [cq.period, cq.omega_theta, cq.omega_psi, cq.rotation_number, cq.drift,
+                      cq.error_estimate] {
+                prop_assert!(v.is_finite());
+            }
+            if cq.status == Status::Ok {
+                prop_assert!((cq.rotation_number - co.rotation_number).abs()
+                    <= 1e-9 + co.errors.rotation_number,
+                    "N {} vs {}", cq.rotation_number, co.rotation_number);
+                prop_assert!((cq.period - co.period).abs()
+                    <= 1e-9 * co.period + co.errors.period);
+                prop_assert!((cq.drift - co.drift).abs()
+                    <= 1e-9 * co.drift.max(1.0) + co.errors.drift);
+            }
+        }
+    }
+}
