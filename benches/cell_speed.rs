@@ -1,0 +1,57 @@
+//! Speed of the cell solver on the standard slice of SPEC §5: α = 0.5, β = 3, ν = η = 0.5,
+//! κ ∈ [0, 2] × ε ∈ [0.5, 4.5] on 256 × 256 cells, all outputs, tol 1e-10, rows of fixed κ
+//! shared out by rayon. Prints cell-components per second for 1 and 2 threads (one run, so
+//! the ratio is meaningful on a shared machine). `cargo bench --bench cell_speed`.
+
+use rayon::prelude::*;
+use rubber_atlas::cell::{solve_level, CellOptions};
+use rubber_atlas::torus::EffectivePotential;
+use rubber_atlas::EllipsoidBody;
+use std::time::Instant;
+
+fn slice(threads: usize, options: &CellOptions) -> (usize, usize, f64) {
+    let body = EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 0.5).unwrap();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    let n = 256;
+    let start = Instant::now();
+    let (components, not_ok) = pool.install(|| {
+        (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let kappa = 2.0 * i as f64 / (n - 1) as f64;
+                let row = EffectivePotential::new(&body, kappa);
+                let mut count = (0, 0);
+                for j in 0..n {
+                    let energy = 0.5 + 4.0 * j as f64 / (n - 1) as f64;
+                    let cell = solve_level(&row, energy, options).unwrap();
+                    count.0 += cell.components.len();
+                    count.1 += cell
+                        .components
+                        .iter()
+                        .filter(|c| c.status != rubber_atlas::cell::Status::Ok)
+                        .count();
+                }
+                count
+            })
+            .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
+    });
+    (components, not_ok, start.elapsed().as_secs_f64())
+}
+
+fn main() {
+    let options = CellOptions {
+        tol: 1e-10,
+        ..CellOptions::default()
+    };
+    for threads in [1, 2] {
+        let (components, not_ok, seconds) = slice(threads, &options);
+        println!(
+            "threads {threads}: {components} cell-components in {seconds:.3} s = {:.0} per second \
+             ({not_ok} not ok)",
+            components as f64 / seconds
+        );
+    }
+}
