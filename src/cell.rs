@@ -25,7 +25,8 @@ pub enum Method {
 /// What to compute and how accurately.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CellOptions {
-    /// Requested accuracy: relative for T, ω_θ, ω_ψ, |Δζ|, R; absolute for N.
+    /// Requested accuracy: relative for T and ω_θ; absolute for N; for Δζ relative to the
+    /// length of the path over the period (|Δζ| itself may be near 0).
     pub tol: f64,
     /// Quadrature or ODE.
     pub method: Method,

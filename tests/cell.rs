@@ -439,8 +439,12 @@ proptest! {
                     "N {} vs {}", cq.rotation_number, co.rotation_number);
                 prop_assert!((cq.period - co.period).abs()
                     <= 1e-9 * co.period + co.errors.period);
+                // The drift's tolerance is relative to the path length over the period
+                // (up to ~10 |Δζ| on these cells).
                 prop_assert!((cq.drift - co.drift).abs()
-                    <= 1e-9 * co.drift.max(1.0) + co.errors.drift);
+                    <= 1e-8 * cq.drift.max(1.0) + co.errors.drift,
+                    "drift {} ± {:e} vs {} ± {:e}", cq.drift, cq.errors.drift, co.drift,
+                    co.errors.drift);
             }
         }
     }
