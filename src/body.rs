@@ -366,12 +366,6 @@ impl<S: Shape> Body<S> {
         self.shape.contact_distance_sq_prime(theta)
     }
 
-    /// B at an angle given by its sine and cosine.
-    #[inline]
-    pub fn reduced_inertia_at(&self, a: Angle) -> f64 {
-        1.0 / self.eta + self.shape.contact_distance_sq_at(a)
-    }
-
     /// U, B and J at one angle, sharing the work (the cell solver's inner loop).
     #[inline]
     pub fn reduction_at(&self, a: Angle) -> Reduction {

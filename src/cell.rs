@@ -7,7 +7,7 @@ use crate::body::{Body, Shape};
 use crate::error::{AtlasError, Result};
 use crate::period_ode;
 use crate::torus::{
-    Component, CriticalKind, CriticalPoint, DriftEstimate, EffectivePotential, MotionKind,
+    Component, CriticalKind, CriticalPoint, EffectivePotential, MotionKind, PeriodIntegrals,
 };
 use serde::Serialize;
 use std::f64::consts::{PI, TAU};
@@ -204,36 +204,13 @@ pub fn solve_component<S: Shape>(
     }
     let tol = options.tol;
     let raw = match options.method {
-        Method::Quadrature => {
-            let q = potential.integrate(energy, component, tol, options.drift)?;
-            RawIntegrals {
-                period: q.period,
-                psi_advance: q.psi_advance,
-                period_error: q.period_error,
-                psi_advance_error: q.psi_advance_error,
-                drift: q.drift,
-                work: q.evaluations,
-                converged: q.converged,
-            }
-        }
+        Method::Quadrature => potential.integrate(energy, component, tol, options.drift)?,
         Method::Ode => period_ode::integrate(potential, energy, component, tol, options.drift)?,
     };
     Ok(finish(component, raw, options))
 }
 
-/// T, Δψ and Δζ with their errors, from either method.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct RawIntegrals {
-    pub period: f64,
-    pub psi_advance: f64,
-    pub period_error: f64,
-    pub psi_advance_error: f64,
-    pub drift: Option<DriftEstimate>,
-    pub work: usize,
-    pub converged: bool,
-}
-
-fn finish(component: &Component, raw: RawIntegrals, options: &CellOptions) -> ComponentResult {
+fn finish(component: &Component, raw: PeriodIntegrals, options: &CellOptions) -> ComponentResult {
     let t = raw.period;
     let omega_theta = TAU / t;
     let omega_psi = raw.psi_advance / t;

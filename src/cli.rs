@@ -2,10 +2,11 @@
 
 use anyhow::{Context, Result};
 use clap::{ArgGroup, Args, Parser, Subcommand, ValueEnum};
-use rubber_atlas::cell::{solve_cell, CellOptions, ComponentResult, Method};
+use rubber_atlas::cell::{solve_cell, solve_component, CellOptions, CellResult, Method, Status};
 use rubber_atlas::critical::CriticalSet;
 use rubber_atlas::error::AtlasError;
 use rubber_atlas::store::{write_table, Column};
+use rubber_atlas::torus::EffectivePotential;
 use rubber_atlas::trajectory::{integrate, Model, Start};
 use rubber_atlas::EllipsoidBody;
 use std::path::PathBuf;
@@ -38,15 +39,15 @@ pub enum MethodArg {
     Ode,
 }
 
+/// Where on the level set: an energy, or an initial state θ(0), θ̇(0).
 #[derive(Debug, Args)]
 #[command(group(ArgGroup::new("start").required(true).args(["energy", "theta0"])))]
-pub struct CellArgs {
-    #[command(flatten)]
-    pub level: LevelArgs,
-    /// Energy ε: every component of the level set.
+pub struct StartArgs {
+    /// Energy ε (`cell`: every component; `trajectory`: start at the lower turning point of
+    /// component --component with θ̇ = 0).
     #[arg(long, allow_negative_numbers = true)]
     pub energy: Option<f64>,
-    /// Initial inclination θ(0): only the component that holds it (ε = V(θ0) + B θ̇0²/2).
+    /// Initial inclination θ(0) (`cell`: only the component that holds it).
     #[arg(long, allow_negative_numbers = true)]
     pub theta0: Option<f64>,
     /// Initial θ̇(0) (with --theta0).
@@ -57,6 +58,14 @@ pub struct CellArgs {
         allow_negative_numbers = true
     )]
     pub theta_dot0: f64,
+}
+
+#[derive(Debug, Args)]
+pub struct CellArgs {
+    #[command(flatten)]
+    pub level: LevelArgs,
+    #[command(flatten)]
+    pub start: StartArgs,
     /// Accuracy: relative for T, ω, drift; absolute for N. 1e-15 <= TOL <= 0.1.
     #[arg(long, default_value_t = 1e-10, allow_negative_numbers = true)]
     pub tol: f64,
@@ -143,28 +152,15 @@ pub enum ModelArg {
 }
 
 #[derive(Debug, Args)]
-#[command(group(ArgGroup::new("start").required(true).args(["energy", "theta0"])))]
 #[command(group(ArgGroup::new("length").required(true).args(["periods", "t_end"])))]
 pub struct TrajectoryArgs {
     #[command(flatten)]
     pub level: LevelArgs,
-    /// Energy ε: start at the lower turning point of component --component, θ̇ = 0.
-    #[arg(long, allow_negative_numbers = true)]
-    pub energy: Option<f64>,
+    #[command(flatten)]
+    pub start: StartArgs,
     /// Which component of the level set (κ, ε) to start on, counted from the smallest θ.
     #[arg(long, default_value_t = 0, requires = "energy")]
     pub component: usize,
-    /// Initial inclination θ(0).
-    #[arg(long, allow_negative_numbers = true)]
-    pub theta0: Option<f64>,
-    /// Initial θ̇(0) (with --theta0).
-    #[arg(
-        long,
-        default_value_t = 0.0,
-        requires = "theta0",
-        allow_negative_numbers = true
-    )]
-    pub theta_dot0: f64,
     /// Length in θ-periods of the starting component.
     #[arg(long, allow_negative_numbers = true)]
     pub periods: Option<f64>,
@@ -205,30 +201,30 @@ fn cell(args: CellArgs) -> Result<()> {
         drift: true,
         resonance_tol: args.resonance_tol,
     };
-    let (energy, theta0) = match (args.energy, args.theta0) {
-        (Some(e), _) => (e, None),
+    let result = match (args.start.energy, args.start.theta0) {
+        (Some(e), _) => solve_cell(&body, args.level.kappa, e, &options)?,
         (None, Some(t)) => {
+            // Only the component that holds θ(0).
             let start = Start {
                 kappa: args.level.kappa,
                 theta0: t,
-                theta_dot0: args.theta_dot0,
+                theta_dot0: args.start.theta_dot0,
             };
             start.check()?;
-            (start.energy(&body), Some(t))
+            options.validate()?;
+            let potential = EffectivePotential::new(&body, start.kappa);
+            let energy = start.energy(&body);
+            let component = start.component_in(&potential)?;
+            CellResult {
+                kappa: start.kappa,
+                energy,
+                status: Status::Ok,
+                components: vec![solve_component(&potential, energy, &component, &options)?],
+            }
         }
         (None, None) => unreachable!("clap requires --energy or --theta0"),
     };
-    let mut result = solve_cell(&body, args.level.kappa, energy, &options)?;
-    if let Some(t) = theta0 {
-        // Only the component that holds θ(0) (the nearest, against rounding at its ends).
-        let distance = |c: &ComponentResult| (c.theta_min - t).max(t - c.theta_max).max(0.0);
-        let nearest = result
-            .components
-            .iter()
-            .min_by(|a, b| distance(a).total_cmp(&distance(b)))
-            .cloned();
-        result.components = nearest.into_iter().collect();
-    }
+    let energy = result.energy;
     if args.json {
         let value = serde_json::json!({
             "alpha": args.level.shape.alpha,
@@ -479,7 +475,7 @@ fn trajectory(args: TrajectoryArgs) -> Result<()> {
         }
         .into());
     }
-    let start = match (args.energy, args.theta0) {
+    let start = match (args.start.energy, args.start.theta0) {
         (Some(e), None) => {
             if !e.is_finite() {
                 return Err(AtlasError::InvalidParameter {
@@ -495,7 +491,7 @@ fn trajectory(args: TrajectoryArgs) -> Result<()> {
             let start = Start {
                 kappa: args.level.kappa,
                 theta0: t,
-                theta_dot0: args.theta_dot0,
+                theta_dot0: args.start.theta_dot0,
             };
             start.check()?;
             start

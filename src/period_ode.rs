@@ -5,11 +5,10 @@
 //! model's formulas, and serves as the reference for every test of [`crate::torus`].
 
 use crate::body::Shape;
-use crate::cell::RawIntegrals;
 use crate::error::{AtlasError, Result};
 use crate::ode::run_dop853;
 use crate::reduced::ReducedSystem;
-use crate::torus::{Component, DriftEstimate, EffectivePotential, MotionKind};
+use crate::torus::{Component, DriftEstimate, EffectivePotential, MotionKind, PeriodIntegrals};
 use nalgebra::SVector;
 use ode_solvers::System;
 use std::cell::RefCell;
@@ -182,7 +181,7 @@ pub fn integrate<S: Shape>(
     component: &Component,
     tol: f64,
     with_drift: bool,
-) -> Result<RawIntegrals> {
+) -> Result<PeriodIntegrals> {
     let (loose, n1) = one_period(potential, energy, component, tol)?;
     let (tight, n2) = one_period(potential, energy, component, (tol * 1e-2).max(1e-15))?;
     // Rounding accumulates over the steps of a run: a few ulps per step.
@@ -203,7 +202,7 @@ pub fn integrate<S: Shape>(
             + tight[4] / tight[0] * timing,
         scale: tight[4],
     });
-    Ok(RawIntegrals {
+    Ok(PeriodIntegrals {
         period: tight[0],
         psi_advance: tight[1],
         period_error,

@@ -129,9 +129,11 @@ impl Component {
             .min_by(|a, b| a.value.total_cmp(&b.value))
     }
 
-    /// Whether `theta` lies in [θ_min, θ_max].
-    pub fn contains(&self, theta: f64) -> bool {
-        self.lower.theta <= theta && theta <= self.upper.theta
+    /// How far `theta` lies outside [θ_min, θ_max] (0 inside).
+    pub fn distance_to(&self, theta: f64) -> f64 {
+        (self.lower.theta - theta)
+            .max(theta - self.upper.theta)
+            .max(0.0)
     }
 }
 
@@ -505,7 +507,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         component: &Component,
         tol: f64,
         with_drift: bool,
-    ) -> Result<QuadratureIntegrals> {
+    ) -> Result<PeriodIntegrals> {
         if component.kind == MotionKind::FixedPoint {
             return Err(AtlasError::NotPeriodic {
                 reason: "the component is a fixed point",
@@ -525,8 +527,8 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         let mut converged = true;
         for (piece, sample) in pieces.iter().zip(samples.iter_mut()) {
             // Half of the tolerance for the quadrature, half left for rounding.
-            while sample.period_error() > 0.5 * tol * sample.period(0)
-                || double * sample.psi_error() / TAU > 0.5 * tol * share
+            while sample.error(|n| n.dt) > 0.5 * tol * sample.period(0)
+                || double * sample.error(|n| n.dpsi) / TAU > 0.5 * tol * share
             {
                 if sample.level >= MAX_LEVEL {
                     converged = false;
@@ -538,10 +540,10 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         let sum = |f: &dyn Fn(&PieceSamples) -> f64| samples.iter().map(f).sum::<f64>();
         let period = double * sum(&|s| s.period(0));
         let psi_advance = double * sum(&|s| s.psi(0));
-        let mut period_error = double * sum(&|s| s.period_error());
-        let mut psi_advance_error = double * sum(&|s| s.psi_error());
-        let period_rounding = double * sum(&|s| s.period_rounding());
-        let psi_rounding = double * sum(&|s| s.psi_rounding());
+        let mut period_error = double * sum(&|s| s.error(|n| n.dt));
+        let mut psi_advance_error = double * sum(&|s| s.error(|n| n.dpsi));
+        let period_rounding = double * sum(&|s| s.rounding(|n| n.dt));
+        let psi_rounding = double * sum(&|s| s.rounding(|n| n.dpsi));
         // Sensitivity to the energy near a saddle (inside the component or just beyond an
         // end): T grows like −log|ε − V_s| / λ there, so a rounding-level error in the gap
         // moves T by about ulp(V_s) / (λ |ε − V_s|) per passage.
@@ -590,13 +592,13 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             drift = Some(result);
         }
         converged &= period_error <= tol * period && psi_advance_error / TAU <= tol;
-        Ok(QuadratureIntegrals {
+        Ok(PeriodIntegrals {
             period,
             psi_advance,
             period_error,
             psi_advance_error,
             drift,
-            evaluations: samples.iter().map(|s| s.evaluations).sum(),
+            work: samples.iter().map(|s| s.evaluations).sum(),
             converged,
         })
     }
@@ -672,15 +674,9 @@ fn drift_estimate(samples: &[PieceSamples], psi_advance: f64, double: f64) -> Dr
         (fine.0[0] - mid.0[0]).hypot(fine.0[1] - mid.0[1]),
         (mid.0[0] - coarse.0[0]).hypot(mid.0[1] - coarse.0[1]),
     );
-    // The geometric model of [`level_error`], on the complex sums.
-    let error = if d2 > 0.0 && d1 <= 0.1 * d2 {
-        d1 * d1 / d2
-    } else {
-        d1
-    };
     DriftEstimate {
         value: fine.0,
-        error: error.max(8.0 * EPS * fine.1),
+        error: geometric_error(d1, d2).max(8.0 * EPS * fine.1),
         scale: fine.1,
     }
 }
@@ -732,9 +728,10 @@ pub struct DriftEstimate {
     pub scale: f64,
 }
 
-/// Integrals over one θ-period of a component.
+/// Integrals over one θ-period of a component, with their errors, from either method
+/// (this module's quadrature or [`crate::period_ode`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct QuadratureIntegrals {
+pub struct PeriodIntegrals {
     /// T = 2 ∫ √(B / (2(ε − V))) dθ over [θ_min, θ_max] (a rotation: ∫ over the circle).
     pub period: f64,
     /// Δψ = ∫ ψ̇ dt over one period.
@@ -745,8 +742,8 @@ pub struct QuadratureIntegrals {
     pub psi_advance_error: f64,
     /// Δζ, when asked for.
     pub drift: Option<DriftEstimate>,
-    /// Integrand evaluations used.
-    pub evaluations: usize,
+    /// Integrand evaluations (quadrature) or accepted steps (ODE) spent.
+    pub work: usize,
     /// Whether every estimate is within the tolerance.
     pub converged: bool,
 }
@@ -825,52 +822,30 @@ impl PieceSamples {
         TanhSinhLevel::new(self.level).step
     }
 
-    /// The T-sum over every 2^`stride_exp`-th node (0: this level; 1: the level below).
-    fn period(&self, stride_exp: u32) -> f64 {
+    /// The sum of `f` over every 2^`stride_exp`-th node (0: this level; 1: the level below),
+    /// times the step of that level.
+    fn sum(&self, stride_exp: u32, f: impl Fn(&NodeSample) -> f64) -> f64 {
         let stride = 1usize << stride_exp;
-        self.step() * stride as f64 * self.nodes.iter().step_by(stride).map(|n| n.dt).sum::<f64>()
+        self.step() * stride as f64 * self.nodes.iter().step_by(stride).map(f).sum::<f64>()
+    }
+
+    fn period(&self, stride_exp: u32) -> f64 {
+        self.sum(stride_exp, |n| n.dt)
     }
 
     fn psi(&self, stride_exp: u32) -> f64 {
-        let stride = 1usize << stride_exp;
-        self.step()
-            * stride as f64
-            * self
-                .nodes
-                .iter()
-                .step_by(stride)
-                .map(|n| n.dpsi)
-                .sum::<f64>()
+        self.sum(stride_exp, |n| n.dpsi)
     }
 
-    /// Error of the T-sum: see [`level_error`].
-    fn period_error(&self) -> f64 {
-        let tail = self.step() * (self.nodes[0].dt.abs() + self.nodes.last().unwrap().dt.abs());
-        level_error([self.period(0), self.period(1), self.period(2)]) + tail
+    /// Error of the sum of `f`: see [`level_error`], plus the tail beyond |τ| = TAU_MAX.
+    fn error(&self, f: impl Fn(&NodeSample) -> f64) -> f64 {
+        let tail = self.step() * (f(&self.nodes[0]).abs() + f(self.nodes.last().unwrap()).abs());
+        level_error([self.sum(0, &f), self.sum(1, &f), self.sum(2, &f)]) + tail
     }
 
-    fn psi_error(&self) -> f64 {
-        let tail = self.step() * (self.nodes[0].dpsi.abs() + self.nodes.last().unwrap().dpsi.abs());
-        level_error([self.psi(0), self.psi(1), self.psi(2)]) + tail
-    }
-
-    /// Σ ½ (relative gap error) |dt| step: the gap enters t′ as (ε − V)^{−1/2}.
-    fn period_rounding(&self) -> f64 {
-        self.step()
-            * self
-                .nodes
-                .iter()
-                .map(|n| 0.5 * n.rounding * n.dt.abs())
-                .sum::<f64>()
-    }
-
-    fn psi_rounding(&self) -> f64 {
-        self.step()
-            * self
-                .nodes
-                .iter()
-                .map(|n| 0.5 * n.rounding * n.dpsi.abs())
-                .sum::<f64>()
+    /// Σ ½ (relative gap error) |f| step: the gap enters t′ as (ε − V)^{−1/2}.
+    fn rounding(&self, f: impl Fn(&NodeSample) -> f64) -> f64 {
+        self.sum(0, |n| 0.5 * n.rounding * f(n).abs())
     }
 
     /// Halve the step: keep the old nodes (now the even ones) and add the odd ones.
@@ -903,11 +878,15 @@ impl PieceSamples {
 /// this overestimates). Before that, d₁ itself is taken.
 fn level_error(sums: [f64; 3]) -> f64 {
     let (d1, d2) = ((sums[0] - sums[1]).abs(), (sums[1] - sums[2]).abs());
-    let floor = 8.0 * EPS * sums[0].abs();
+    geometric_error(d1, d2).max(8.0 * EPS * sums[0].abs())
+}
+
+/// d₁²/d₂ once the level differences shrink by 10 or more per level, d₁ before.
+fn geometric_error(d1: f64, d2: f64) -> f64 {
     if d2 > 0.0 && d1 <= 0.1 * d2 {
-        (d1 * d1 / d2).max(floor)
+        d1 * d1 / d2
     } else {
-        d1.max(floor)
+        d1
     }
 }
 

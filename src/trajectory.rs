@@ -54,8 +54,15 @@ impl Start {
         })
     }
 
-    /// Checks that θ(0) and θ̇(0) are finite, with 0 < θ(0) < π when κ ≠ 0.
+    /// Checks that κ, θ(0) and θ̇(0) are finite, with 0 < θ(0) < π when κ ≠ 0.
     pub fn check(&self) -> Result<()> {
+        if !self.kappa.is_finite() {
+            return Err(AtlasError::InvalidParameter {
+                name: "kappa",
+                value: self.kappa,
+                reason: "must be a finite number",
+            });
+        }
         let t = self.theta0;
         if !(t.is_finite() && (self.kappa == 0.0 || (t > 0.0 && t < std::f64::consts::PI))) {
             return Err(AtlasError::InvalidInitialAngle {
@@ -80,17 +87,22 @@ impl Start {
 
     /// The component of the level set that holds θ(0).
     pub fn component<S: Shape>(&self, body: &Body<S>) -> Result<Component> {
-        let energy = self.energy(body);
-        let comps = EffectivePotential::new(body, self.kappa).components(energy)?;
-        let nearest = comps.iter().min_by(|a, b| {
-            let d = |c: &Component| {
-                (c.theta_min() - self.theta0)
-                    .max(self.theta0 - c.theta_max())
-                    .max(0.0)
-            };
-            d(a).total_cmp(&d(b))
+        self.component_in(&EffectivePotential::new(body, self.kappa))
+    }
+
+    /// The component that holds θ(0), among those of `potential` at this start's energy (the
+    /// nearest one, against rounding at its ends).
+    pub fn component_in<S: Shape>(
+        &self,
+        potential: &EffectivePotential<'_, S>,
+    ) -> Result<Component> {
+        let energy = self.energy(potential.body);
+        let comps = potential.components(energy)?;
+        let nearest = comps.into_iter().min_by(|a, b| {
+            a.distance_to(self.theta0)
+                .total_cmp(&b.distance_to(self.theta0))
         });
-        nearest.cloned().ok_or(AtlasError::NotPeriodic {
+        nearest.ok_or(AtlasError::NotPeriodic {
             reason: "no component holds theta0",
         })
     }

@@ -355,7 +355,7 @@ fn quadrature_period_and_precession_match_the_ode() {
     let pi = EffectivePotential::new(&b, 1.0)
         .integrate(s.energy(&b), &comp, 1e-13, false)
         .unwrap();
-    let n = |q: &rubber_atlas::torus::QuadratureIntegrals| -q.psi_advance / std::f64::consts::TAU;
+    let n = |q: &rubber_atlas::torus::PeriodIntegrals| -q.psi_advance / std::f64::consts::TAU;
     assert!(pi.converged);
     assert!((n(&pi) + 0.759).abs() < 5e-4, "N = {}", n(&pi));
     let tr = integrate(&b, &s, Model::Reduced, pi.period, 10, ODE_TOL).unwrap();
