@@ -1,7 +1,8 @@
 //! Speed of the cell solver on the standard slice of SPEC §5: α = 0.5, β = 3, ν = η = 0.5,
 //! κ ∈ [0, 2] × ε ∈ [0.5, 4.5] on 256 × 256 cells, all outputs, tol 1e-10, rows of fixed κ
-//! shared out by rayon. Prints cell-components per second for 1 and 2 threads (one run, so
-//! the ratio is meaningful on a shared machine). `cargo bench --bench cell_speed`.
+//! shared out by rayon. Prints cell-components per second for 1 and 2 threads, the median
+//! of five runs of each, interleaved in one process so that the ratio is meaningful on a
+//! shared machine. `cargo bench --bench cell_speed`.
 
 use rayon::prelude::*;
 use rubber_atlas::cell::{solve_level, CellOptions};
@@ -46,12 +47,23 @@ fn main() {
         tol: 1e-10,
         ..CellOptions::default()
     };
-    for threads in [1, 2] {
-        let (components, not_ok, seconds) = slice(threads, &options);
+    let mut seconds = [Vec::new(), Vec::new()];
+    let mut counts = (0, 0);
+    for _ in 0..5 {
+        for (threads, times) in [1, 2].into_iter().zip(seconds.iter_mut()) {
+            let (components, not_ok, elapsed) = slice(threads, &options);
+            counts = (components, not_ok);
+            times.push(elapsed);
+        }
+    }
+    let (components, not_ok) = counts;
+    for (threads, times) in [1, 2].into_iter().zip(seconds.iter_mut()) {
+        times.sort_by(f64::total_cmp);
+        let median = times[times.len() / 2];
         println!(
-            "threads {threads}: {components} cell-components in {seconds:.3} s = {:.0} per second \
-             ({not_ok} not ok)",
-            components as f64 / seconds
+            "threads {threads}: {components} cell-components in {median:.3} s (median of 5) = \
+             {:.0} per second ({not_ok} not ok)",
+            components as f64 / median
         );
     }
 }

@@ -25,14 +25,14 @@ impl Angle {
     /// The angle θ itself.
     #[inline]
     pub fn new(theta: f64) -> Self {
-        let (sin, cos) = theta.sin_cos();
+        let (sin, cos) = libm::sincos(theta);
         Self { sin, cos }
     }
 
     /// The angle π − φ, from its distance φ to the pole θ = π.
     #[inline]
     pub fn from_pi(phi: f64) -> Self {
-        let (sin, cos) = phi.sin_cos();
+        let (sin, cos) = libm::sincos(phi);
         Self { sin, cos: -cos }
     }
 
