@@ -105,14 +105,14 @@ fn run<S: Shape>(
     Ok((y, steps))
 }
 
-/// One run at tolerance `tol`: [T, Δψ, Δx_c, Δy_c, path scale, timing error of the event]
-/// and the steps taken.
+/// One run at tolerance `tol`: [T, Δψ, Δx_c, Δy_c, path scale, timing error of the event,
+/// energy error at the end] and the steps taken.
 fn one_period<S: Shape>(
     potential: &EffectivePotential<'_, S>,
     energy: f64,
     component: &Component,
     tol: f64,
-) -> Result<([f64; 6], usize)> {
+) -> Result<([f64; 7], usize)> {
     let system = ReducedSystem::new(potential.body, potential.kappa);
     let theta0 = component.theta_min();
     let (p0, event) = match component.kind {
@@ -170,7 +170,13 @@ fn one_period<S: Shape>(
     // The event time is only as good as g's absolute accuracy (~ tol) over its rate.
     let (_, rate) = plain.event(&y);
     let timing = tol * y[1].abs().max(1.0) / rate.abs().max(f64::MIN_POSITIVE);
-    Ok(([ta + s, y[2], y[3], y[4], y[5], timing], steps))
+    let end_energy =
+        0.5 * potential.body.reduced_inertia(y[0]) * y[1] * y[1] + system.effective_potential(y[0]);
+    let energy_error = (end_energy - energy).abs();
+    Ok((
+        [ta + s, y[2], y[3], y[4], y[5], timing, energy_error],
+        steps,
+    ))
 }
 
 /// T, Δψ and Δζ of a libration or rotation by two ODE runs, at `tol` and at tol/100; the
@@ -193,13 +199,25 @@ pub fn integrate<S: Shape>(
     let psi_rate = potential
         .psi_rate(crate::torus::Site::at(theta0).angle())
         .abs();
-    let period_error = (tight[0] - loose[0]).abs() + eps * tight[0] + timing;
-    let psi_advance_error = (tight[1] - loose[1]).abs() + eps * tight[1].abs() + psi_rate * timing;
+    // Near a saddle T is ill-conditioned in ε: the energy the runs drift off by moves T by
+    // δε/(λ |ε − V_s|) per passage, which the difference of the two runs need not show.
+    let double = if component.kind == MotionKind::Rotation {
+        1.0
+    } else {
+        2.0
+    };
+    let energy_error = tight[6].max(loose[6]);
+    let (saddle_t, saddle_psi) =
+        potential.saddle_conditioning(energy, component, tight[0], double, energy_error);
+    let period_error = (tight[0] - loose[0]).abs() + eps * tight[0] + timing + saddle_t;
+    let psi_advance_error =
+        (tight[1] - loose[1]).abs() + eps * tight[1].abs() + psi_rate * timing + saddle_psi;
     let drift = with_drift.then(|| DriftEstimate {
         value: [tight[2], tight[3]],
         error: (tight[2] - loose[2]).hypot(tight[3] - loose[3])
             + eps * tight[4]
-            + tight[4] / tight[0] * timing,
+            + tight[4] / tight[0] * (timing + saddle_t)
+            + tight[4] * saddle_psi,
         scale: tight[4],
     });
     Ok(PeriodIntegrals {

@@ -565,7 +565,8 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         let mut psi_advance_error = double * sum(&|s| s.error(|n| n.dpsi));
         let period_rounding = double * sum(&|s| s.rounding(|n| n.dt));
         let psi_rounding = double * sum(&|s| s.rounding(|n| n.dpsi));
-        let (saddle_t, saddle_psi) = self.saddle_conditioning(energy, component, period, double);
+        let (saddle_t, saddle_psi) =
+            self.saddle_conditioning(energy, component, period, double, 0.0);
         period_error += period_rounding + saddle_t;
         psi_advance_error += psi_rounding + saddle_psi;
         let mut drift = None;
@@ -603,14 +604,15 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
 
     /// The errors of T and Δψ caused by the conditioning of the energy near a saddle (inside
     /// the component, passed `double` times a period, or just beyond an end, passed once):
-    /// T grows like −log|ε − V_s| / λ there, so a rounding-level error in the gap moves T by
-    /// about ulp(V_s) / (λ |ε − V_s|) per passage.
-    fn saddle_conditioning(
+    /// T grows like −log|ε − V_s| / λ there, so an error δε in the energy (at least the
+    /// rounding of V_s, or `energy_error` if larger) moves T by δε / (λ |ε − V_s|) per passage.
+    pub(crate) fn saddle_conditioning(
         &self,
         energy: f64,
         component: &Component,
         period: f64,
         double: f64,
+        energy_error: f64,
     ) -> (f64, f64) {
         let (mut saddle_t, mut saddle_psi) = (0.0, 0.0);
         for (p, passes) in component
@@ -629,7 +631,8 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             let lambda = (p.curvature.abs() / b).sqrt();
             let gap = (energy - p.value).abs().max(EPS * p.value.abs().max(1.0));
             let sensitivity = (1.0 / lambda).min(period) / gap;
-            let dt = passes * 4.0 * EPS * p.value.abs().max(1.0) * sensitivity;
+            let delta = energy_error.max(4.0 * EPS * p.value.abs().max(1.0));
+            let dt = passes * delta * sensitivity;
             saddle_t += dt;
             saddle_psi += dt * self.psi_rate(a).abs();
         }
@@ -782,7 +785,9 @@ pub struct PeriodIntegrals {
     pub converged: bool,
 }
 
-const START_LEVEL: u32 = 2;
+/// The first level, the coarsest at which the level differences are trusted: its two levels
+/// below (steps ½ and ¼ in τ) are then past the first, pre-asymptotic ones.
+const START_LEVEL: u32 = 4;
 const MAX_LEVEL: u32 = FINEST_LEVEL;
 
 #[derive(Debug, Clone, Copy)]
@@ -916,23 +921,13 @@ fn interleave(
     Ok(nodes)
 }
 
-/// The error of the finest of three successive tanh-sinh sums (finest first). The level
-/// differences d₁ = |I₀ − I₁| and d₂ = |I₁ − I₂| measure the errors of I₁ and I₂; once they
-/// shrink by a factor of at least 10 per level the error of I₀ is bounded by d₁²/d₂, the
-/// next term of a geometric decay (tanh-sinh errors in fact square from level to level, so
-/// this overestimates). Before that, d₁ itself is taken.
+/// The error of the finest of three successive tanh-sinh sums (finest first), from the level
+/// differences d₁ = |I₀ − I₁| and d₂ = |I₁ − I₂| by [`cautious_error`]: tanh-sinh errors
+/// square from level to level once converging, but near a separatrix the first levels are
+/// not in that regime (d₁²/d₂ was 7× short at tol 1e-6 on random near-saddle cells).
 fn level_error(sums: [f64; 3]) -> f64 {
     let (d1, d2) = ((sums[0] - sums[1]).abs(), (sums[1] - sums[2]).abs());
-    geometric_error(d1, d2).max(8.0 * EPS * sums[0].abs())
-}
-
-/// d₁²/d₂ once the level differences shrink by 10 or more per level, d₁ before.
-fn geometric_error(d1: f64, d2: f64) -> f64 {
-    if d2 > 0.0 && d1 <= 0.1 * d2 {
-        d1 * d1 / d2
-    } else {
-        d1
-    }
+    cautious_error(d1, d2).max(8.0 * EPS * sums[0].abs())
 }
 
 /// The error of the finest of three successive sums of a nested rule from the level

@@ -6,20 +6,18 @@
 //! at small κ) it stops early and the tanh-sinh path of the parent module takes over.
 
 use super::{
-    cautious_error, interleave, sample, weighted, Component, DriftEstimate, EffectivePotential, NodeSample,
-    PeriodIntegrals, Piece, EPS,
+    cautious_error, interleave, sample, weighted, Component, DriftEstimate, EffectivePotential,
+    NodeSample, PeriodIntegrals, Piece, EPS,
 };
-use crate::body::Shape;
+use crate::body::{Angle, Shape};
 use crate::error::Result;
 use crate::quadrature::{real_fft, real_inverse_fft, IntervalNode, FINEST_COSINE_INTERVALS};
 use rustfft::num_complex::Complex;
 use std::f64::consts::{PI, TAU};
 
-/// φ-steps on [0, π] of the first level.
-const FIRST_INTERVALS: usize = 4;
-/// φ-steps on [0, π] before the level differences are trusted: the coarsest of the three
-/// levels compared then has 4 steps.
-const MIN_INTERVALS: usize = 16;
+/// φ-steps on [0, π] of the first level, the fewest for which the level differences are
+/// trusted: the coarsest of the three levels compared then has 4 steps.
+const FIRST_INTERVALS: usize = 16;
 /// φ-steps on [0, π] beyond which the tanh-sinh rule is cheaper.
 const LAST_INTERVALS: usize = 128;
 const _: () = assert!(LAST_INTERVALS <= FINEST_COSINE_INTERVALS);
@@ -35,22 +33,39 @@ pub(super) fn integrate<S: Shape>(
     tol: f64,
     with_drift: bool,
 ) -> Result<Option<PeriodIntegrals>> {
-    let Some(mut samples) = Samples::new(v, piece, energy) else {
+    for map in Map::candidates(v, piece) {
+        let result = integrate_on(v, piece, &map, energy, component, tol, with_drift)?;
+        if result.is_some() {
+            return Ok(result);
+        }
+    }
+    Ok(None)
+}
+
+/// [`integrate`] with one map.
+fn integrate_on<S: Shape>(
+    v: &EffectivePotential<'_, S>,
+    piece: &Piece,
+    map: &Map,
+    energy: f64,
+    component: &Component,
+    tol: f64,
+    with_drift: bool,
+) -> Result<Option<PeriodIntegrals>> {
+    let Some(mut samples) = Samples::new(v, piece, map, energy) else {
         return Ok(None);
     };
     loop {
         let period = 2.0 * samples.sum(1, |n| n.dt);
         let t_error = 2.0 * samples.error(|n| n.dt);
         let psi_error = 2.0 * samples.error(|n| n.dpsi);
-        let mut done = samples.intervals >= MIN_INTERVALS
-            && t_error <= 0.5 * tol * period
-            && psi_error / TAU <= 0.5 * tol;
+        let mut done = t_error <= 0.5 * tol * period && psi_error / TAU <= 0.5 * tol;
         // The drift (the costly part) only once T and Δψ have converged.
-        let drift = (done && with_drift).then(|| samples.drift());
+        let drift = (done && with_drift).then(|| samples.drift(psi_error));
         done &= drift.is_none_or(|d| d.error <= tol * d.scale);
         if done {
             let psi_advance = 2.0 * samples.sum(1, |n| n.dpsi);
-            let (saddle_t, saddle_psi) = v.saddle_conditioning(energy, component, period, 2.0);
+            let (saddle_t, saddle_psi) = v.saddle_conditioning(energy, component, period, 2.0, 0.0);
             let period_rounding = 2.0 * samples.rounding(|n| n.dt);
             let psi_rounding = 2.0 * samples.rounding(|n| n.dpsi);
             let period_error = t_error + period_rounding + saddle_t;
@@ -78,7 +93,7 @@ pub(super) fn integrate<S: Shape>(
             return Ok(None);
         }
         let at = |node| sample(v, piece, energy, node);
-        if samples.refine(piece.length, at).is_err() {
+        if samples.refine(map, at).is_err() {
             return Ok(None);
         }
     }
@@ -92,15 +107,19 @@ struct Samples {
 }
 
 impl Samples {
-    fn new<S: Shape>(v: &EffectivePotential<'_, S>, piece: &Piece, energy: f64) -> Option<Self> {
+    fn new<S: Shape>(
+        v: &EffectivePotential<'_, S>,
+        piece: &Piece,
+        map: &Map,
+        energy: f64,
+    ) -> Option<Self> {
         let n = FIRST_INTERVALS;
         let mut nodes = Vec::with_capacity(2 * LAST_INTERVALS + 1);
-        nodes.push(end_sample(v, piece, true)?);
+        nodes.push(end_sample(v, piece, map, true)?);
         for j in 1..n {
-            let node = IntervalNode::cosine_tabulated(n, j, piece.length);
-            nodes.push(sample(v, piece, energy, node).ok()?);
+            nodes.push(sample(v, piece, energy, map.node(n, j)).ok()?);
         }
-        nodes.push(end_sample(v, piece, false)?);
+        nodes.push(end_sample(v, piece, map, false)?);
         Some(Self {
             intervals: n,
             nodes,
@@ -153,27 +172,26 @@ impl Samples {
         self.sum(1, |n| 0.5 * n.rounding * f(n).abs())
     }
 
-    /// Halve the φ-step on an interval of length `length`, with `at` the integrands at a
-    /// node: keep the old nodes (now the even ones) and add the odd ones.
-    fn refine(
-        &mut self,
-        length: f64,
-        at: impl Fn(IntervalNode) -> Result<NodeSample>,
-    ) -> Result<()> {
+    /// Halve the φ-step of `map`, with `at` the integrands at a node: keep the old nodes
+    /// (now the even ones) and add the odd ones.
+    fn refine(&mut self, map: &Map, at: impl Fn(IntervalNode) -> Result<NodeSample>) -> Result<()> {
         let n = 2 * self.intervals;
-        self.nodes = interleave(&self.nodes, |j| {
-            at(IntervalNode::cosine_tabulated(n, j, length))
-        })?;
+        self.nodes = interleave(&self.nodes, |j| at(map.node(n, j)))?;
         self.intervals = n;
         Ok(())
     }
 
-    /// Δζ on this level, with its error from the two levels below.
-    fn drift(&self) -> DriftEstimate {
+    /// Δζ on this level, with its error from the two levels below. Those reuse this level's
+    /// ψ̃ (the phases cost most), so their differences see the aliasing of P̂ and of ν but
+    /// not that of ψ̃; ψ̃'s pointwise error is of the order of Δψ's (both are the aliasing of
+    /// the same coefficients), so `psi_error` (Δψ's estimate) times the path's length bounds
+    /// its effect and is added.
+    fn drift(&self, psi_error: f64) -> DriftEstimate {
+        let phases = antiderivative_phases(&self.nodes);
         let (fine, mid, coarse) = (
-            fourier_drift(&self.nodes, 1),
-            fourier_drift(&self.nodes, 2),
-            fourier_drift(&self.nodes, 4),
+            fourier_drift(&self.nodes, 1, &phases),
+            fourier_drift(&self.nodes, 2, &phases),
+            fourier_drift(&self.nodes, 4, &phases),
         );
         let (d1, d2) = (
             (fine.0[0] - mid.0[0]).hypot(fine.0[1] - mid.0[1]),
@@ -181,19 +199,130 @@ impl Samples {
         );
         DriftEstimate {
             value: fine.0,
-            error: cautious_error(d1, d2).max(8.0 * EPS * fine.1),
+            error: cautious_error(d1, d2).max(8.0 * EPS * fine.1) + psi_error * fine.1,
             scale: fine.1,
         }
     }
 }
 
+/// How φ ∈ [0, π] covers a libration [θ_min, θ_max].
+enum Map {
+    /// θ = θ_min + L (1 − cos φ)/2.
+    Plain { length: f64 },
+    /// The same in the Mercator coordinate s = ln tan(θ/2) (dθ/ds = sin θ): it sends the
+    /// poles θ = 0, π to s = ∓∞, and V = κ²/(2 sin²θ) + U, with sin θ = sech s and
+    /// cos θ = −tanh s, is analytic in the strip |Im s| < π/2 whatever the distance of a
+    /// turning point to a pole, where in θ the pole at distance θ_min narrows the strip of
+    /// convergence to ~√(θ_min/L).
+    Mercator {
+        /// tan(θ/2) at the two ends.
+        tan_half: [f64; 2],
+        /// s_max − s_min.
+        length: f64,
+        /// θ_max − θ_min.
+        theta_length: f64,
+    },
+}
+
+impl Map {
+    /// The maps to try in turn: the plain one, then (κ ≠ 0 and a turning point closer to
+    /// its pole than the libration is long) Mercator's. Mercator's coarsens the middle of a
+    /// long libration, where the shape's own singularities may lie close to the real axis
+    /// (the ellipsoid's at θ = π/2 ± i artanh(1/β) for β > 1), so it comes second.
+    fn candidates<S: Shape>(
+        v: &EffectivePotential<'_, S>,
+        piece: &Piece,
+    ) -> impl Iterator<Item = Map> {
+        let pole_distance = piece.left.site.theta.min(piece.right.site.from_pi);
+        let plain = Map::Plain {
+            length: piece.length,
+        };
+        let mercator =
+            (v.kappa != 0.0 && pole_distance < piece.length).then(|| Map::mercator(piece));
+        std::iter::once(plain).chain(mercator)
+    }
+
+    fn mercator(piece: &Piece) -> Self {
+        // tan(θ/2) = sin θ / (1 + cos θ) = (1 − cos θ) / sin θ, whichever has no cancellation.
+        let tan_half = |a: Angle| {
+            if a.cos >= 0.0 {
+                a.sin / (1.0 + a.cos)
+            } else {
+                (1.0 - a.cos) / a.sin
+            }
+        };
+        let tan_half = [tan_half(piece.left.angle), tan_half(piece.right.angle)];
+        Map::Mercator {
+            tan_half,
+            length: (tan_half[1] / tan_half[0]).ln(),
+            theta_length: piece.length,
+        }
+    }
+
+    /// Node j of the grid of `intervals` φ-steps, with θ measured from the nearer end.
+    fn node(&self, intervals: usize, j: usize) -> IntervalNode {
+        match *self {
+            Map::Plain { length } => IntervalNode::cosine_tabulated(intervals, j, length),
+            Map::Mercator {
+                tan_half,
+                length,
+                theta_length,
+            } => {
+                let unit = IntervalNode::cosine_tabulated(intervals, j, 1.0);
+                let left = unit.from_left <= unit.from_right;
+                // s − s_end = ±L_s sin²(φ/2) or ∓L_s cos²(φ/2); with q = e^{s − s_end} and
+                // t = tan(θ_end/2): |θ − θ_end| = 2 atan(t |q − 1| / (1 + t² q)) and
+                // sin θ = 2 t q / (1 + t² q²).
+                let (t, ds) = if left {
+                    (tan_half[0], length * unit.from_left)
+                } else {
+                    (tan_half[1], -length * unit.from_right)
+                };
+                let q_minus_1 = ds.exp_m1();
+                let q = 1.0 + q_minus_1;
+                let near = 2.0 * (t * q_minus_1.abs() / (1.0 + t * t * q)).atan();
+                let sin_theta = 2.0 * t * q / (1.0 + t * t * q * q);
+                // dθ/dφ = sin θ ds/dφ = sin θ L_s sin(φ/2) cos(φ/2).
+                let jacobian = sin_theta * length * unit.jacobian;
+                let far = theta_length - near;
+                if left {
+                    IntervalNode {
+                        from_left: near,
+                        from_right: far,
+                        jacobian,
+                    }
+                } else {
+                    IntervalNode {
+                        from_left: far,
+                        from_right: near,
+                        jacobian,
+                    }
+                }
+            }
+        }
+    }
+
+    /// ℓ with θ − θ_end ≈ ℓ φ²/4 near an end (φ measured from that end): L, or sin θ_end L_s.
+    fn end_length(&self, piece: &Piece, left: bool) -> f64 {
+        match *self {
+            Map::Plain { length } => length,
+            Map::Mercator { length, .. } => {
+                let end = if left { &piece.left } else { &piece.right };
+                end.angle.sin * length
+            }
+        }
+    }
+}
+
 /// The limit of the integrands at a turning point, where φ = 0 (left) or π (right): with
-/// ε − V ≈ g·(distance to the end), g = ∓V′ + tilt/L, dt/dφ → √(B L / (2 g)) and dθ/dφ → 0.
+/// ε − V ≈ g·(distance to the end), g = ∓V′ + tilt/L, θ − θ_end ≈ ℓ φ²/4 (see
+/// [`Map::end_length`]), dt/dφ → √(B ℓ / (2 g)) and dθ/dφ → 0.
 /// `None` when g is not safely positive (a nearly flat turning point: the substitution does
 /// not make the integrand smooth there).
 fn end_sample<S: Shape>(
     v: &EffectivePotential<'_, S>,
     piece: &Piece,
+    map: &Map,
     left: bool,
 ) -> Option<NodeSample> {
     let end = if left { &piece.left } else { &piece.right };
@@ -213,8 +342,28 @@ fn end_sample<S: Shape>(
     if g.is_nan() || g <= 1e3 * g_error {
         return None;
     }
-    let dt = (red.reduced_inertia * piece.length / (2.0 * g)).sqrt();
+    let dt = (red.reduced_inertia * map.end_length(piece, left) / (2.0 * g)).sqrt();
     Some(weighted(v, a, &red, dt, 0.0, g_error / g))
+}
+
+/// e^{iψ̃} at every node (ψ̃(0) = 0), ψ̃ the spectral antiderivative of ψ̇ dt/dφ − ν on the
+/// circle: ψ̃ = Σ_{k≠0} ĥ_k e^{ikφ} / (ik), the Nyquist term (odd in k) dropped. ψ̃ is odd,
+/// so the way out holds all of it. Returned as (sin, cos).
+fn antiderivative_phases(nodes: &[NodeSample]) -> Vec<(f64, f64)> {
+    let n = nodes.len() - 1;
+    let m = 2 * n;
+    let mut values: Vec<f64> = (0..m).map(|j| nodes[j.min(m - j)].dpsi).collect();
+    let mut spectrum = vec![Complex::new(0.0, 0.0); n + 1];
+    real_fft(&mut values, &mut spectrum);
+    spectrum[0] = Complex::new(0.0, 0.0);
+    spectrum[n] = Complex::new(0.0, 0.0);
+    for (k, c) in spectrum.iter_mut().enumerate().take(n).skip(1) {
+        *c *= Complex::new(0.0, -1.0 / (k as f64 * m as f64));
+    }
+    real_inverse_fft(&mut spectrum, &mut values);
+    (0..=n)
+        .map(|j| libm::sincos(values[j] - values[0]))
+        .collect()
 }
 
 /// Δζ and the L1 size of its integrand from every `stride`-th node. The path over one period
@@ -224,29 +373,22 @@ fn end_sample<S: Shape>(
 /// so Δζ = Σ_k P̂_k ∫₀^{2π} e^{i(ν+k)φ} dφ = 2 e^{iπν} sin(πν) Σ_k P̂_k / (ν + k): exact
 /// but for the aliasing of P̂, which decays like the trapezoid error. ψ̃ is odd, so
 /// P(−φ) = conj P(φ) and every P̂_k is real: R = |Σ_k P̂_k / (ν + k)|.
-fn fourier_drift(nodes: &[NodeSample], stride: usize) -> ([f64; 2], f64) {
+fn fourier_drift(nodes: &[NodeSample], stride: usize, phases: &[(f64, f64)]) -> ([f64; 2], f64) {
     let n = (nodes.len() - 1) / stride;
     let m = 2 * n;
     let node = |j: usize| &nodes[j.min(m - j) * stride];
-    let mut values: Vec<f64> = (0..m).map(|j| node(j).dpsi).collect();
+    // ν: the mean of ψ̇ dt/dφ over the circle, on this level.
+    let inner: f64 = (1..n).map(|j| node(j).dpsi).sum();
+    let nu = (node(0).dpsi + node(n).dpsi + 2.0 * inner) / m as f64;
+    let mut values = vec![0.0; m];
     let mut spectrum = vec![Complex::new(0.0, 0.0); n + 1];
-    real_fft(&mut values, &mut spectrum);
-    let nu = spectrum[0].re / m as f64;
-    // ψ̃ = Σ_{k≠0} ĥ_k e^{ikφ} / (ik); the Nyquist term (odd in k) is dropped.
-    spectrum[0] = Complex::new(0.0, 0.0);
-    spectrum[n] = Complex::new(0.0, 0.0);
-    for (k, c) in spectrum.iter_mut().enumerate().take(n).skip(1) {
-        *c *= Complex::new(0.0, -1.0 / (k as f64 * m as f64));
-    }
-    let mut psi = vec![0.0; m];
-    real_inverse_fft(&mut spectrum, &mut psi);
     // y_j = Re P_j + Im P_j: its real transform Y_k gives m P̂_{±k} = Re Y_k ∓ Im Y_k (the
     // even part Re P transforms to a real, the odd part Im P to an imaginary sequence).
     let mut scale = 0.0;
     for j in 0..=n {
         let s = node(j);
         scale += s.along.abs() + s.across.abs();
-        let (sp, cp) = libm::sincos(psi[j] - psi[0]);
+        let (sp, cp) = phases[j * stride];
         // P = −e^{iψ̃} (along + i across)
         let (re, im) = (
             -(cp * s.along - sp * s.across),
@@ -270,23 +412,22 @@ fn fourier_drift(nodes: &[NodeSample], stride: usize) -> ([f64; 2], f64) {
     let k0 = (-nu).round();
     let delta = nu + k0;
     let (sd, cd) = (PI * delta).sin_cos();
-    let weight = |k: f64| {
+    let term = |p: f64, k: f64| {
         if k == k0 {
-            if delta == 0.0 {
-                PI
-            } else {
-                sd / delta
-            }
+            p * if delta == 0.0 { PI } else { sd / delta }
         } else {
-            sd / (nu + k)
+            p * sd / (nu + k)
         }
     };
-    let mut sum = (spectrum[0].re - spectrum[0].im) * weight(0.0);
-    for (k, c) in spectrum.iter().enumerate().skip(1) {
-        sum += (c.re - c.im) * weight(k as f64);
-        if k < n {
-            sum += (c.re + c.im) * weight(-(k as f64));
-        }
+    let mut sum = term(spectrum[0].re - spectrum[0].im, 0.0) + term(spectrum[n].re, n as f64);
+    for (k, c) in spectrum.iter().enumerate().take(n).skip(1) {
+        let (plus, minus, k) = (c.re - c.im, c.re + c.im, k as f64);
+        sum += if k == k0.abs() {
+            term(plus, k) + term(minus, -k)
+        } else {
+            // m P̂_k/(ν + k) + m P̂_{−k}/(ν − k) with one division (|ν ± k| ≥ ½ here).
+            sd * (plus * (nu - k) + minus * (nu + k)) / ((nu - k) * (nu + k))
+        };
     }
     let drift = 2.0 * sum / m as f64;
     ([cd * drift, sd * drift], scale * PI / n as f64)

@@ -1,0 +1,210 @@
+"""The reduced model of SPEC §1 in plain Python, for scripts that check or race rubber-atlas.
+
+Three layers share the formulas of SPEC §1.2–1.3 (Z, U, B, J, V, ψ̇):
+- `HighPrecision`: T and Δψ (N = −Δψ/2π) of one component by mpmath's tanh-sinh quadrature at
+  40 significant digits, split at the critical points of V — an independent reference for the
+  hard cells (near a separatrix, a pole or a minimum), where an ODE run is least reliable.
+- `midpoint_rotation_numbers`: what a researcher vectorises by hand with NumPy — N alone by
+  the periodic midpoint rule after θ = c − (L/2) cos φ.
+- `scipy_cell`: what a researcher writes first — turning points by brentq, T and Δψ by
+  scipy.integrate.quad.
+"""
+
+from __future__ import annotations
+
+import math
+
+import mpmath
+import numpy as np
+
+
+class Body:
+    """The ellipsoid of SPEC §1.2: α, β, ν, η."""
+
+    def __init__(self, alpha: float, beta: float, nu: float = 0.5, eta: float = 0.5):
+        self.alpha, self.beta, self.nu, self.eta = alpha, beta, nu, eta
+
+    # Formulas generic in the number type (float, numpy array or mpmath mpf), with the
+    # trigonometric functions passed in.
+    def _z(self, s, c, sqrt):
+        return sqrt(self.beta**2 * s * s + c * c)
+
+    def potential(self, theta, kappa, lib=np):
+        """V(θ) = κ²/(2 sin²θ) + Z(θ) + α cosθ."""
+        s, c = lib.sin(theta), lib.cos(theta)
+        return kappa * kappa / (2 * s * s) + self._z(s, c, lib.sqrt) + self.alpha * c
+
+    def slope(self, theta, kappa, lib=np):
+        """V′(θ) = −κ² cosθ / sin³θ − α sinθ + (β² − 1) sinθ cosθ / Z."""
+        s, c = lib.sin(theta), lib.cos(theta)
+        z = self._z(s, c, lib.sqrt)
+        return -kappa * kappa * c / s**3 - self.alpha * s + (self.beta**2 - 1) * s * c / z
+
+    def inertia(self, theta, lib=np):
+        """B(θ) = 1/η + (β⁴ sin²θ + (cosθ + αZ)²) / Z²."""
+        s, c = lib.sin(theta), lib.cos(theta)
+        z = self._z(s, c, lib.sqrt)
+        return 1 / self.eta + (self.beta**4 * s * s + (c + self.alpha * z) ** 2) / (z * z)
+
+    def integral_factor(self, theta, lib=np):
+        """J(θ) = √((cos²θ + ν sin²θ)/η + (Z + α cosθ)²)."""
+        s, c = lib.sin(theta), lib.cos(theta)
+        z = self._z(s, c, lib.sqrt)
+        return lib.sqrt((c * c + self.nu * s * s) / self.eta + (z + self.alpha * c) ** 2)
+
+    def psi_rate(self, theta, kappa, lib=np):
+        """ψ̇ = −κ cosθ / (J sin²θ)."""
+        s, c = lib.sin(theta), lib.cos(theta)
+        return -kappa * c / (self.integral_factor(theta, lib) * s * s)
+
+
+def _bisect(f, a, b):
+    """A root of f between a and b (f changes sign) by bisection to the working precision."""
+    fa = f(a)
+    eps = mpmath.mpf(2) ** (-mpmath.mp.prec)
+    while abs(b - a) > 4 * eps * max(abs(a), abs(b)):
+        m = (a + b) / 2
+        fm = f(m)
+        if fm == 0:
+            return m
+        if (fm > 0) == (fa > 0):
+            a, fa = m, fm
+        else:
+            b = m
+    return (a + b) / 2
+
+
+class _Mp:
+    """mpmath under the names the formulas use."""
+
+    sin, cos, sqrt = staticmethod(mpmath.sin), staticmethod(mpmath.cos), staticmethod(mpmath.sqrt)
+
+
+class HighPrecision:
+    """T and N of the component of {V ≤ ε} around a given θ, at `digits` significant digits."""
+
+    def __init__(self, body: Body, kappa: float, digits: int = 40):
+        self.body, self.kappa, self.digits = body, mpmath.mpf(kappa), digits
+
+    def _v(self, theta):
+        return self.body.potential(theta, self.kappa, _Mp)
+
+    def _dv(self, theta):
+        return self.body.slope(theta, self.kappa, _Mp)
+
+    def critical_points(self, cells: int = 4000):
+        """Roots of V′ in (0, π) (κ ≠ 0), by a scan of sin³θ V′ and findroot."""
+        with mpmath.workdps(self.digits):
+            g = lambda t: self._dv(t) * mpmath.sin(t) ** 3  # noqa: E731
+            grid = [mpmath.pi * (i + 0.5) / cells for i in range(cells)]
+            values = [g(t) for t in grid]
+            roots = []
+            for a, b, fa, fb in zip(grid, grid[1:], values, values[1:]):
+                if fa == 0 or fa * fb < 0:
+                    roots.append(_bisect(g, a, b))
+            return roots
+
+    def component(self, energy: float, near: float, critical=None):
+        """The turning points [θ_min, θ_max] of the component containing or nearest `near`,
+        and the critical points strictly inside."""
+        with mpmath.workdps(self.digits):
+            e = mpmath.mpf(energy)
+            crit = self.critical_points() if critical is None else critical
+            nodes = [mpmath.mpf(0)] + list(crit) + [mpmath.pi]
+            level = lambda t: self._v(t) - e  # noqa: E731
+            # Walk the monotone pieces between nodes; each sign change holds one turning point.
+            ends = []
+            for a, b in zip(nodes, nodes[1:]):
+                la = mpmath.inf if a == 0 else level(a)
+                lb = mpmath.inf if b == mpmath.pi else level(b)
+                if (la > 0) != (lb > 0):
+                    lo = a if a > 0 else mpmath.mpf(10) ** (-self.digits // 2)
+                    hi = b if b < mpmath.pi else mpmath.pi - mpmath.mpf(10) ** (-self.digits // 2)
+                    ends.append(_bisect(level, lo, hi))
+            pairs = list(zip(ends[0::2], ends[1::2]))
+            lo, hi = min(pairs, key=lambda p: 0 if p[0] <= near <= p[1] else min(abs(p[0] - near), abs(p[1] - near)))
+            interior = [c for c in crit if lo < c < hi]
+            return lo, hi, interior
+
+    def integrals(self, energy: float, near: float):
+        """(θ_min, θ_max, T, N) of the component nearest `near`, as floats."""
+        with mpmath.workdps(self.digits):
+            e = mpmath.mpf(energy)
+            lo, hi, interior = self.component(energy, near)
+            points = [lo] + interior + [hi]
+
+            def dt(t):
+                gap = e - self._v(t)
+                # Nodes within the last digits of a turning point may round to gap ≤ 0; their
+                # weight (√ of the distance) is far below the working precision.
+                if gap <= 0:
+                    return mpmath.mpf(0)
+                return mpmath.sqrt(self.body.inertia(t, _Mp) / (2 * gap))
+
+            period = 2 * mpmath.quad(dt, points)
+            advance = 2 * mpmath.quad(lambda t: self.body.psi_rate(t, self.kappa, _Mp) * dt(t), points)
+            return float(lo), float(hi), float(period), float(-advance / (2 * mpmath.pi))
+
+
+def midpoint_rotation_numbers(body: Body, kappas, energies, nodes: int = 64):
+    """N for every (κ, ε) of a grid whose cells each hold one libration around the minimum
+    of V, vectorised over the grid: turning points by vectorised bisection (60 halvings), then
+    the periodic midpoint rule in φ after θ = c − (L/2) cos φ, with `nodes` nodes on [0, π].
+    The way a researcher computes N alone with NumPy; no error control."""
+    kappa, energy = np.meshgrid(np.asarray(kappas, float), np.asarray(energies, float), indexing="ij")
+    kappa, energy = kappa.ravel(), energy.ravel()
+    # The minimum of V per κ by vectorised golden-section-free bisection on V′.
+    lo, hi = np.full_like(kappa, 1e-6), np.full_like(kappa, math.pi - 1e-6)
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        rising = body.slope(mid, kappa) > 0
+        hi = np.where(rising, mid, hi)
+        lo = np.where(rising, lo, mid)
+    centre = 0.5 * (lo + hi)
+
+    def root(a, b):
+        for _ in range(60):
+            mid = 0.5 * (a + b)
+            above = body.potential(mid, kappa) > energy
+            # V − ε changes sign between a and b: keep the half that still does.
+            a_above = body.potential(a, kappa) > energy
+            a, b = np.where(above == a_above, mid, a), np.where(above == a_above, b, mid)
+        return 0.5 * (a + b)
+
+    theta_min = root(np.full_like(kappa, 1e-9), centre)
+    theta_max = root(centre, np.full_like(kappa, math.pi - 1e-9))
+    phi = (np.arange(nodes) + 0.5) * math.pi / nodes
+    c, half = 0.5 * (theta_min + theta_max), 0.5 * (theta_max - theta_min)
+    theta = c[:, None] - half[:, None] * np.cos(phi)[None, :]
+    gap = np.maximum(energy[:, None] - body.potential(theta, kappa[:, None]), 1e-300)
+    dt = np.sqrt(body.inertia(theta) / (2 * gap)) * half[:, None] * np.sin(phi)[None, :]
+    advance = 2 * math.pi / nodes * np.sum(body.psi_rate(theta, kappa[:, None]) * dt, axis=1)
+    return (-advance / (2 * math.pi)).reshape(len(kappas), len(energies))
+
+
+def scipy_cell(body: Body, kappa: float, energy: float, tol: float = 1e-10):
+    """(T, N) of the libration around the lowest minimum of V with SciPy: the minimum by
+    minimize_scalar, the turning points by brentq, T and Δψ by quad (which copes with the
+    1/√ ends by its own extrapolation)."""
+    from scipy import integrate, optimize
+
+    v = lambda t: body.potential(t, kappa, math_lib)  # noqa: E731
+    centre = optimize.minimize_scalar(v, bounds=(1e-6, math.pi - 1e-6), method="bounded").x
+    theta_min = optimize.brentq(lambda t: v(t) - energy, 1e-12, centre, xtol=1e-15)
+    theta_max = optimize.brentq(lambda t: v(t) - energy, centre, math.pi - 1e-12, xtol=1e-15)
+
+    def dt(t):
+        return math.sqrt(body.inertia(t, math_lib) / (2 * max(energy - v(t), 1e-300)))
+
+    period = 2 * integrate.quad(dt, theta_min, theta_max, epsabs=0, epsrel=tol, limit=200)[0]
+    advance = 2 * integrate.quad(
+        lambda t: body.psi_rate(t, kappa, math_lib) * dt(t), theta_min, theta_max, epsabs=tol, epsrel=tol, limit=200
+    )[0]
+    return period, -advance / (2 * math.pi)
+
+
+class _Math:
+    sin, cos, sqrt = staticmethod(math.sin), staticmethod(math.cos), staticmethod(math.sqrt)
+
+
+math_lib = _Math
