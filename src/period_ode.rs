@@ -106,13 +106,13 @@ fn run<S: Shape>(
 }
 
 /// One run at tolerance `tol`: [T, Δψ, Δx_c, Δy_c, path scale, timing error of the event,
-/// energy error at the end] and the steps taken.
+/// energy error at the end, 1 if the run did not come back to θ_min] and the steps taken.
 fn one_period<S: Shape>(
     potential: &EffectivePotential<'_, S>,
     energy: f64,
     component: &Component,
     tol: f64,
-) -> Result<([f64; 7], usize)> {
+) -> Result<([f64; 8], usize)> {
     let system = ReducedSystem::new(potential.body, potential.kappa);
     let theta0 = component.theta_min();
     let (p0, event) = match component.kind {
@@ -167,14 +167,37 @@ fn one_period<S: Shape>(
         }
         s -= correction;
     }
-    // The event time is only as good as g's absolute accuracy (~ tol) over its rate.
+    // The event time is only as good as g's absolute accuracy (~ tol) over its rate, and
+    // never better than the rounding of t itself (which matters where ψ̇ is huge: near a
+    // pole at small κ, ψ̇ ~ 1/κ at θ_min).
     let (_, rate) = plain.event(&y);
-    let timing = tol * y[1].abs().max(1.0) / rate.abs().max(f64::MIN_POSITIVE);
+    let timing = (tol * y[1].abs().max(1.0) / rate.abs().max(f64::MIN_POSITIVE))
+        .max(2.0 * f64::EPSILON * (ta + s));
+    // A libration's run must come back to θ_min: near a separatrix the energy error can carry
+    // it over the saddle into the neighbouring well, and the event then marks another orbit
+    // (far from θ_min; an event on the right orbit is off by ~ tol ε / V′(θ_min) only).
+    let strayed = match event {
+        EventKind::Momentum => {
+            let length = component.theta_max() - component.theta_min();
+            (y[0] - theta0).abs() > 1e-2 * length.max(f64::MIN_POSITIVE)
+        }
+        EventKind::Angle(_) => false,
+    };
     let end_energy =
         0.5 * potential.body.reduced_inertia(y[0]) * y[1] * y[1] + system.effective_potential(y[0]);
     let energy_error = (end_energy - energy).abs();
+    let strayed = if strayed { 1.0 } else { 0.0 };
     Ok((
-        [ta + s, y[2], y[3], y[4], y[5], timing, energy_error],
+        [
+            ta + s,
+            y[2],
+            y[3],
+            y[4],
+            y[5],
+            timing,
+            energy_error,
+            strayed,
+        ],
         steps,
     ))
 }
@@ -209,16 +232,25 @@ pub fn integrate<S: Shape>(
     let energy_error = tight[6].max(loose[6]);
     let (saddle_t, saddle_psi) =
         potential.saddle_conditioning(energy, component, tight[0], double, energy_error);
-    let period_error = (tight[0] - loose[0]).abs() + eps * tight[0] + timing + saddle_t;
-    let psi_advance_error =
+    let mut period_error = (tight[0] - loose[0]).abs() + eps * tight[0] + timing + saddle_t;
+    let mut psi_advance_error =
         (tight[1] - loose[1]).abs() + eps * tight[1].abs() + psi_rate * timing + saddle_psi;
-    let drift = with_drift.then(|| DriftEstimate {
-        value: [tight[2], tight[3]],
-        error: (tight[2] - loose[2]).hypot(tight[3] - loose[3])
+    // A run that strayed into another orbit measured nothing of this one.
+    let strayed = tight[7] != 0.0 || loose[7] != 0.0;
+    if strayed {
+        period_error = period_error.max(tight[0].abs());
+        psi_advance_error = psi_advance_error.max(tight[1].abs()).max(TAU);
+    }
+    let drift = with_drift.then(|| {
+        let error = (tight[2] - loose[2]).hypot(tight[3] - loose[3])
             + eps * tight[4]
             + tight[4] / tight[0] * (timing + saddle_t)
-            + tight[4] * saddle_psi,
-        scale: tight[4],
+            + tight[4] * saddle_psi;
+        DriftEstimate {
+            value: [tight[2], tight[3]],
+            error: if strayed { error.max(tight[4]) } else { error },
+            scale: tight[4],
+        }
     });
     Ok(PeriodIntegrals {
         period: tight[0],
