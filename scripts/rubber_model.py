@@ -146,40 +146,45 @@ class HighPrecision:
             return float(lo), float(hi), float(period), float(-advance / (2 * mpmath.pi))
 
 
-def midpoint_rotation_numbers(body: Body, kappas, energies, nodes: int = 64):
-    """N for every (κ, ε) of a grid whose cells each hold one libration around the minimum
-    of V, vectorised over the grid: turning points by vectorised bisection (60 halvings), then
-    the periodic midpoint rule in φ after θ = c − (L/2) cos φ, with `nodes` nodes on [0, π].
-    The way a researcher computes N alone with NumPy; no error control."""
+def midpoint_rotation_numbers(body: Body, kappas, energies, nodes: int = 64, grid: int = 128):
+    """N for every (κ, ε) of a grid, for the libration around the lowest minimum of V,
+    vectorised over the cells: V on a θ-grid of `grid` points locates the minimum and the first
+    grid points above ε on either side, 50 bisections refine the turning points, and the
+    periodic midpoint rule in φ after θ = c − (L/2) cos φ with `nodes` nodes on [0, π] gives
+    Δψ. The way a researcher computes N alone with NumPy: no error control, NaN where ε is
+    below the minimum."""
     kappa, energy = np.meshgrid(np.asarray(kappas, float), np.asarray(energies, float), indexing="ij")
-    kappa, energy = kappa.ravel(), energy.ravel()
-    # The minimum of V per κ by vectorised golden-section-free bisection on V′.
-    lo, hi = np.full_like(kappa, 1e-6), np.full_like(kappa, math.pi - 1e-6)
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        rising = body.slope(mid, kappa) > 0
-        hi = np.where(rising, mid, hi)
-        lo = np.where(rising, lo, mid)
-    centre = 0.5 * (lo + hi)
+    kappa, energy = kappa.ravel()[:, None], energy.ravel()[:, None]
+    theta = np.linspace(1e-9, math.pi - 1e-9, grid)[None, :]
+    v = body.potential(theta, kappa)
+    index = np.arange(grid)[None, :]
+    lowest = np.argmin(v, axis=1)[:, None]
+    above = v > energy
+    # First grid point above ε right of the minimum, last one left of it (else the poles).
+    right = np.where(above & (index > lowest), index, grid - 1).min(axis=1)
+    left = np.where(above & (index < lowest), index, 0).max(axis=1)
+    step = theta[0, 1] - theta[0, 0]
+    kappa, energy = kappa[:, 0], energy[:, 0]
 
-    def root(a, b):
-        for _ in range(60):
-            mid = 0.5 * (a + b)
-            above = body.potential(mid, kappa) > energy
-            # V − ε changes sign between a and b: keep the half that still does.
-            a_above = body.potential(a, kappa) > energy
-            a, b = np.where(above == a_above, mid, a), np.where(above == a_above, b, mid)
-        return 0.5 * (a + b)
+    def root(inside, outside):
+        # V(inside) ≤ ε < V(outside): halve the bracket 50 times.
+        for _ in range(50):
+            mid = 0.5 * (inside + outside)
+            out = body.potential(mid, kappa) > energy
+            outside, inside = np.where(out, mid, outside), np.where(out, inside, mid)
+        return 0.5 * (inside + outside)
 
-    theta_min = root(np.full_like(kappa, 1e-9), centre)
-    theta_max = root(centre, np.full_like(kappa, math.pi - 1e-9))
+    theta_min = root(theta[0, left] + step, theta[0, left])
+    theta_max = root(theta[0, right] - step, theta[0, right])
     phi = (np.arange(nodes) + 0.5) * math.pi / nodes
     c, half = 0.5 * (theta_min + theta_max), 0.5 * (theta_max - theta_min)
-    theta = c[:, None] - half[:, None] * np.cos(phi)[None, :]
-    gap = np.maximum(energy[:, None] - body.potential(theta, kappa[:, None]), 1e-300)
-    dt = np.sqrt(body.inertia(theta) / (2 * gap)) * half[:, None] * np.sin(phi)[None, :]
-    advance = 2 * math.pi / nodes * np.sum(body.psi_rate(theta, kappa[:, None]) * dt, axis=1)
-    return (-advance / (2 * math.pi)).reshape(len(kappas), len(energies))
+    t = c[:, None] - half[:, None] * np.cos(phi)[None, :]
+    gap = energy[:, None] - body.potential(t, kappa[:, None])
+    dt = np.sqrt(body.inertia(t) / (2 * gap)) * half[:, None] * np.sin(phi)[None, :]
+    advance = 2 * math.pi / nodes * np.sum(body.psi_rate(t, kappa[:, None]) * dt, axis=1)
+    n = -advance / (2 * math.pi)
+    n[energy <= v.min(axis=1)] = np.nan
+    return n.reshape(len(kappas), len(energies))
 
 
 def scipy_cell(body: Body, kappa: float, energy: float, tol: float = 1e-10):

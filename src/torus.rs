@@ -454,9 +454,12 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             .flatten()
             .find(|p| p.value <= energy)
             .copied();
-        let level = |site: Site| -> f64 {
+        let inside_angle = inside.map(|c| c.site.angle());
+        // (V − ε, V′) at a site.
+        let level = |site: Site| -> (f64, f64) {
             let t = site.angle();
-            if let Some(c) = inside {
+            let slope = self.slope(t);
+            if let (Some(c), Some(c_angle)) = (inside, inside_angle) {
                 let diff =
                     if self.kappa != 0.0 && site.theta > FRAC_PI_2 && c.site.theta > FRAC_PI_2 {
                         c.site.from_pi - site.from_pi
@@ -465,11 +468,11 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                     };
                 let (sd, cd) = libm::sincos(diff);
                 if cd > -0.4 {
-                    let d = divided_difference(self, t, c.site.angle(), sd, cd).0;
-                    return sd * d - (energy - c.value);
+                    let d = divided_difference(self, t, c_angle, sd, cd).0;
+                    return (sd * d - (energy - c.value), slope);
                 }
             }
-            self.value(t) - energy
+            (self.value(t) - energy, slope)
         };
         // Newton starts from the quadratic model around the minimum inside,
         // θ = c ± √(2 (ε − V_c) / V″_c), when it has one.
@@ -480,16 +483,13 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         });
         let start_theta = offset.map(|(c, d)| c.site.theta + d);
         let start_phi = offset.map(|(c, d)| c.site.from_pi - d);
-        let f_left = |x: f64| {
-            let s = Site::at(x);
-            (level(s), self.slope(s.angle()))
-        };
+        let f_left = |x: f64| level(Site::at(x));
         if self.kappa == 0.0 || hi <= FRAC_PI_2 {
             return Site::at(safe_newton(f_left, lo, hi, start_theta));
         }
         let f_right = |phi: f64| {
-            let s = Site::from_pi(phi);
-            (level(s), -self.slope(s.angle()))
+            let (value, slope) = level(Site::from_pi(phi));
+            (value, -slope)
         };
         let phi_lo = b.map_or(0.0, |p| p.site.from_pi);
         if lo >= FRAC_PI_2 {

@@ -56,15 +56,16 @@ fn integrate_on<S: Shape>(
         return Ok(None);
     };
     loop {
-        let period = 2.0 * samples.sum(1, |n| n.dt);
-        let t_error = 2.0 * samples.error(|n| n.dt);
-        let psi_error = 2.0 * samples.error(|n| n.dpsi);
+        let (t_sums, psi_sums) = samples.level_sums();
+        let period = 2.0 * t_sums[0];
+        let t_error = 2.0 * level_error(t_sums);
+        let psi_error = 2.0 * level_error(psi_sums);
         let mut done = t_error <= 0.5 * tol * period && psi_error / TAU <= 0.5 * tol;
         // The drift (the costly part) only once T and Δψ have converged.
         let drift = (done && with_drift).then(|| samples.drift(psi_error));
         done &= drift.is_none_or(|d| d.error <= tol * d.scale);
         if done {
-            let psi_advance = 2.0 * samples.sum(1, |n| n.dpsi);
+            let psi_advance = 2.0 * psi_sums[0];
             let (saddle_t, saddle_psi) = v.saddle_conditioning(energy, component, period, 2.0, 0.0);
             let period_rounding = 2.0 * samples.rounding(|n| n.dt);
             let psi_rounding = 2.0 * samples.rounding(|n| n.dpsi);
@@ -87,8 +88,8 @@ fn integrate_on<S: Shape>(
             }));
         }
         let hopeless = samples.intervals >= LAST_INTERVALS
-            || !samples.reaches(|n| n.dt, 0.5 * tol * period)
-            || !samples.reaches(|n| n.dpsi, 0.25 * tol * TAU);
+            || !reaches(samples.intervals, t_sums, 0.5 * tol * period)
+            || !reaches(samples.intervals, psi_sums, 0.25 * tol * TAU);
         if hopeless {
             return Ok(None);
         }
@@ -138,33 +139,26 @@ impl Samples {
         PI * stride as f64 / self.intervals as f64 * (inner + ends)
     }
 
-    /// Error of the sum of `f` on n steps, from the sums on n, n/2 and n/4 steps (see
-    /// [`cautious_error`]: the trapezoid rule's E(n) = C ρⁿ would allow d₁²/d₂, but not an
-    /// integrand with singularities at several distances from the real axis).
-    fn error(&self, f: impl Fn(&NodeSample) -> f64 + Copy) -> f64 {
-        let (i0, i1, i2) = (self.sum(1, f), self.sum(2, f), self.sum(4, f));
-        cautious_error((i0 - i1).abs(), (i1 - i2).abs()).max(8.0 * EPS * i0.abs())
-    }
-
-    /// Whether the geometric convergence seen so far reaches `target` within
-    /// [`LAST_INTERVALS`]: with d₁ ≈ E(n/2) and d₂ ≈ E(n/4), E(m) ≈ d₁ (d₁/d₂)^{(m − n/2)/(n/4)}.
-    /// Only judged from 16 steps on (before that the convergence may not have set in).
-    fn reaches(&self, f: impl Fn(&NodeSample) -> f64 + Copy, target: f64) -> bool {
-        if self.intervals < 16 {
-            return true;
+    /// The trapezoid sums over [0, π] of dt/dφ and of ψ̇ dt/dφ on n, n/2 and n/4 steps
+    /// (finest first), in one pass.
+    fn level_sums(&self) -> ([f64; 3], [f64; 3]) {
+        let (mut t, mut psi) = ([0.0; 3], [0.0; 3]);
+        let last = self.nodes.len() - 1;
+        for (j, node) in self.nodes.iter().enumerate() {
+            let w = if j == 0 || j == last { 0.5 } else { 1.0 };
+            for (level, stride) in [1, 2, 4].into_iter().enumerate() {
+                if j % stride == 0 {
+                    t[level] += w * node.dt;
+                    psi[level] += w * node.dpsi;
+                }
+            }
         }
-        let (i0, i1, i2) = (self.sum(1, f), self.sum(2, f), self.sum(4, f));
-        let (d1, d2) = ((i0 - i1).abs(), (i1 - i2).abs());
-        if d1 <= target || d2 == 0.0 {
-            return true;
+        let h = PI / self.intervals as f64;
+        for (level, stride) in [1.0, 2.0, 4.0].into_iter().enumerate() {
+            t[level] *= h * stride;
+            psi[level] *= h * stride;
         }
-        let ratio = d1 / d2;
-        if ratio >= 0.5 {
-            return false;
-        }
-        let n = self.intervals as f64;
-        let doublings_left = (LAST_INTERVALS as f64 - 0.5 * n) / (0.25 * n);
-        d1 * ratio.powf(doublings_left) <= target
+        (t, psi)
     }
 
     /// Σ ½ (relative gap error) |f| over the nodes with the trapezoid weights.
@@ -203,6 +197,32 @@ impl Samples {
             scale: fine.1,
         }
     }
+}
+
+/// Error of the trapezoid sum on n steps from the sums on n, n/2 and n/4 steps (see
+/// [`cautious_error`]: the trapezoid rule's E(n) = C ρⁿ would allow d₁²/d₂, but not an
+/// integrand with singularities at several distances from the real axis).
+fn level_error(sums: [f64; 3]) -> f64 {
+    let [i0, i1, i2] = sums;
+    cautious_error((i0 - i1).abs(), (i1 - i2).abs()).max(8.0 * EPS * i0.abs())
+}
+
+/// Whether the geometric convergence seen in `sums` (on n = `intervals`, n/2 and n/4 steps)
+/// brings the error within `target` by [`LAST_INTERVALS`] steps: with d₁ ≈ E(n/2),
+/// d₂ ≈ E(n/4) and r = d₁/d₂, E(m) ≈ d₁ r^{(m − n/2)/(n/4)}.
+fn reaches(intervals: usize, sums: [f64; 3], target: f64) -> bool {
+    let [i0, i1, i2] = sums;
+    let (d1, d2) = ((i0 - i1).abs(), (i1 - i2).abs());
+    if d1 <= target || d2 == 0.0 {
+        return true;
+    }
+    let ratio = d1 / d2;
+    if ratio >= 0.5 {
+        return false;
+    }
+    let n = intervals as f64;
+    let quarters_left = (LAST_INTERVALS as f64 - 0.5 * n) / (0.25 * n);
+    d1 * ratio.powf(quarters_left) <= target
 }
 
 /// How φ ∈ [0, π] covers a libration [θ_min, θ_max].
