@@ -180,7 +180,8 @@ def midpoint_rotation_numbers(body: Body, kappas, energies, nodes: int = 64, gri
     c, half = 0.5 * (theta_min + theta_max), 0.5 * (theta_max - theta_min)
     t = c[:, None] - half[:, None] * np.cos(phi)[None, :]
     gap = energy[:, None] - body.potential(t, kappa[:, None])
-    dt = np.sqrt(body.inertia(t) / (2 * gap)) * half[:, None] * np.sin(phi)[None, :]
+    with np.errstate(invalid="ignore"):  # cells without motion: NaN, masked below
+        dt = np.sqrt(body.inertia(t) / (2 * gap)) * half[:, None] * np.sin(phi)[None, :]
     advance = 2 * math.pi / nodes * np.sum(body.psi_rate(t, kappa[:, None]) * dt, axis=1)
     n = -advance / (2 * math.pi)
     n[energy <= v.min(axis=1)] = np.nan

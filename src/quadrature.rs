@@ -7,7 +7,6 @@
 
 use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
 use rustfft::num_complex::Complex;
-use rustfft::{Fft, FftPlanner};
 use std::cell::RefCell;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 use std::sync::Arc;
@@ -135,13 +134,9 @@ impl TanhSinhLevel {
     }
 }
 
-type Plans = (Arc<dyn Fft<f64>>, Arc<dyn Fft<f64>>);
 type RealPlans = (Arc<dyn RealToComplex<f64>>, Arc<dyn ComplexToReal<f64>>);
 
 thread_local! {
-    static PLANNER: RefCell<FftPlanner<f64>> = RefCell::new(FftPlanner::new());
-    /// Forward and inverse plans for the power-of-two sizes, by log₂ of the size.
-    static POWER_OF_TWO_PLANS: RefCell<Vec<Option<Plans>>> = const { RefCell::new(Vec::new()) };
     static REAL_PLANNER: RefCell<RealFftPlanner<f64>> = RefCell::new(RealFftPlanner::new());
     /// Real-data plans for the power-of-two sizes, by log₂ of the size.
     static REAL_PLANS: RefCell<Vec<Option<RealPlans>>> = const { RefCell::new(Vec::new()) };
@@ -213,23 +208,6 @@ pub fn real_inverse_fft(spectrum: &mut [Complex<f64>], output: &mut [f64]) {
     });
 }
 
-/// The discrete Fourier transform of `buf` (a power of two long) in place, unnormalised:
-/// X_k = Σ_j x_j e^{∓2πi jk/n} (− forward, + inverse), with plans cached per thread.
-pub fn fft(buf: &mut [Complex<f64>], inverse: bool) {
-    let n = buf.len();
-    let plans = cached(&POWER_OF_TWO_PLANS, n, || {
-        PLANNER.with(|p| {
-            let mut p = p.borrow_mut();
-            (p.plan_fft_forward(n), p.plan_fft_inverse(n))
-        })
-    });
-    if inverse {
-        plans.1.process(buf)
-    } else {
-        plans.0.process(buf)
-    }
-}
-
 /// Cumulative integrals on a uniform grid of a function that vanishes (with its derivatives)
 /// at both ends of the grid, as tanh-sinh integrands do: G_j = ∫ from τ_0 to τ_j of g, from
 /// the trigonometric interpolant of the zero-padded samples (spectrally accurate).
@@ -239,31 +217,28 @@ pub fn spectral_antiderivative(values: &[f64], step: f64) -> Vec<f64> {
     if n < 2 {
         return vec![0.0; n];
     }
-    let m = n.next_power_of_two();
-    let mut buf: Vec<Complex<f64>> = values
+    let m = n.next_power_of_two().max(2);
+    let mut padded: Vec<f64> = values
         .iter()
-        .map(|&v| Complex::new(v, 0.0))
-        .chain(std::iter::repeat_n(Complex::new(0.0, 0.0), m - n))
+        .copied()
+        .chain(std::iter::repeat_n(0.0, m - n))
         .collect();
-    fft(&mut buf, false);
-    let mean = buf[0].re;
-    // c_k = ĝ_k m / (2πi k′) with k′ the signed frequency; the Nyquist term is dropped.
-    let mut offset = Complex::new(0.0, 0.0);
-    buf[0] = Complex::new(0.0, 0.0);
-    buf[m / 2] = Complex::new(0.0, 0.0);
-    for (k, c) in buf.iter_mut().enumerate().skip(1) {
-        let signed = if k < m / 2 {
-            k as f64
-        } else {
-            k as f64 - m as f64
-        };
-        *c *= Complex::new(0.0, -(m as f64) / (TAU * signed));
-        offset += *c;
+    let mut spectrum = vec![Complex::new(0.0, 0.0); m / 2 + 1];
+    real_fft(&mut padded, &mut spectrum);
+    let mean = spectrum[0].re;
+    // c_k = ĝ_k m / (2πi k) for 0 < k < m/2 (the negative frequencies are their conjugates,
+    // so Σ_{k≠0} c_k = 2 Re Σ c_k); the Nyquist term is dropped.
+    let mut offset = 0.0;
+    spectrum[0] = Complex::new(0.0, 0.0);
+    spectrum[m / 2] = Complex::new(0.0, 0.0);
+    for (k, c) in spectrum.iter_mut().enumerate().take(m / 2).skip(1) {
+        *c *= Complex::new(0.0, -(m as f64) / (TAU * k as f64));
+        offset += 2.0 * c.re;
     }
-    fft(&mut buf, true);
+    real_inverse_fft(&mut spectrum, &mut padded);
     let scale = step / m as f64;
     (0..n)
-        .map(|j| scale * (mean * j as f64 + (buf[j] - offset).re))
+        .map(|j| scale * (mean * j as f64 + padded[j] - offset))
         .collect()
 }
 

@@ -455,9 +455,10 @@ proptest! {
 
     /// Random cells from just above the lowest minimum (lift 1e-3) to far above it (lift 3):
     /// at tol 1e-6, 1e-9 and 1e-12 the quadrature's error estimates of T, N and the drift are
-    /// honest against the ODE at 1e-12 (the difference is within the two estimates; the
-    /// ODE's own estimate compares with a run at tol/100, which at 1e-12 is still above the
-    /// rounding floor), and a status of ok comes with estimates within the tolerance.
+    /// honest against the ODE (the difference is within the two estimates), and a status of
+    /// ok comes with estimates within the tolerance. The reference is the ODE at 1e-13; its
+    /// uncertainty is its own estimate or its difference from the ODE at 1e-12, whichever
+    /// is larger (near a pole at small κ either run alone can be optimistic).
     #[test]
     fn error_estimates_are_honest_on_random_cells((alpha, beta) in random_body(),
                                                   kappa in -2.0f64..2.0,
@@ -465,16 +466,20 @@ proptest! {
         let b = body(alpha, beta);
         let (_, v_m, _) = minimum_of_v(&b, kappa);
         let energy = v_m + 10f64.powf(log_lift);
-        let o = solve(&b, kappa, energy, Method::Ode, 1e-12);
+        let o = solve(&b, kappa, energy, Method::Ode, 1e-13);
+        let o_loose = solve(&b, kappa, energy, Method::Ode, 1e-12);
         for tol in [1e-6, 1e-9, 1e-12] {
             let q = solve(&b, kappa, energy, Method::Quadrature, tol);
             prop_assert_eq!(q.components.len(), o.components.len());
-            for (cq, co) in q.components.iter().zip(&o.components) {
+            for ((cq, co), cl) in q.components.iter().zip(&o.components).zip(&o_loose.components) {
+                let spread = |a: f64, e: f64, loose: f64| e.max((a - loose).abs());
                 let pairs = [
-                    ("T", cq.period, cq.errors.period, co.period, co.errors.period),
+                    ("T", cq.period, cq.errors.period, co.period,
+                     spread(co.period, co.errors.period, cl.period)),
                     ("N", cq.rotation_number, cq.errors.rotation_number, co.rotation_number,
-                     co.errors.rotation_number),
-                    ("drift", cq.drift, cq.errors.drift, co.drift, co.errors.drift),
+                     spread(co.rotation_number, co.errors.rotation_number, cl.rotation_number)),
+                    ("drift", cq.drift, cq.errors.drift, co.drift,
+                     spread(co.drift, co.errors.drift, cl.drift)),
                 ];
                 for (name, a, ea, o_value, eo) in pairs {
                     prop_assert!((a - o_value).abs() <= ea + eo,

@@ -6,13 +6,14 @@
 //! at small κ) it stops early and the tanh-sinh path of the parent module takes over.
 
 use super::{
-    cautious_error, interleave, sample, weighted, Component, DriftEstimate, EffectivePotential,
-    NodeSample, PeriodIntegrals, Piece, EPS,
+    cautious_error, drift_error, interleave, sample, weighted, Component, DriftEstimate,
+    EffectivePotential, NodeSample, PeriodIntegrals, Piece, EPS,
 };
 use crate::body::{Angle, Shape};
 use crate::error::Result;
 use crate::quadrature::{real_fft, real_inverse_fft, IntervalNode, FINEST_COSINE_INTERVALS};
 use rustfft::num_complex::Complex;
+use std::cell::RefCell;
 use std::f64::consts::{PI, TAU};
 
 /// φ-steps on [0, π] of the first level, the fewest for which the level differences are
@@ -62,7 +63,7 @@ fn integrate_on<S: Shape>(
         let psi_error = 2.0 * level_error(psi_sums);
         let mut done = t_error <= 0.5 * tol * period && psi_error / TAU <= 0.5 * tol;
         // The drift (the costly part) only once T and Δψ have converged.
-        let drift = (done && with_drift).then(|| samples.drift(psi_error));
+        let drift = (done && with_drift).then(|| samples.drift());
         done &= drift.is_none_or(|d| d.error <= tol * d.scale);
         if done {
             let psi_advance = 2.0 * psi_sums[0];
@@ -175,17 +176,14 @@ impl Samples {
         Ok(())
     }
 
-    /// Δζ on this level, with its error from the two levels below. Those reuse this level's
-    /// ψ̃ (the phases cost most), so their differences see the aliasing of P̂ and of ν but
-    /// not that of ψ̃; ψ̃'s pointwise error is of the order of Δψ's (both are the aliasing of
-    /// the same coefficients), so `psi_error` (Δψ's estimate) times the path's length bounds
-    /// its effect and is added.
-    fn drift(&self, psi_error: f64) -> DriftEstimate {
-        let phases = antiderivative_phases(&self.nodes);
+    /// Δζ on this level, with its error from the two levels below, each computed from
+    /// scratch (its own ψ̃ and phases: reusing this level's would hide ψ̃'s aliasing, which
+    /// Δψ's estimate does not bound, ĥ₀ converging faster than the higher coefficients).
+    fn drift(&self) -> DriftEstimate {
         let (fine, mid, coarse) = (
-            fourier_drift(&self.nodes, 1, &phases),
-            fourier_drift(&self.nodes, 2, &phases),
-            fourier_drift(&self.nodes, 4, &phases),
+            fourier_drift(&self.nodes, 1),
+            fourier_drift(&self.nodes, 2),
+            fourier_drift(&self.nodes, 4),
         );
         let (d1, d2) = (
             (fine.0[0] - mid.0[0]).hypot(fine.0[1] - mid.0[1]),
@@ -193,7 +191,7 @@ impl Samples {
         );
         DriftEstimate {
             value: fine.0,
-            error: cautious_error(d1, d2).max(8.0 * EPS * fine.1) + psi_error * fine.1,
+            error: drift_error(d1, d2).max(8.0 * EPS * fine.1),
             scale: fine.1,
         }
     }
@@ -366,24 +364,48 @@ fn end_sample<S: Shape>(
     Some(weighted(v, a, &red, dt, 0.0, g_error / g))
 }
 
-/// e^{iψ̃} at every node (ψ̃(0) = 0), ψ̃ the spectral antiderivative of ψ̇ dt/dφ − ν on the
-/// circle: ψ̃ = Σ_{k≠0} ĥ_k e^{ikφ} / (ik), the Nyquist term (odd in k) dropped. ψ̃ is odd,
-/// so the way out holds all of it. Returned as (sin, cos).
-fn antiderivative_phases(nodes: &[NodeSample]) -> Vec<(f64, f64)> {
-    let n = nodes.len() - 1;
+/// ψ̃ at every `stride`-th node (ψ̃(0) = 0), ψ̃ the spectral antiderivative of ψ̇ dt/dφ − ν on
+/// the circle of that level: ψ̃ = Σ_{k≠0} ĥ_k e^{ikφ} / (ik), the Nyquist term (odd in k)
+/// dropped. ψ̃ is odd, so the way out holds all of it.
+/// Written into `values` (2n long; the first n + 1 entries are the result), with `spectrum`
+/// (n + 1 long) as scratch.
+fn antiderivative(
+    nodes: &[NodeSample],
+    stride: usize,
+    values: &mut [f64],
+    spectrum: &mut [Complex<f64>],
+) {
+    let n = (nodes.len() - 1) / stride;
     let m = 2 * n;
-    let mut values: Vec<f64> = (0..m).map(|j| nodes[j.min(m - j)].dpsi).collect();
-    let mut spectrum = vec![Complex::new(0.0, 0.0); n + 1];
-    real_fft(&mut values, &mut spectrum);
+    for (j, v) in values.iter_mut().enumerate() {
+        *v = nodes[j.min(m - j) * stride].dpsi;
+    }
+    real_fft(values, spectrum);
     spectrum[0] = Complex::new(0.0, 0.0);
     spectrum[n] = Complex::new(0.0, 0.0);
     for (k, c) in spectrum.iter_mut().enumerate().take(n).skip(1) {
         *c *= Complex::new(0.0, -1.0 / (k as f64 * m as f64));
     }
-    real_inverse_fft(&mut spectrum, &mut values);
-    (0..=n)
-        .map(|j| libm::sincos(values[j] - values[0]))
-        .collect()
+    real_inverse_fft(spectrum, values);
+    let start = values[0];
+    values[..=n].iter_mut().for_each(|v| *v -= start);
+}
+
+/// Per-thread buffers of [`fourier_drift`]: ψ̃, the transform's input and its spectrum.
+struct DriftBuffers {
+    psi: Vec<f64>,
+    values: Vec<f64>,
+    spectrum: Vec<Complex<f64>>,
+}
+
+thread_local! {
+    static DRIFT_BUFFERS: RefCell<DriftBuffers> = const {
+        RefCell::new(DriftBuffers {
+            psi: Vec::new(),
+            values: Vec::new(),
+            spectrum: Vec::new(),
+        })
+    };
 }
 
 /// Δζ and the L1 size of its integrand from every `stride`-th node. The path over one period
@@ -393,22 +415,45 @@ fn antiderivative_phases(nodes: &[NodeSample]) -> Vec<(f64, f64)> {
 /// so Δζ = Σ_k P̂_k ∫₀^{2π} e^{i(ν+k)φ} dφ = 2 e^{iπν} sin(πν) Σ_k P̂_k / (ν + k): exact
 /// but for the aliasing of P̂, which decays like the trapezoid error. ψ̃ is odd, so
 /// P(−φ) = conj P(φ) and every P̂_k is real: R = |Σ_k P̂_k / (ν + k)|.
-fn fourier_drift(nodes: &[NodeSample], stride: usize, phases: &[(f64, f64)]) -> ([f64; 2], f64) {
+fn fourier_drift(nodes: &[NodeSample], stride: usize) -> ([f64; 2], f64) {
+    DRIFT_BUFFERS.with(|buffers| {
+        let buffers = &mut *buffers.borrow_mut();
+        let n = (nodes.len() - 1) / stride;
+        buffers.psi.resize(2 * n, 0.0);
+        buffers.values.resize(2 * n, 0.0);
+        buffers.spectrum.resize(n + 1, Complex::new(0.0, 0.0));
+        fourier_drift_in(
+            nodes,
+            stride,
+            &mut buffers.psi[..2 * n],
+            &mut buffers.values[..2 * n],
+            &mut buffers.spectrum[..=n],
+        )
+    })
+}
+
+/// [`fourier_drift`] with its buffers.
+fn fourier_drift_in(
+    nodes: &[NodeSample],
+    stride: usize,
+    psi: &mut [f64],
+    values: &mut [f64],
+    spectrum: &mut [Complex<f64>],
+) -> ([f64; 2], f64) {
     let n = (nodes.len() - 1) / stride;
     let m = 2 * n;
     let node = |j: usize| &nodes[j.min(m - j) * stride];
     // ν: the mean of ψ̇ dt/dφ over the circle, on this level.
     let inner: f64 = (1..n).map(|j| node(j).dpsi).sum();
     let nu = (node(0).dpsi + node(n).dpsi + 2.0 * inner) / m as f64;
-    let mut values = vec![0.0; m];
-    let mut spectrum = vec![Complex::new(0.0, 0.0); n + 1];
+    antiderivative(nodes, stride, psi, spectrum);
     // y_j = Re P_j + Im P_j: its real transform Y_k gives m P̂_{±k} = Re Y_k ∓ Im Y_k (the
     // even part Re P transforms to a real, the odd part Im P to an imaginary sequence).
     let mut scale = 0.0;
     for j in 0..=n {
         let s = node(j);
         scale += s.along.abs() + s.across.abs();
-        let (sp, cp) = phases[j * stride];
+        let (sp, cp) = libm::sincos(psi[j]);
         // P = −e^{iψ̃} (along + i across)
         let (re, im) = (
             -(cp * s.along - sp * s.across),
@@ -426,12 +471,12 @@ fn fourier_drift(nodes: &[NodeSample], stride: usize, phases: &[(f64, f64)]) -> 
             .iter()
             .map(|s| s.along.abs() + s.across.abs())
             .sum::<f64>();
-    real_fft(&mut values, &mut spectrum);
+    real_fft(values, spectrum);
     // ν = δ − k₀ with |δ| ≤ ½: 2 e^{iπν} sin(πν) = 2 e^{iπδ} sin(πδ), and the k₀ term
     // is P̂_{k₀} · 2 e^{iπδ} sin(πδ)/δ, finite as δ → 0 (exact resonance: 2π P̂_{k₀}).
     let k0 = (-nu).round();
     let delta = nu + k0;
-    let (sd, cd) = (PI * delta).sin_cos();
+    let (sd, cd) = libm::sincos(PI * delta);
     let term = |p: f64, k: f64| {
         if k == k0 {
             p * if delta == 0.0 { PI } else { sd / delta }

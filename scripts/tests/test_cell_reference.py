@@ -1,0 +1,119 @@
+"""`rubber-atlas cell` against an independent high-precision quadrature (mpmath, 40 digits) on
+the hard cells of SPEC §2.2 — near a separatrix and at small κ, where an ODE run is the least
+reliable reference — and the hand-written Python solvers of scripts/ on the same cells."""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "scripts"))
+
+from rubber_model import Body, HighPrecision, midpoint_rotation_numbers, scipy_cell  # noqa: E402
+
+BIN = os.environ.get("RUBBER_ATLAS_BIN", str(ROOT / "target" / "release" / "rubber-atlas"))
+CELLS = ROOT / "benches" / "work_precision_cells.csv"
+
+
+def truth_cells():
+    with CELLS.open() as f:
+        return [
+            {k: (v if k == "class" else float(v)) for k, v in row.items()}
+            for row in csv.DictReader(f)
+        ]
+
+
+def cell(c, tol, method="quadrature"):
+    out = subprocess.run(
+        [BIN, "cell", "--alpha", repr(c["alpha"]), "--beta", repr(c["beta"]), "--nu", "0.5", "--eta", "0.5",
+         "--kappa", repr(c["kappa"]), "--energy", repr(c["energy"]), "--tol", repr(tol), "--method", method,
+         "--json"],
+        check=True, capture_output=True, text=True,
+    ).stdout
+    components = json.loads(out)["components"]
+
+    def distance(comp):
+        return max(comp["theta_min"] - c["theta"], c["theta"] - comp["theta_max"], 0.0)
+
+    return min(components, key=distance)
+
+
+@pytest.mark.parametrize("tol", [1e-6, 1e-9, 1e-12])
+def test_quadrature_is_honest_against_40_digit_values(tol):
+    """On every cell of the study (regular, 1e-3 … 1e-9 from a separatrix, κ = 1e-2 … 1e-6)
+    the true errors of T and N lie within the solver's estimates, and status ok means the
+    estimates are within the tolerance."""
+    cells = truth_cells()
+    assert {c["class"] for c in cells} == {"regular", "separatrix", "small_kappa"}
+    for c in cells:
+        comp = cell(c, tol)
+        where = f"{c['class']} kappa {c['kappa']} energy {c['energy']!r} tol {tol}"
+        assert abs(comp["period"] - c["period"]) <= comp["errors"]["period"], where
+        assert abs(comp["rotation_number"] - c["rotation_number"]) <= comp["errors"]["rotation_number"], where
+        if comp["status"] == "ok":
+            assert comp["errors"]["period"] <= tol * comp["period"], where
+            assert comp["errors"]["rotation_number"] <= tol, where
+        else:
+            assert comp["status"] == "tolerance_not_reached", where
+
+
+def test_tight_quadrature_reaches_the_last_digits_away_from_saddles():
+    """Regular and small-κ cells at tol 1e-12: N within 1e-13 of the 40-digit value."""
+    for c in truth_cells():
+        if c["class"] == "separatrix":
+            continue
+        comp = cell(c, 1e-12)
+        assert comp["status"] == "ok"
+        assert abs(comp["rotation_number"] - c["rotation_number"]) < 1e-13
+        assert abs(comp["period"] - c["period"]) < 1e-13 * c["period"]
+
+
+def test_ode_method_is_honest_where_it_converges():
+    """The ODE method's estimates cover its true error on the regular cells."""
+    for c in truth_cells():
+        if c["class"] != "regular":
+            continue
+        comp = cell(c, 1e-10, method="ode")
+        assert abs(comp["rotation_number"] - c["rotation_number"]) <= comp["errors"]["rotation_number"]
+        assert abs(comp["period"] - c["period"]) <= comp["errors"]["period"]
+
+
+@pytest.mark.parametrize("kind", ["separatrix", "small_kappa"])
+def test_the_stored_truth_is_mpmath(kind):
+    """The truth file is what mpmath computes now (one cell of each hard class recomputed)."""
+    c = next(c for c in truth_cells() if c["class"] == kind)
+    hp = HighPrecision(Body(c["alpha"], c["beta"]), c["kappa"])
+    _, _, period, rotation = hp.integrals(c["energy"], c["theta"])
+    assert period == pytest.approx(c["period"], rel=1e-15)
+    assert rotation == pytest.approx(c["rotation_number"], abs=1e-15)
+
+
+def test_hand_written_solvers_agree_on_regular_cells():
+    """The NumPy midpoint and SciPy solvers the speed comparison races against compute the
+    same N on regular cells (so the race compares like with like)."""
+    regular = [c for c in truth_cells() if c["class"] == "regular"]
+    body = Body(0.5, 3.0)
+    for c in regular:
+        n = midpoint_rotation_numbers(body, [c["kappa"]], [c["energy"]], nodes=256)[0, 0]
+        assert abs(n - c["rotation_number"]) < 1e-10
+        period, n_scipy = scipy_cell(body, c["kappa"], c["energy"])
+        assert abs(n_scipy - c["rotation_number"]) < 1e-9
+        assert period == pytest.approx(c["period"], rel=1e-9)
+    # Below the minimum of V the vectorised script gives NaN, not a number.
+    assert np.isnan(midpoint_rotation_numbers(body, [1.0], [0.5])[0, 0])
+
+
+def test_work_precision_plot(tmp_path):
+    from plot_work_precision import plot
+
+    png = tmp_path / "wp.png"
+    plot(ROOT / "docs" / "work-precision.csv", png)
+    assert png.stat().st_size > 10_000
