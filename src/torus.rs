@@ -713,7 +713,7 @@ fn drift_estimate(samples: &[PieceSamples], psi_advance: f64, double: f64) -> Dr
     );
     DriftEstimate {
         value: fine.0,
-        error: drift_error(d1, d2).max(8.0 * EPS * fine.1),
+        error: cautious_error(d1, d2).max(8.0 * EPS * fine.1),
         scale: fine.1,
     }
 }
@@ -932,24 +932,19 @@ fn level_error(sums: [f64; 3]) -> f64 {
 
 /// The error of the finest of three successive sums of a nested rule from the level
 /// differences d₁ ≈ E₁ and d₂ ≈ E₂ of the two coarser ones, for rules whose convergence
-/// need not be a single geometric decay: with r = d₁/d₂, E₀ = d₁ r² under E(n) = C ρⁿ, but
+/// need not be a single geometric decay. With r = d₁/d₂, E₀ = d₁ r² under E(n) = C ρⁿ, but
 /// an integrand with singularities at several distances converges fast at first and slower
-/// later (seen on random cells: r = 9e-4 followed by E₀/E₁ = 2e-3), so the estimate is d₁ √r,
-/// and d₁ until r ≤ 0.01. Used for T and Δψ by either rule.
+/// later, and the first levels may not be in the asymptotic regime at all (seen on random
+/// cells: r = 9e-4 followed by E₀/E₁ = 2e-3 for T, r = 2e-5 followed by 1e-2 for the drift,
+/// and Δψ 3× above d₁ √r on 16 steps). So the estimate is d₁ max(√r, 1/10) — never more than
+/// one digit beyond the last level difference — and d₁ itself until r ≤ 0.01. Used for T,
+/// Δψ and Δζ by either rule.
 fn cautious_error(d1: f64, d2: f64) -> f64 {
     if d2 > 0.0 && d1 <= 0.01 * d2 {
-        d1 * (d1 / d2).sqrt()
+        d1 * (d1 / d2).sqrt().max(0.1)
     } else {
         d1
     }
-}
-
-/// The error of the finest of three drift values (see [`cautious_error`]), never taken below
-/// d₁/10: the drift's integrand carries e^{iψ}, whose spectrum fills in late, so its
-/// convergence slows down more often than that of T (seen on random cells: a level ratio of
-/// 2e-5 followed by 1e-2).
-fn drift_error(d1: f64, d2: f64) -> f64 {
-    cautious_error(d1, d2).max(0.1 * d1)
 }
 
 /// The integrands at one tanh-sinh node of a piece.

@@ -3,6 +3,7 @@
 //! random cells.
 
 use proptest::prelude::*;
+use proptest::test_runner::RngSeed;
 use rubber_atlas::cell::{
     solve_cell, solve_level, CellOptions, CellResult, ComponentResult, Method, Status,
 };
@@ -414,7 +415,11 @@ fn random_body() -> impl Strategy<Value = (f64, f64)> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig {
+        cases: 24,
+        rng_seed: RngSeed::Fixed(20_261_120),
+        ..ProptestConfig::default()
+    })]
 
     /// Random cells: quadrature (tol 1e-9) and ODE (tol 1e-12) agree within the requested
     /// tolerance, nothing is NaN or infinite, and status ok never comes with a wrong value.
@@ -451,7 +456,13 @@ proptest! {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 1024, ..ProptestConfig::default() })]
+    // Seeded, so that CI checks the same 1024 cells every run (the estimator was also checked
+    // on several thousand cells of other seeds while it was built).
+    #![proptest_config(ProptestConfig {
+        cases: 1024,
+        rng_seed: RngSeed::Fixed(20_261_121),
+        ..ProptestConfig::default()
+    })]
 
     /// Random cells from just above the lowest minimum (lift 1e-3) to far above it (lift 3):
     /// at tol 1e-6, 1e-9 and 1e-12 the quadrature's error estimates of T, N and the drift are

@@ -6,8 +6,8 @@
 //! at small κ) it stops early and the tanh-sinh path of the parent module takes over.
 
 use super::{
-    cautious_error, drift_error, interleave, sample, weighted, Component, DriftEstimate,
-    EffectivePotential, NodeSample, PeriodIntegrals, Piece, EPS,
+    cautious_error, interleave, sample, weighted, Component, DriftEstimate, EffectivePotential,
+    NodeSample, PeriodIntegrals, Piece, EPS,
 };
 use crate::body::{Angle, Shape};
 use crate::error::Result;
@@ -191,7 +191,7 @@ impl Samples {
         );
         DriftEstimate {
             value: fine.0,
-            error: drift_error(d1, d2).max(8.0 * EPS * fine.1),
+            error: cautious_error(d1, d2).max(8.0 * EPS * fine.1),
             scale: fine.1,
         }
     }
