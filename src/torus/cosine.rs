@@ -106,6 +106,9 @@ fn integrate_on<S: Shape>(
 struct Samples {
     intervals: usize,
     nodes: Vec<NodeSample>,
+    /// Δζ and its path scale already computed on a level, by its number of steps (a level's
+    /// nodes never change, so a refinement reuses them as its two coarser levels).
+    drifts: Vec<(usize, ([f64; 2], f64))>,
 }
 
 impl Samples {
@@ -125,6 +128,7 @@ impl Samples {
         Some(Self {
             intervals: n,
             nodes,
+            drifts: Vec::new(),
         })
     }
 
@@ -179,11 +183,11 @@ impl Samples {
     /// Δζ on this level, with its error from the two levels below, each computed from
     /// scratch (its own ψ̃ and phases: reusing this level's would hide ψ̃'s aliasing, which
     /// Δψ's estimate does not bound, ĥ₀ converging faster than the higher coefficients).
-    fn drift(&self) -> DriftEstimate {
+    fn drift(&mut self) -> DriftEstimate {
         let (fine, mid, coarse) = (
-            fourier_drift(&self.nodes, 1),
-            fourier_drift(&self.nodes, 2),
-            fourier_drift(&self.nodes, 4),
+            self.level_drift(1),
+            self.level_drift(2),
+            self.level_drift(4),
         );
         let (d1, d2) = (
             (fine.0[0] - mid.0[0]).hypot(fine.0[1] - mid.0[1]),
@@ -194,6 +198,19 @@ impl Samples {
             error: cautious_error(d1, d2).max(8.0 * EPS * fine.1),
             scale: fine.1,
         }
+    }
+}
+
+impl Samples {
+    /// [`fourier_drift`] on every `stride`-th node, computed once per level.
+    fn level_drift(&mut self, stride: usize) -> ([f64; 2], f64) {
+        let intervals = self.intervals / stride;
+        if let Some((_, known)) = self.drifts.iter().find(|(n, _)| *n == intervals) {
+            return *known;
+        }
+        let value = fourier_drift(&self.nodes, stride);
+        self.drifts.push((intervals, value));
+        value
     }
 }
 
