@@ -3,11 +3,13 @@
 //! invariant torus), their turning points, and the integrals over one θ-period — the period
 //! T, the precession Δψ and the drift Δζ of the centre of mass (paper §5, `dpsi`; SPEC §2).
 //!
-//! Each component is cut at its turning points and at every critical point inside it; each
-//! piece is integrated in θ by the tanh-sinh rule, whose nodes crowd double-exponentially at
-//! the piece's ends, where the 1/√ singularity of a turning point, the near-logarithmic one of
-//! a nearby saddle and the narrow ψ̇ peak near a pole at small κ all sit. The gap ε − V(θ) is
-//! evaluated from the nearer end of the piece with the divided difference of V, so it keeps
+//! A libration is first integrated whole after the cosine substitution (module `cosine`),
+//! geometrically convergent unless a saddle or a pole comes close. Otherwise the component is
+//! cut at its turning points and at every maximum or tangency inside it, and each piece is
+//! integrated in θ by the tanh-sinh rule, whose nodes crowd double-exponentially at the
+//! piece's ends, where the 1/√ singularity of a turning point, the near-logarithmic one of a
+//! nearby saddle and the narrow ψ̇ peak near a pole at small κ all sit. In both, the gap
+//! ε − V(θ) is evaluated from the nearer end with the divided difference of V, so it keeps
 //! full relative precision right up to the turning points (SPEC §2.3).
 
 use crate::body::{Angle, Body, Reduction, Shape};
