@@ -15,6 +15,7 @@ use crate::quadrature::{real_fft, real_inverse_fft, IntervalNode, FINEST_COSINE_
 use rustfft::num_complex::Complex;
 use std::cell::RefCell;
 use std::f64::consts::{PI, TAU};
+use std::sync::OnceLock;
 
 /// φ-steps on [0, π] of the first level, the fewest for which the level differences are
 /// trusted: the coarsest of the three levels compared then has 4 steps.
@@ -400,12 +401,20 @@ fn antiderivative(
     real_fft(values, spectrum);
     spectrum[0] = Complex::new(0.0, 0.0);
     spectrum[n] = Complex::new(0.0, 0.0);
-    for (k, c) in spectrum.iter_mut().enumerate().take(n).skip(1) {
-        *c *= Complex::new(0.0, -1.0 / (k as f64 * m as f64));
+    let reciprocals = reciprocals();
+    let inv_m = 1.0 / m as f64;
+    for (c, inv_k) in spectrum[1..n].iter_mut().zip(&reciprocals[1..n]) {
+        *c *= Complex::new(0.0, -inv_k * inv_m);
     }
     real_inverse_fft(spectrum, values);
     let start = values[0];
     values[..=n].iter_mut().for_each(|v| *v -= start);
+}
+
+/// 1/k for k = 0 … [`LAST_INTERVALS`] (k = 0 unused), made once.
+fn reciprocals() -> &'static [f64] {
+    static TABLE: OnceLock<Vec<f64>> = OnceLock::new();
+    TABLE.get_or_init(|| (0..=LAST_INTERVALS).map(|k| 1.0 / k as f64).collect())
 }
 
 /// Per-thread buffers of [`fourier_drift`]: ψ̃, the transform's input and its spectrum.
