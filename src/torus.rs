@@ -898,7 +898,7 @@ impl PieceSamples {
     ) -> Result<()> {
         self.level += 1;
         let level = self.level;
-        self.nodes = interleave(&self.nodes, |j| {
+        interleave(&mut self.nodes, |j| {
             let node = IntervalNode::tanh_sinh_tabulated(level, j, piece.length);
             sample(v, piece, energy, node)
         })?;
@@ -907,20 +907,21 @@ impl PieceSamples {
     }
 }
 
-/// The nodes of the next finer level of a nested rule: the old ones become the even nodes
-/// and `new(j)` gives each odd node j.
+/// The nodes of the next finer level of a nested rule, in place: the old ones become the
+/// even nodes and `new(j)` gives each odd node j (on an error the nodes are left half-made).
 fn interleave(
-    old: &[NodeSample],
+    nodes: &mut Vec<NodeSample>,
     mut new: impl FnMut(usize) -> Result<NodeSample>,
-) -> Result<Vec<NodeSample>> {
-    let mut nodes = Vec::with_capacity(2 * old.len() - 1);
-    for (j, node) in old.iter().enumerate() {
-        if j > 0 {
-            nodes.push(new(2 * j - 1)?);
-        }
-        nodes.push(*node);
+) -> Result<()> {
+    let old = nodes.len();
+    nodes.resize(2 * old - 1, NodeSample::default());
+    for j in (1..old).rev() {
+        nodes[2 * j] = nodes[j];
     }
-    Ok(nodes)
+    for j in 1..old {
+        nodes[2 * j - 1] = new(2 * j - 1)?;
+    }
+    Ok(())
 }
 
 /// The error of the finest of three successive tanh-sinh sums (finest first), from the level
@@ -971,10 +972,11 @@ fn sample<S: Shape>(
     };
     let red = v.body.reduction_at(a);
     let k2 = v.kappa * v.kappa;
+    let inv_sin = 1.0 / a.sin;
     let v_t = if k2 == 0.0 {
         red.potential
     } else {
-        0.5 * k2 / (a.sin * a.sin) + red.potential
+        0.5 * k2 * inv_sin * inv_sin + red.potential
     };
     let direct = energy - v_t;
     let direct_err = 4.0 * EPS * (energy.abs() + v_t.abs());
@@ -1016,11 +1018,9 @@ fn weighted<S: Shape>(
     let (dpsi, along) = if v.kappa == 0.0 {
         (0.0, 0.0)
     } else {
-        let w3 = v.kappa / red.integral_factor;
-        (
-            -w3 * a.cos / (a.sin * a.sin) * dt,
-            red.potential * w3 / a.sin * dt,
-        )
+        // ω3 dt / sin θ = κ dt / (J sin θ), with one division.
+        let w3_dt = v.kappa * dt / (red.integral_factor * a.sin);
+        (-w3_dt * a.cos / a.sin, red.potential * w3_dt)
     };
     NodeSample {
         dt,

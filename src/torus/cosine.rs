@@ -21,7 +21,7 @@ use std::sync::OnceLock;
 /// trusted: the coarsest of the three levels compared then has 4 steps.
 const FIRST_INTERVALS: usize = 16;
 /// φ-steps on [0, π] beyond which the tanh-sinh rule is cheaper.
-const LAST_INTERVALS: usize = 128;
+const LAST_INTERVALS: usize = 256;
 const _: () = assert!(LAST_INTERVALS <= FINEST_COSINE_INTERVALS);
 
 /// T, Δψ and (if `with_drift`) Δζ of a libration that is one piece (see the parent's
@@ -176,7 +176,7 @@ impl Samples {
     /// (now the even ones) and add the odd ones.
     fn refine(&mut self, map: &Map, at: impl Fn(IntervalNode) -> Result<NodeSample>) -> Result<()> {
         let n = 2 * self.intervals;
-        self.nodes = interleave(&self.nodes, |j| at(map.node(n, j)))?;
+        interleave(&mut self.nodes, |j| at(map.node(n, j)))?;
         self.intervals = n;
         Ok(())
     }
