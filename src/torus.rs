@@ -573,7 +573,8 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         psi_advance_error += psi_rounding + saddle_psi;
         let mut drift = None;
         if with_drift {
-            let mut result = drift_estimate(&samples, psi_advance, double);
+            let mut known = Vec::new();
+            let mut result = drift_estimate(&samples, psi_advance, double, &mut known);
             for _ in 0..(MAX_LEVEL - START_LEVEL) {
                 if result.error <= tol * result.scale
                     || samples.iter().any(|s| s.level >= MAX_LEVEL)
@@ -584,7 +585,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                     sample.refine(self, piece, energy)?;
                 }
                 let psi = double * samples.iter().map(|s| s.psi(0)).sum::<f64>();
-                result = drift_estimate(&samples, psi, double);
+                result = drift_estimate(&samples, psi, double, &mut known);
             }
             converged &= result.error <= tol * result.scale;
             // Rounding in T and Δψ enters the drift through the phases and the weights.
@@ -699,14 +700,27 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
 /// Δζ = −∫ U [a t′ (e^{iψ} + e^{i(Δψ−ψ)}) + i (e^{iψ} − e^{i(Δψ−ψ)})] dθ over [θ_min, θ_max]
 /// with a = κ/(J sinθ), t′ = dt/dθ (from ζ̇ = −U e^{iψ}(a + i p), see
 /// [`crate::reduced::ReducedSystem::centre_velocity`]).
-fn drift_estimate(samples: &[PieceSamples], psi_advance: f64, double: f64) -> DriftEstimate {
-    let level = |stride_exp: u32| {
+/// `known` keeps the sums already made, by the pieces' levels (a refinement reuses them as its
+/// two coarser levels).
+fn drift_estimate(
+    samples: &[PieceSamples],
+    psi_advance: f64,
+    double: f64,
+    known: &mut Vec<(Vec<u32>, ([f64; 2], f64))>,
+) -> DriftEstimate {
+    let mut level = |stride_exp: u32| {
+        let key: Vec<u32> = samples.iter().map(|s| s.level - stride_exp).collect();
+        if let Some((_, value)) = known.iter().find(|(k, _)| *k == key) {
+            return *value;
+        }
         let psi = if stride_exp == 0 {
             psi_advance
         } else {
             double * samples.iter().map(|s| s.psi(stride_exp)).sum::<f64>()
         };
-        drift_sum(samples, psi, double, 1 << stride_exp)
+        let value = drift_sum(samples, psi, double, 1 << stride_exp);
+        known.push((key, value));
+        value
     };
     let (fine, mid, coarse) = (level(0), level(1), level(2));
     let (d1, d2) = (
