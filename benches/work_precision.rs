@@ -1,6 +1,7 @@
 //! Work-precision study of the cell solver (issue 3): for tolerances 1e-4 … 1e-13 and both
-//! methods, the time per cell and the error in N and T on three classes of cells — regular,
-//! near a separatrix (1e-3 … 1e-9 from the top of V) and small κ (1e-2 … 1e-6) — against the
+//! methods, the time per cell and the error in N and T on four classes of cells — regular,
+//! near a separatrix (1e-3 and 1e-6 from the top of V), very near it (1e-9 and 1e-12) and
+//! small κ (1e-2 … 1e-6) — against the
 //! 40-digit values of `benches/work_precision_cells.csv` (scripts/work_precision_truth.py).
 //! Time per cell is for all the cell's components, with the row's critical points found
 //! beforehand (as in an atlas, where a row of cells shares them).
@@ -113,7 +114,7 @@ fn main() {
     let cells = read_cells(&root.join("benches/work_precision_cells.csv"));
     let tolerances: Vec<f64> = (4..=13).map(|k| 10f64.powi(-k)).collect();
     let mut rows = Vec::new();
-    for class in ["regular", "separatrix", "small_kappa"] {
+    for class in ["regular", "separatrix", "separatrix_close", "small_kappa"] {
         let members: Vec<&Cell> = cells.iter().filter(|c| c.class == class).collect();
         for (method, name) in [(Method::Quadrature, "quadrature"), (Method::Ode, "ode")] {
             for &tol in &tolerances {

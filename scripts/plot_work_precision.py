@@ -21,7 +21,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 ROOT = Path(__file__).resolve().parents[1]
 CLASSES = [
     ("regular", "regular librations"),
-    ("separatrix", "1e-3 … 1e-9 from a separatrix"),
+    ("separatrix", "1e-3 and 1e-6 from a separatrix"),
+    ("separatrix_close", "1e-9 and 1e-12 from a separatrix"),
     ("small_kappa", "small κ (1e-2 … 1e-6)"),
 ]
 STYLE = {"quadrature": ("C0", "o"), "ode": ("C3", "s")}
@@ -45,7 +46,7 @@ def read(path: Path):
 
 def plot(csv_path: Path, png_path: Path) -> None:
     table = read(csv_path)
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6), sharey=True)
+    fig, axes = plt.subplots(1, len(CLASSES), figsize=(19, 4.6), sharey=True)
     for ax, (key, title) in zip(axes, CLASSES):
         for method, (colour, marker) in STYLE.items():
             rows = sorted(table.get((key, method), []), key=lambda r: -r["tol"])

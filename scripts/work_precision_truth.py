@@ -3,8 +3,9 @@ true T and N from mpmath's tanh-sinh quadrature at 40 digits (scripts/rubber_mod
 
 Three classes on the paper's body (α = 0.5, β = 3, ν = η = 0.5):
 - regular: librations well inside the allowed region (κ from 0.4 to 1.6);
-- separatrix: ε within 1e-3 … 1e-9 of the top of V at κ = 1, below (two components, each
-  listed) and above (one component around the saddle);
+- separatrix: ε within 1e-3 and 1e-6 of the top of V at κ = 1, below (two components, each
+  listed) and above (one component around the saddle); separatrix_close: the same at 1e-9
+  and 1e-12, where the rounding of ε − V near the saddle limits any double-precision method;
 - small_kappa: κ from 1e-2 down to 1e-6, where a turning point nears the pole θ = 0.
 
 Run it again (`.venv/bin/python scripts/work_precision_truth.py`) after changing the cells.
@@ -30,11 +31,12 @@ def cells():
     hp = HighPrecision(body, 1.0)
     saddle = [c for c in hp.critical_points() if hp._dv(c + mpmath.mpf("1e-8")) < 0][0]
     top = float(hp._v(saddle))
-    for exponent in (3, 6, 9):
+    for exponent in (3, 6, 9, 12):
+        kind = "separatrix" if exponent <= 6 else "separatrix_close"
         below = top - 10.0**-exponent
-        yield "separatrix", 1.0, below, float(saddle) - 0.3
-        yield "separatrix", 1.0, below, float(saddle) + 0.3
-        yield "separatrix", 1.0, top + 10.0**-exponent, float(saddle)
+        yield kind, 1.0, below, float(saddle) - 0.3
+        yield kind, 1.0, below, float(saddle) + 0.3
+        yield kind, 1.0, top + 10.0**-exponent, float(saddle)
     for kappa in (1e-2, 1e-3, 1e-4, 1e-6):
         yield "small_kappa", kappa, 2.5, 0.3
 

@@ -547,11 +547,18 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             2.0
         };
         let share = 1.0 / pieces.len() as f64;
+        // Near a saddle the conditioning of ε (below) may exceed the tolerance: refining the
+        // quadrature much below that bound (a worst case; a tenth of it) would buy nothing.
+        let provisional = double * samples.iter().map(|s| s.period(0)).sum::<f64>();
+        let (floor_t, floor_psi) =
+            self.saddle_conditioning(energy, component, provisional, double, 0.0);
         let mut converged = true;
         for (piece, sample) in pieces.iter().zip(samples.iter_mut()) {
             // Half of the tolerance for the quadrature, half left for rounding.
-            while sample.error(|n| n.dt) > 0.5 * tol * sample.period(0)
-                || double * sample.error(|n| n.dpsi) / TAU > 0.5 * tol * share
+            while sample.error(|n| n.dt)
+                > (0.5 * tol * sample.period(0)).max(0.1 * floor_t * share / double)
+                || double * sample.error(|n| n.dpsi) / TAU
+                    > (0.5 * tol * share).max(0.1 * floor_psi * share / TAU)
             {
                 if sample.level >= MAX_LEVEL {
                     converged = false;
@@ -573,10 +580,12 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         psi_advance_error += psi_rounding + saddle_psi;
         let mut drift = None;
         if with_drift {
+            // Rounding in T and Δψ enters the drift through the phases and the weights.
+            let phase = period_rounding / period.max(1e-300) + psi_rounding + saddle_psi;
             let mut known = Vec::new();
             let mut result = drift_estimate(&samples, psi_advance, double, &mut known);
             for _ in 0..(MAX_LEVEL - START_LEVEL) {
-                if result.error <= tol * result.scale
+                if result.error <= tol.max(0.1 * phase) * result.scale
                     || samples.iter().any(|s| s.level >= MAX_LEVEL)
                 {
                     break;
@@ -588,8 +597,6 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 result = drift_estimate(&samples, psi, double, &mut known);
             }
             converged &= result.error <= tol * result.scale;
-            // Rounding in T and Δψ enters the drift through the phases and the weights.
-            let phase = period_rounding / period.max(1e-300) + psi_rounding + saddle_psi;
             result.error += phase * result.scale;
             drift = Some(result);
         }
@@ -706,7 +713,7 @@ fn drift_estimate(
     samples: &[PieceSamples],
     psi_advance: f64,
     double: f64,
-    known: &mut Vec<(Vec<u32>, ([f64; 2], f64))>,
+    known: &mut KnownDrifts,
 ) -> DriftEstimate {
     let mut level = |stride_exp: u32| {
         let key: Vec<u32> = samples.iter().map(|s| s.level - stride_exp).collect();
@@ -733,6 +740,9 @@ fn drift_estimate(
         scale: fine.1,
     }
 }
+
+/// Drift sums already made (Δζ and its path scale), by the pieces' levels.
+type KnownDrifts = Vec<(Vec<u32>, ([f64; 2], f64))>;
 
 /// Δζ and the L1 size of its integrand from every `stride`-th node of each piece's samples.
 fn drift_sum(
