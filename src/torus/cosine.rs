@@ -17,9 +17,17 @@ use std::cell::RefCell;
 use std::f64::consts::{PI, TAU};
 use std::sync::OnceLock;
 
-/// φ-steps on [0, π] of the first level, the fewest for which the level differences are
-/// trusted: the coarsest of the three levels compared then has 4 steps.
-const FIRST_INTERVALS: usize = 16;
+/// φ-steps on [0, π] of the first level: 16, the fewest for which the level differences are
+/// trusted (the coarsest of the three levels compared then has 4 steps), or 32 below tol
+/// 1e-7, where the estimate (at most a digit beyond the last difference) hardly ever lets 16
+/// steps pass and the level would only be overhead.
+fn first_intervals(tol: f64) -> usize {
+    if tol >= 1e-7 {
+        16
+    } else {
+        32
+    }
+}
 /// φ-steps on [0, π] beyond which the tanh-sinh rule is cheaper.
 const LAST_INTERVALS: usize = 256;
 const _: () = assert!(LAST_INTERVALS <= FINEST_COSINE_INTERVALS);
@@ -54,7 +62,7 @@ fn integrate_on<S: Shape>(
     tol: f64,
     with_drift: bool,
 ) -> Result<Option<PeriodIntegrals>> {
-    let Some(mut samples) = Samples::new(v, piece, map, energy) else {
+    let Some(mut samples) = Samples::new(v, piece, map, energy, first_intervals(tol)) else {
         return Ok(None);
     };
     loop {
@@ -118,8 +126,9 @@ impl Samples {
         piece: &Piece,
         map: &Map,
         energy: f64,
+        intervals: usize,
     ) -> Option<Self> {
-        let n = FIRST_INTERVALS;
+        let n = intervals;
         let mut nodes = Vec::with_capacity(2 * LAST_INTERVALS + 1);
         nodes.push(end_sample(v, piece, map, true)?);
         for j in 1..n {
