@@ -391,23 +391,27 @@ fn end_sample<S: Shape>(
     Some(weighted(v, a, &red, dt, 0.0, g_error / g))
 }
 
-/// ψ̃ at every `stride`-th node (ψ̃(0) = 0), ψ̃ the spectral antiderivative of ψ̇ dt/dφ − ν on
-/// the circle of that level: ψ̃ = Σ_{k≠0} ĥ_k e^{ikφ} / (ik), the Nyquist term (odd in k)
-/// dropped. ψ̃ is odd, so the way out holds all of it.
-/// Written into `values` (2n long; the first n + 1 entries are the result), with `spectrum`
-/// (n + 1 long) as scratch.
+/// ν (the mean of ψ̇ dt/dφ over the circle, Δψ/2π) and ψ̃ at every `stride`-th node
+/// (ψ̃(0) = 0), ψ̃ the spectral antiderivative of ψ̇ dt/dφ − ν on the circle of that level:
+/// ψ̃ = Σ_{k≠0} ĥ_k e^{ikφ} / (ik), the Nyquist term (odd in k) dropped. ψ̃ is odd, so the
+/// way out holds all of it. Written into `values` (2n long; the first n + 1 entries are the
+/// result), with `spectrum` (n + 1 long) as scratch.
 fn antiderivative(
     nodes: &[NodeSample],
     stride: usize,
     values: &mut [f64],
     spectrum: &mut [Complex<f64>],
-) {
+) -> f64 {
     let n = (nodes.len() - 1) / stride;
     let m = 2 * n;
-    for (j, v) in values.iter_mut().enumerate() {
-        *v = nodes[j.min(m - j) * stride].dpsi;
+    for (j, node) in nodes.iter().step_by(stride).enumerate() {
+        values[j] = node.dpsi;
+        if j > 0 && j < n {
+            values[m - j] = node.dpsi;
+        }
     }
     real_fft(values, spectrum);
+    let nu = spectrum[0].re / m as f64;
     spectrum[0] = Complex::new(0.0, 0.0);
     spectrum[n] = Complex::new(0.0, 0.0);
     let reciprocals = reciprocals();
@@ -418,6 +422,7 @@ fn antiderivative(
     real_inverse_fft(spectrum, values);
     let start = values[0];
     values[..=n].iter_mut().for_each(|v| *v -= start);
+    nu
 }
 
 /// 1/k for k = 0 … [`LAST_INTERVALS`] (k = 0 unused), made once.
@@ -477,11 +482,9 @@ fn fourier_drift_in(
 ) -> ([f64; 2], f64) {
     let n = (nodes.len() - 1) / stride;
     let m = 2 * n;
-    let node = |j: usize| &nodes[j.min(m - j) * stride];
+    let node = |j: usize| &nodes[j * stride];
     // ν: the mean of ψ̇ dt/dφ over the circle, on this level.
-    let inner: f64 = (1..n).map(|j| node(j).dpsi).sum();
-    let nu = (node(0).dpsi + node(n).dpsi + 2.0 * inner) / m as f64;
-    antiderivative(nodes, stride, psi, spectrum);
+    let nu = antiderivative(nodes, stride, psi, spectrum);
     // y_j = Re P_j + Im P_j: its real transform Y_k gives m P̂_{±k} = Re Y_k ∓ Im Y_k (the
     // even part Re P transforms to a real, the odd part Im P to an imaginary sequence).
     let mut scale = 0.0;
