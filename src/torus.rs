@@ -486,8 +486,10 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         let start_theta = offset.map(|(c, d)| c.site.theta + d);
         let start_phi = offset.map(|(c, d)| c.site.from_pi - d);
         let f_left = |x: f64| level(Site::at(x));
+        // The sign of V − ε at a node is known (a pole is +∞): no evaluation needed there.
+        let below = |n: &Option<CriticalPoint>| n.is_some_and(|p| p.value < energy);
         if self.kappa == 0.0 || hi <= FRAC_PI_2 {
-            return Site::at(safe_newton(f_left, lo, hi, start_theta));
+            return Site::at(safe_newton(f_left, lo, hi, below(a), start_theta));
         }
         let f_right = |phi: f64| {
             let (value, slope) = level(Site::from_pi(phi));
@@ -496,7 +498,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         let phi_lo = b.map_or(0.0, |p| p.site.from_pi);
         if lo >= FRAC_PI_2 {
             let phi_hi = a.map_or(PI, |p| p.site.from_pi);
-            return Site::from_pi(safe_newton(f_right, phi_lo, phi_hi, start_phi));
+            return Site::from_pi(safe_newton(f_right, phi_lo, phi_hi, below(b), start_phi));
         }
         // The bracket straddles π/2: pick the half with the sign change.
         let mid = f_left(FRAC_PI_2).0;
@@ -504,9 +506,9 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         if mid == 0.0 {
             Site::at(FRAC_PI_2)
         } else if (mid < 0.0) != (lo_val < 0.0) {
-            Site::at(safe_newton(f_left, lo, FRAC_PI_2, start_theta))
+            Site::at(safe_newton(f_left, lo, FRAC_PI_2, below(a), start_theta))
         } else {
-            Site::from_pi(safe_newton(f_right, phi_lo, FRAC_PI_2, start_phi))
+            Site::from_pi(safe_newton(f_right, phi_lo, FRAC_PI_2, below(b), start_phi))
         }
     }
 
@@ -1082,10 +1084,14 @@ fn divided_difference<S: Shape>(
 
 /// A root of f on [lo, hi] (f changes sign there), by Newton steps that stay in the bracket,
 /// bisection otherwise, from `start` if it lies inside the bracket (else the midpoint); `f`
-/// returns (value, derivative).
-fn safe_newton(f: impl Fn(f64) -> (f64, f64), mut lo: f64, mut hi: f64, start: Option<f64>) -> f64 {
-    let (flo, _) = f(lo);
-    let lo_negative = flo < 0.0 || (flo.is_nan() && f(hi).0 > 0.0);
+/// returns (value, derivative); `lo_negative` is the sign of f at `lo`.
+fn safe_newton(
+    f: impl Fn(f64) -> (f64, f64),
+    mut lo: f64,
+    mut hi: f64,
+    lo_negative: bool,
+    start: Option<f64>,
+) -> f64 {
     let mut x = start
         .filter(|x| *x > lo.min(hi) && *x < lo.max(hi))
         .unwrap_or(0.5 * (lo + hi));
