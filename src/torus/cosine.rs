@@ -70,23 +70,30 @@ fn integrate_on<S: Shape>(
         let period = 2.0 * t_sums[0];
         let t_error = 2.0 * level_error(t_sums);
         let psi_error = 2.0 * level_error(psi_sums);
-        let mut done = t_error <= 0.5 * tol * period && psi_error / TAU <= 0.5 * tol;
-        // The drift (the costly part) only once T and Δψ have converged.
-        let drift = (done && with_drift).then(|| samples.drift());
-        done &= drift.is_none_or(|d| d.error <= tol * d.scale);
+        // The whole error estimate (quadrature, rounding of the gap, conditioning near a
+        // saddle) is held to the tolerance; the last two are computed only when the first
+        // leaves room for them.
+        let mut done = t_error <= tol * period && psi_error / TAU <= tol;
+        let (mut period_error, mut psi_advance_error, mut phase) = (t_error, psi_error, 0.0);
         if done {
-            let psi_advance = 2.0 * psi_sums[0];
             let (saddle_t, saddle_psi) = v.saddle_conditioning(energy, component, period, 2.0, 0.0);
             let period_rounding = 2.0 * samples.rounding(|n| n.dt);
             let psi_rounding = 2.0 * samples.rounding(|n| n.dpsi);
-            let period_error = t_error + period_rounding + saddle_t;
-            let psi_advance_error = psi_error + psi_rounding + saddle_psi;
-            let drift = drift.map(|mut d| {
-                // Rounding in T and Δψ enters the drift through the phases and the weights.
-                let phase = period_rounding / period + psi_rounding + saddle_psi;
-                d.error += phase * d.scale;
-                d
-            });
+            period_error += period_rounding + saddle_t;
+            psi_advance_error += psi_rounding + saddle_psi;
+            // Rounding in T and Δψ enters the drift through the phases and the weights.
+            phase = period_rounding / period + psi_rounding + saddle_psi;
+            done = period_error <= tol * period && psi_advance_error / TAU <= tol;
+        }
+        // The drift (the costly part) only once T and Δψ have converged.
+        let drift = (done && with_drift).then(|| {
+            let mut d = samples.drift();
+            d.error += phase * d.scale;
+            d
+        });
+        done &= drift.is_none_or(|d| d.error <= tol * d.scale);
+        if done {
+            let psi_advance = 2.0 * psi_sums[0];
             return Ok(Some(PeriodIntegrals {
                 period,
                 psi_advance,
@@ -99,7 +106,7 @@ fn integrate_on<S: Shape>(
         }
         let hopeless = samples.intervals >= LAST_INTERVALS
             || !reaches(samples.intervals, t_sums, 0.5 * tol * period)
-            || !reaches(samples.intervals, psi_sums, 0.25 * tol * TAU);
+            || !reaches(samples.intervals, psi_sums, 0.5 * tol * TAU);
         if hopeless {
             return Ok(None);
         }
