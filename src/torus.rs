@@ -556,11 +556,12 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             self.saddle_conditioning(energy, component, provisional, double, 0.0);
         let mut converged = true;
         for (piece, sample) in pieces.iter().zip(samples.iter_mut()) {
-            // The quadrature gets the tolerance less the rounding of the gap.
-            while sample.error(|n| n.dt) + sample.rounding(|n| n.dt)
-                > (tol * sample.period(0)).max(0.1 * floor_t * share / double)
-                || double * (sample.error(|n| n.dpsi) + sample.rounding(|n| n.dpsi)) / TAU
-                    > (tol * share).max(0.1 * floor_psi * share / TAU)
+            // Half of the tolerance for the quadrature, half left for rounding (which the
+            // refinement cannot reduce).
+            while sample.error(|n| n.dt)
+                > (0.5 * tol * sample.period(0)).max(0.1 * floor_t * share / double)
+                || double * sample.error(|n| n.dpsi) / TAU
+                    > (0.5 * tol * share).max(0.1 * floor_psi * share / TAU)
             {
                 if sample.level >= MAX_LEVEL {
                     converged = false;
