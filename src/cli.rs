@@ -60,6 +60,19 @@ pub struct StartArgs {
     pub theta_dot0: f64,
 }
 
+impl StartArgs {
+    /// The checked start at θ(0) = `theta0` with this θ̇(0), at F2 = `kappa`.
+    fn at_theta0(&self, kappa: f64, theta0: f64) -> rubber_atlas::Result<Start> {
+        let start = Start {
+            kappa,
+            theta0,
+            theta_dot0: self.theta_dot0,
+        };
+        start.check()?;
+        Ok(start)
+    }
+}
+
 #[derive(Debug, Args)]
 pub struct CellArgs {
     #[command(flatten)]
@@ -205,12 +218,7 @@ fn cell(args: CellArgs) -> Result<()> {
         (Some(e), _) => solve_cell(&body, args.level.kappa, e, &options)?,
         (None, Some(t)) => {
             // Only the component that holds θ(0).
-            let start = Start {
-                kappa: args.level.kappa,
-                theta0: t,
-                theta_dot0: args.start.theta_dot0,
-            };
-            start.check()?;
+            let start = args.start.at_theta0(args.level.kappa, t)?;
             options.validate()?;
             let potential = EffectivePotential::new(&body, start.kappa);
             let energy = start.energy(&body);
@@ -487,15 +495,7 @@ fn trajectory(args: TrajectoryArgs) -> Result<()> {
             }
             Start::at_energy(&body, args.level.kappa, e, args.component)?
         }
-        (None, Some(t)) => {
-            let start = Start {
-                kappa: args.level.kappa,
-                theta0: t,
-                theta_dot0: args.start.theta_dot0,
-            };
-            start.check()?;
-            start
-        }
+        (None, Some(t)) => args.start.at_theta0(args.level.kappa, t)?,
         _ => unreachable!("clap requires exactly one of --energy, --theta0"),
     };
     let t_end = match (args.periods, args.t_end) {

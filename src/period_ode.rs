@@ -105,14 +105,31 @@ fn run<S: Shape>(
     Ok((y, steps))
 }
 
-/// One run at tolerance `tol`: [T, Δψ, Δx_c, Δy_c, path scale, timing error of the event,
-/// energy error at the end, 1 if the run did not come back to θ_min] and the steps taken.
+/// What one run over a θ-period measured.
+struct PeriodRun {
+    /// T.
+    period: f64,
+    /// Δψ.
+    psi_advance: f64,
+    /// Δζ = (Δx_c, Δy_c).
+    drift: [f64; 2],
+    /// ∫ U (|a| + |p|) dt, the path's length scale.
+    scale: f64,
+    /// Error of the event's time.
+    timing: f64,
+    /// |ε(end) − ε|.
+    energy_error: f64,
+    /// Whether the run failed to come back to θ_min (it strayed into another orbit).
+    strayed: bool,
+}
+
+/// One run at tolerance `tol`, and the steps taken.
 fn one_period<S: Shape>(
     potential: &EffectivePotential<'_, S>,
     energy: f64,
     component: &Component,
     tol: f64,
-) -> Result<([f64; 8], usize)> {
+) -> Result<(PeriodRun, usize)> {
     let system = ReducedSystem::new(potential.body, potential.kappa);
     let theta0 = component.theta_min();
     let (p0, event) = match component.kind {
@@ -185,21 +202,16 @@ fn one_period<S: Shape>(
     };
     let end_energy =
         0.5 * potential.body.reduced_inertia(y[0]) * y[1] * y[1] + system.effective_potential(y[0]);
-    let energy_error = (end_energy - energy).abs();
-    let strayed = if strayed { 1.0 } else { 0.0 };
-    Ok((
-        [
-            ta + s,
-            y[2],
-            y[3],
-            y[4],
-            y[5],
-            timing,
-            energy_error,
-            strayed,
-        ],
-        steps,
-    ))
+    let run = PeriodRun {
+        period: ta + s,
+        psi_advance: y[2],
+        drift: [y[3], y[4]],
+        scale: y[5],
+        timing,
+        energy_error: (end_energy - energy).abs(),
+        strayed,
+    };
+    Ok((run, steps))
 }
 
 /// T, Δψ and Δζ of a libration or rotation by two ODE runs, at `tol` and at tol/100; the
@@ -217,7 +229,7 @@ pub fn integrate<S: Shape>(
     let eps = 8.0 * f64::EPSILON * (n2 as f64).max(1.0);
     // The event's timing error moves the end of the period by dt: T by dt, Δψ by |ψ̇| dt,
     // Δζ by |ζ̇| dt (bounded by the path scale's mean rate).
-    let timing = tight[5];
+    let timing = tight.timing;
     let theta0 = component.theta_min();
     let psi_rate = potential
         .psi_rate(crate::torus::Site::at(theta0).angle())
@@ -229,36 +241,43 @@ pub fn integrate<S: Shape>(
     } else {
         2.0
     };
-    let energy_error = tight[6].max(loose[6]);
+    let energy_error = tight.energy_error.max(loose.energy_error);
     let (saddle_t, saddle_psi) =
-        potential.saddle_conditioning(energy, component, tight[0], double, energy_error);
-    let mut period_error = (tight[0] - loose[0]).abs() + eps * tight[0] + timing + saddle_t;
-    let mut psi_advance_error =
-        (tight[1] - loose[1]).abs() + eps * tight[1].abs() + psi_rate * timing + saddle_psi;
+        potential.saddle_conditioning(energy, component, tight.period, double, energy_error);
+    let mut period_error =
+        (tight.period - loose.period).abs() + eps * tight.period + timing + saddle_t;
+    let mut psi_advance_error = (tight.psi_advance - loose.psi_advance).abs()
+        + eps * tight.psi_advance.abs()
+        + psi_rate * timing
+        + saddle_psi;
     // A run that strayed into another orbit measured nothing of this one.
-    let strayed = tight[7] != 0.0 || loose[7] != 0.0;
+    let strayed = tight.strayed || loose.strayed;
     if strayed {
-        period_error = period_error.max(tight[0].abs());
-        psi_advance_error = psi_advance_error.max(tight[1].abs()).max(TAU);
+        period_error = period_error.max(tight.period.abs());
+        psi_advance_error = psi_advance_error.max(tight.psi_advance.abs()).max(TAU);
     }
     let drift = with_drift.then(|| {
-        let error = (tight[2] - loose[2]).hypot(tight[3] - loose[3])
-            + eps * tight[4]
-            + tight[4] / tight[0] * (timing + saddle_t)
-            + tight[4] * saddle_psi;
+        let error = (tight.drift[0] - loose.drift[0]).hypot(tight.drift[1] - loose.drift[1])
+            + eps * tight.scale
+            + tight.scale / tight.period * (timing + saddle_t)
+            + tight.scale * saddle_psi;
         DriftEstimate {
-            value: [tight[2], tight[3]],
-            error: if strayed { error.max(tight[4]) } else { error },
-            scale: tight[4],
+            value: tight.drift,
+            error: if strayed {
+                error.max(tight.scale)
+            } else {
+                error
+            },
+            scale: tight.scale,
         }
     });
     Ok(PeriodIntegrals {
-        period: tight[0],
-        psi_advance: tight[1],
+        period: tight.period,
+        psi_advance: tight.psi_advance,
         period_error,
         psi_advance_error,
         drift,
         work: n1 + n2,
-        converged: period_error <= tol * tight[0] && psi_advance_error / TAU <= tol,
+        converged: period_error <= tol * tight.period && psi_advance_error / TAU <= tol,
     })
 }

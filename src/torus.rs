@@ -732,16 +732,7 @@ fn drift_estimate(
         known.push((key, value));
         value
     };
-    let (fine, mid, coarse) = (level(0), level(1), level(2));
-    let (d1, d2) = (
-        (fine.0[0] - mid.0[0]).hypot(fine.0[1] - mid.0[1]),
-        (mid.0[0] - coarse.0[0]).hypot(mid.0[1] - coarse.0[1]),
-    );
-    DriftEstimate {
-        value: fine.0,
-        error: cautious_error(d1, d2).max(8.0 * EPS * fine.1),
-        scale: fine.1,
-    }
+    DriftEstimate::from_levels(level(0), level(1), level(2))
 }
 
 /// Drift sums already made (Δζ and its path scale), by the pieces' levels.
@@ -792,6 +783,22 @@ pub struct DriftEstimate {
     pub error: f64,
     /// ∫ |integrand|: the size of the path over one period, the scale of the tolerance.
     pub scale: f64,
+}
+
+impl DriftEstimate {
+    /// The finest of three successive (Δζ, path scale) values, with its error from their
+    /// differences by [`cautious_error`].
+    fn from_levels(fine: ([f64; 2], f64), mid: ([f64; 2], f64), coarse: ([f64; 2], f64)) -> Self {
+        let (d1, d2) = (
+            (fine.0[0] - mid.0[0]).hypot(fine.0[1] - mid.0[1]),
+            (mid.0[0] - coarse.0[0]).hypot(mid.0[1] - coarse.0[1]),
+        );
+        Self {
+            value: fine.0,
+            error: cautious_error(d1, d2).max(8.0 * EPS * fine.1),
+            scale: fine.1,
+        }
+    }
 }
 
 /// Integrals over one θ-period of a component, with their errors, from either method
@@ -951,10 +958,11 @@ fn interleave(
     Ok(())
 }
 
-/// The error of the finest of three successive tanh-sinh sums (finest first), from the level
-/// differences d₁ = |I₀ − I₁| and d₂ = |I₁ − I₂| by [`cautious_error`]: tanh-sinh errors
-/// square from level to level once converging, but near a separatrix the first levels are
-/// not in that regime (d₁²/d₂ was 7× short at tol 1e-6 on random near-saddle cells).
+/// The error of the finest of three successive sums of a nested rule (finest first), from
+/// the level differences d₁ = |I₀ − I₁| and d₂ = |I₁ − I₂| by [`cautious_error`], for the
+/// tanh-sinh rule (whose errors square from level to level once converging, but not in the
+/// first levels near a separatrix: d₁²/d₂ was 7× short at tol 1e-6 there) and the trapezoid
+/// rule (E(n) = C ρⁿ would allow d₁²/d₂, but not with singularities at several distances).
 fn level_error(sums: [f64; 3]) -> f64 {
     let (d1, d2) = ((sums[0] - sums[1]).abs(), (sums[1] - sums[2]).abs());
     cautious_error(d1, d2).max(8.0 * EPS * sums[0].abs())

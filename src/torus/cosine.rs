@@ -6,7 +6,7 @@
 //! at small κ) it stops early and the tanh-sinh path of the parent module takes over.
 
 use super::{
-    cautious_error, interleave, sample, weighted, Component, DriftEstimate, EffectivePotential,
+    interleave, level_error, sample, weighted, Component, DriftEstimate, EffectivePotential,
     NodeSample, PeriodIntegrals, Piece, EPS,
 };
 use crate::body::{Angle, Shape};
@@ -66,7 +66,8 @@ fn integrate_on<S: Shape>(
         return Ok(None);
     };
     loop {
-        let (t_sums, psi_sums) = samples.level_sums();
+        let sums = samples.level_sums();
+        let (t_sums, psi_sums) = (sums.t, sums.psi);
         let period = 2.0 * t_sums[0];
         let t_error = 2.0 * level_error(t_sums);
         let psi_error = 2.0 * level_error(psi_sums);
@@ -74,8 +75,8 @@ fn integrate_on<S: Shape>(
         // rounding of the gap and the conditioning near a saddle, which refining cannot
         // reduce (when those alone exceed it, a tenth of them: the status then says so).
         let (saddle_t, saddle_psi) = v.saddle_conditioning(energy, component, period, 2.0, 0.0);
-        let extra_t = 2.0 * samples.rounding(|n| n.dt) + saddle_t;
-        let extra_psi = 2.0 * samples.rounding(|n| n.dpsi) + saddle_psi;
+        let extra_t = 2.0 * sums.t_rounding + saddle_t;
+        let extra_psi = 2.0 * sums.psi_rounding + saddle_psi;
         let budget = |allowed: f64, extra: f64| (allowed - extra).max(0.1 * extra);
         let mut done =
             t_error <= budget(tol * period, extra_t) && psi_error <= budget(tol * TAU, extra_psi);
@@ -115,6 +116,16 @@ fn integrate_on<S: Shape>(
     }
 }
 
+/// What [`Samples::level_sums`] gives: the half-period sums of T and Δψ on three levels and
+/// their rounding bounds.
+#[derive(Default)]
+struct LevelSums {
+    t: [f64; 3],
+    psi: [f64; 3],
+    t_rounding: f64,
+    psi_rounding: f64,
+}
+
 /// The samples at φ_j = jπ/n, j = 0 … n, with n = `intervals`; the levels below are every
 /// second and every fourth node.
 struct Samples {
@@ -147,43 +158,32 @@ impl Samples {
         })
     }
 
-    /// The trapezoid sum over [0, π] of `f` on every `stride`-th node (ends weighted ½).
-    fn sum(&self, stride: usize, f: impl Fn(&NodeSample) -> f64) -> f64 {
-        let last = self.nodes.len() - 1;
-        let inner: f64 = self.nodes[stride..last]
-            .iter()
-            .step_by(stride)
-            .map(&f)
-            .sum();
-        let ends = 0.5 * (f(&self.nodes[0]) + f(&self.nodes[last]));
-        PI * stride as f64 / self.intervals as f64 * (inner + ends)
-    }
-
-    /// The trapezoid sums over [0, π] of dt/dφ and of ψ̇ dt/dφ on n, n/2 and n/4 steps
-    /// (finest first), in one pass.
-    fn level_sums(&self) -> ([f64; 3], [f64; 3]) {
-        let (mut t, mut psi) = ([0.0; 3], [0.0; 3]);
+    /// In one pass over the nodes: the trapezoid sums over [0, π] of dt/dφ and of ψ̇ dt/dφ on
+    /// n, n/2 and n/4 steps (finest first), and the bounds on their rounding on n steps,
+    /// Σ ½ (relative gap error) |f| with the trapezoid weights.
+    fn level_sums(&self) -> LevelSums {
+        let mut sums = LevelSums::default();
         let last = self.nodes.len() - 1;
         for (j, node) in self.nodes.iter().enumerate() {
             let w = if j == 0 || j == last { 0.5 } else { 1.0 };
             for (level, stride) in [1, 2, 4].into_iter().enumerate() {
                 if j % stride == 0 {
-                    t[level] += w * node.dt;
-                    psi[level] += w * node.dpsi;
+                    sums.t[level] += w * node.dt;
+                    sums.psi[level] += w * node.dpsi;
                 }
             }
+            let r = 0.5 * w * node.rounding;
+            sums.t_rounding += r * node.dt.abs();
+            sums.psi_rounding += r * node.dpsi.abs();
         }
         let h = PI / self.intervals as f64;
         for (level, stride) in [1.0, 2.0, 4.0].into_iter().enumerate() {
-            t[level] *= h * stride;
-            psi[level] *= h * stride;
+            sums.t[level] *= h * stride;
+            sums.psi[level] *= h * stride;
         }
-        (t, psi)
-    }
-
-    /// Σ ½ (relative gap error) |f| over the nodes with the trapezoid weights.
-    fn rounding(&self, f: impl Fn(&NodeSample) -> f64) -> f64 {
-        self.sum(1, |n| 0.5 * n.rounding * f(n).abs())
+        sums.t_rounding *= h;
+        sums.psi_rounding *= h;
+        sums
     }
 
     /// Halve the φ-step of `map`, with `at` the integrands at a node: keep the old nodes
@@ -199,20 +199,9 @@ impl Samples {
     /// scratch (its own ψ̃ and phases: reusing this level's would hide ψ̃'s aliasing, which
     /// Δψ's estimate does not bound, ĥ₀ converging faster than the higher coefficients).
     fn drift(&mut self) -> DriftEstimate {
-        let (fine, mid, coarse) = (
-            self.level_drift(1),
-            self.level_drift(2),
-            self.level_drift(4),
-        );
-        let (d1, d2) = (
-            (fine.0[0] - mid.0[0]).hypot(fine.0[1] - mid.0[1]),
-            (mid.0[0] - coarse.0[0]).hypot(mid.0[1] - coarse.0[1]),
-        );
-        DriftEstimate {
-            value: fine.0,
-            error: cautious_error(d1, d2).max(8.0 * EPS * fine.1),
-            scale: fine.1,
-        }
+        let fine = self.level_drift(1);
+        let mid = self.level_drift(2);
+        DriftEstimate::from_levels(fine, mid, self.level_drift(4))
     }
 }
 
@@ -227,14 +216,6 @@ impl Samples {
         self.drifts.push((intervals, value));
         value
     }
-}
-
-/// Error of the trapezoid sum on n steps from the sums on n, n/2 and n/4 steps (see
-/// [`cautious_error`]: the trapezoid rule's E(n) = C ρⁿ would allow d₁²/d₂, but not an
-/// integrand with singularities at several distances from the real axis).
-fn level_error(sums: [f64; 3]) -> f64 {
-    let [i0, i1, i2] = sums;
-    cautious_error((i0 - i1).abs(), (i1 - i2).abs()).max(8.0 * EPS * i0.abs())
 }
 
 /// Whether the geometric convergence seen in `sums` (on n = `intervals`, n/2 and n/4 steps)
