@@ -2,8 +2,10 @@
 by side in one run on the standard slice of SPEC §5 (α = 0.5, β = 3, ν = η = 0.5,
 κ ∈ [0, 2] × ε ∈ [0.5, 4.5] on 256 × 256 cells):
 
-- rubber-atlas: `cargo bench --bench cell_speed` (all outputs with error control, tol 1e-10),
-  1 and 2 threads, in cell-components per second;
+- rubber-atlas: `cargo bench --bench cell_speed`, with error control at tol 1e-10, 1 and 2
+  threads, in cell-components per second: all outputs, and N alone (T, ω_θ, ω_ψ and N
+  without the drift integrals: what the NumPy script computes, and what a scene that asks
+  for no drift costs);
 - NumPy: N alone by the periodic midpoint rule (64 nodes), vectorised over the whole slice
   (scripts/rubber_model.py, `midpoint_rotation_numbers`), one core;
 - SciPy: T and N by `scipy.integrate.quad` cell by cell (`scipy_cell`), one core, on a sample
@@ -36,13 +38,15 @@ KAPPAS = np.linspace(0.0, 2.0, 256)
 ENERGIES = np.linspace(0.5, 4.5, 256)
 
 
-def rust_rates() -> dict[int, float]:
-    """Cell-components per second of `cargo bench --bench cell_speed`, by thread count."""
+def rust_rates() -> dict[tuple[str, int], float]:
+    """Cell-components per second (median of 7) of `cargo bench --bench cell_speed`, by output
+    set ("all outputs", "N alone") and thread count."""
     out = subprocess.run(
         ["cargo", "bench", "--quiet", "--bench", "cell_speed"], cwd=ROOT, check=True, capture_output=True, text=True
     ).stdout
-    rates = {int(m[1]): float(m[2]) for m in re.finditer(r"threads (\d+): .*= (\d+) per second", out)}
-    if set(rates) != {1, 2}:
+    pattern = r"(all outputs|N alone), threads (\d+): .*= (\d+) per second"
+    rates = {(m[1], int(m[2])): float(m[3]) for m in re.finditer(pattern, out)}
+    if set(rates) != {(o, t) for o in ("all outputs", "N alone") for t in (1, 2)}:
         raise RuntimeError(f"unexpected cell_speed output:\n{out}")
     return rates
 
@@ -138,8 +142,10 @@ def main() -> None:
     scipy_errors = np.array(scipy_errors)
 
     rows = [
-        ("rubber-atlas, 1 thread (all outputs, tol 1e-10)", rust[1], 1),
-        ("rubber-atlas, 2 threads (all outputs, tol 1e-10)", rust[2], 2),
+        ("rubber-atlas, 1 thread (all outputs, tol 1e-10)", rust["all outputs", 1], 1),
+        ("rubber-atlas, 2 threads (all outputs, tol 1e-10)", rust["all outputs", 2], 2),
+        ("rubber-atlas, 1 thread (N alone, tol 1e-10)", rust["N alone", 1], 1),
+        ("rubber-atlas, 2 threads (N alone, tol 1e-10)", rust["N alone", 2], 2),
         (f"NumPy midpoint, N only, 64 nodes ({numpy_cells} cells)", numpy_cells_per_s, 1),
         (f"scipy.integrate.quad, T and N ({scipy_done} cells)", scipy_cells_per_s, 1),
     ]
@@ -148,10 +154,10 @@ def main() -> None:
     for name, rate, cores in rows:
         print(f"{name:58} {rate:12.0f} {rate / cores:12.0f}")
     print()
-    print(f"rubber-atlas (2 threads) / NumPy: {rust[2] / numpy_cells_per_s:7.1f}   per core: "
-          f"{rust[1] / numpy_cells_per_s:6.1f}")
-    print(f"rubber-atlas (2 threads) / SciPy: {rust[2] / scipy_cells_per_s:7.0f}   per core: "
-          f"{rust[1] / scipy_cells_per_s:6.0f}")
+    for outputs in ("N alone", "all outputs"):
+        for name, other in (("NumPy (64 nodes)", numpy_cells_per_s), ("SciPy", scipy_cells_per_s)):
+            print(f"rubber-atlas ({outputs}, 2 threads) / {name}: {rust[outputs, 2] / other:7.1f}   "
+                  f"1 thread: {rust[outputs, 1] / other:6.1f}")
     print()
     print(f"accuracy against rubber-atlas (tol 1e-10) on {len(sample)} random cells of the slice:")
     print(f"{'solver':38} {'cells/s':>10} {'median |ΔN|':>12} {'> 1e-10':>8} {'> 1e-6':>8}")
@@ -168,8 +174,8 @@ def main() -> None:
         writer = csv.writer(f)
         writer.writerow(["solver", "cells_per_second", "cores", "median_abs_error_n", "share_error_above_1e-10",
                          "share_error_above_1e-6"])
-        writer.writerow(["rubber-atlas 1 thread", f"{rust[1]:.0f}", 1, "", "", ""])
-        writer.writerow(["rubber-atlas 2 threads", f"{rust[2]:.0f}", 2, "", "", ""])
+        for (outputs, threads), rate in sorted(rust.items()):
+            writer.writerow([f"rubber-atlas {outputs} {threads} thread(s)", f"{rate:.0f}", threads, "", "", ""])
         for nodes, rate, _, errors in numpy_rows:
             writer.writerow([f"numpy midpoint {nodes} nodes N only", f"{rate:.0f}", 1, f"{np.median(errors):.1e}",
                              f"{np.mean(errors > 1e-10):.3f}", f"{np.mean(errors > 1e-6):.3f}"])
