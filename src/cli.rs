@@ -1,11 +1,16 @@
 //! Command-line definitions (clap) and the glue from flags to the library.
 
+use crate::progress::Reporter;
 use anyhow::{Context, Result};
 use clap::{ArgGroup, Args, Parser, Subcommand, ValueEnum};
+use rubber_atlas::atlas::Shard;
 use rubber_atlas::cell::{solve_cell, solve_component, CellOptions, CellResult, Method, Status};
 use rubber_atlas::critical::CriticalSet;
 use rubber_atlas::error::AtlasError;
+use rubber_atlas::scene::Scene;
+use rubber_atlas::store::atlas_file::AttrValue;
 use rubber_atlas::store::{write_table, Column};
+use rubber_atlas::sweep::{self, RunRequest};
 use rubber_atlas::torus::EffectivePotential;
 use rubber_atlas::trajectory::{integrate, Model, Start};
 use rubber_atlas::EllipsoidBody;
@@ -29,6 +34,52 @@ pub enum Command {
     /// One cell (κ, ε): per component of the allowed set ω_θ, ω_ψ, the rotation number N, the
     /// drift |Δζ| and radius R, bounded or not, status and error estimates.
     Cell(CellArgs),
+    /// Builds the atlas of a scene (TOML) into an HDF5 file that opens in xarray, with
+    /// progress, resume after a crash, and shards for a cluster.
+    Run(RunArgs),
+    /// Joins the shard files of one scene (made with `run --shard I/N`) into one atlas.
+    Merge(MergeArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// The scene file (TOML; see atlas/*.toml).
+    #[arg(value_name = "SCENE")]
+    pub scene: PathBuf,
+    /// Output file [default: atlas/<name>.h5; with --shard I/N atlas/<name>.shard-I-of-N.h5].
+    #[arg(long, value_name = "PATH")]
+    pub out: Option<PathBuf>,
+    /// Worker threads [default: every core].
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+    /// Continue an interrupted run of the same scene and output (finished units are kept).
+    #[arg(long)]
+    pub resume: bool,
+    /// Overwrite an existing output and discard an interrupted run.
+    #[arg(long)]
+    pub force: bool,
+    /// Compute part I of N of the grid (1 <= I <= N) into its own file.
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<String>,
+    /// No progress and no summary.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// The shard files, all N of them, in any order.
+    #[arg(value_name = "SHARDS", required = true)]
+    pub shards: Vec<PathBuf>,
+    /// The merged atlas.
+    #[arg(long, value_name = "FILE")]
+    pub out: PathBuf,
+    /// Overwrite an existing output.
+    #[arg(long)]
+    pub force: bool,
+    /// No summary.
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -200,7 +251,121 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Diagram(args) => diagram(args),
         Command::Trajectory(args) => trajectory(args),
         Command::Cell(args) => cell(args),
+        Command::Run(args) => run_scene(args),
+        Command::Merge(args) => merge(args),
     }
+}
+
+/// The attributes a command adds to the files it writes: its command line and the time.
+fn invocation_attributes() -> Vec<(String, AttrValue)> {
+    vec![
+        ("command_line".into(), AttrValue::Text(command_line())),
+        (
+            "created".into(),
+            AttrValue::Text(crate::progress::utc_now()),
+        ),
+    ]
+}
+
+fn run_scene(args: RunArgs) -> Result<()> {
+    let scene = Scene::from_file(&args.scene)?;
+    let shard = match &args.shard {
+        Some(text) => Shard::parse(text)?,
+        None => Shard::WHOLE,
+    };
+    let out = args.out.clone().unwrap_or_else(|| {
+        if shard == Shard::WHOLE {
+            PathBuf::from(format!("atlas/{}.h5", scene.name))
+        } else {
+            PathBuf::from(format!(
+                "atlas/{}.shard-{}-of-{}.h5",
+                scene.name, shard.index, shard.count
+            ))
+        }
+    });
+    if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        if !parent.is_dir() {
+            return Err(AtlasError::Atlas {
+                path: out.display().to_string(),
+                reason: format!("the directory {} does not exist", parent.display()),
+            }
+            .into());
+        }
+    }
+    let threads = match args.threads {
+        Some(0) => {
+            return Err(AtlasError::Atlas {
+                path: "--threads 0".into(),
+                reason: "needs at least one thread".into(),
+            }
+            .into())
+        }
+        Some(n) => n,
+        None => std::thread::available_parallelism().map_or(1, |n| n.get()),
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .context("cannot start the worker threads")?;
+    let request = RunRequest {
+        out: out.clone(),
+        resume: args.resume,
+        force: args.force,
+        shard,
+        attributes: invocation_attributes(),
+    };
+    let reporter = Reporter::new(args.quiet, &scene.name);
+    let summary = pool.install(|| sweep::run(&scene, &request, &reporter))?;
+    reporter.finish();
+    if !args.quiet {
+        print_summary(&summary, &out, threads);
+    }
+    Ok(())
+}
+
+fn merge(args: MergeArgs) -> Result<()> {
+    let summary = sweep::merge(
+        &args.shards,
+        &args.out,
+        args.force,
+        &invocation_attributes(),
+    )?;
+    if !args.quiet {
+        println!(
+            "merged {} shards into {} ({} cells, {} components) in {:.2} s",
+            args.shards.len(),
+            args.out.display(),
+            summary.cells,
+            summary.components,
+            summary.seconds
+        );
+    }
+    Ok(())
+}
+
+fn print_summary(summary: &sweep::Summary, out: &std::path::Path, threads: usize) {
+    let [ok, no_motion, failed] = summary.cells_by_status;
+    let [c_ok, c_tol, c_fixed, c_sep] = summary.components_by_status;
+    let rate = summary.cells_computed as f64 / summary.seconds.max(1e-9);
+    println!("wrote {}", out.display());
+    println!(
+        "cells: {} (with motion {ok}, no motion {no_motion}, failed {failed}); components: {}",
+        summary.cells, summary.components
+    );
+    println!(
+        "components by status: ok {c_ok}, tolerance_not_reached {c_tol}, fixed_point {c_fixed}, \
+         separatrix {c_sep}"
+    );
+    println!(
+        "units: {} ({} resumed from an interrupted run, {} computed now)",
+        summary.units,
+        summary.units_resumed,
+        summary.units - summary.units_resumed
+    );
+    println!(
+        "time: {:.2} s on {threads} thread(s), {} cells computed, {rate:.0} cells per second",
+        summary.seconds, summary.cells_computed
+    );
 }
 
 fn cell(args: CellArgs) -> Result<()> {

@@ -32,6 +32,16 @@ pub enum AtlasError {
     /// Writing an output file failed.
     #[error("cannot write {path}: {reason}")]
     Output { path: String, reason: String },
+    /// A scene file that cannot be read or is not valid: the file, the key and the reason.
+    #[error("{file}: {key}: {reason}")]
+    Scene {
+        file: String,
+        key: String,
+        reason: String,
+    },
+    /// An atlas file, a shard or a resume journal that cannot be used as asked.
+    #[error("{path}: {reason}")]
+    Atlas { path: String, reason: String },
 }
 
 /// Shorthand for results of this crate.

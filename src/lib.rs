@@ -16,13 +16,17 @@
 //!   equilibria, ε_min.
 //! - [`torus`]: one level set (κ, ε): its components, turning points, period and precession.
 //! - [`trajectory`]: time histories from either model; [`ode`] wraps the DOP853 integrator.
-//! - [`store`]: CSV and HDF5 output.
+//! - [`scene`]: the TOML scene files of atlas runs.
+//! - [`atlas`]: the grid driver — work units, rayon over κ-rows, dense per-cell arrays.
+//! - [`store`]: CSV and HDF5 output, the atlas file and the resume journal.
+//! - [`sweep`]: a whole run (resume, shards) and the merge of shards.
 //!
 //! Units are the paper's: length b3, mass m, time √(b3/g). The paper's misprints (in B(θ), the
 //! velocity of the centre of mass, θ*, ε_min, the stability of the equator, the type (c)
 //! boundary) are corrected as in SPEC §1; each correction is pinned by a test against the full
 //! equations or a direct numerical search.
 
+pub mod atlas;
 pub mod body;
 pub mod cell;
 pub mod critical;
@@ -32,7 +36,9 @@ pub mod ode;
 pub mod period_ode;
 pub mod quadrature;
 pub mod reduced;
+pub mod scene;
 pub mod store;
+pub mod sweep;
 pub mod torus;
 pub mod trajectory;
 

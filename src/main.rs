@@ -3,6 +3,7 @@
 //! computation that failed.
 
 mod cli;
+mod progress;
 
 use clap::Parser;
 use std::process::ExitCode;
@@ -41,6 +42,8 @@ fn main() -> ExitCode {
                             | rubber_atlas::AtlasError::NoMotion { .. }
                             | rubber_atlas::AtlasError::NotPeriodic { .. }
                             | rubber_atlas::AtlasError::Output { .. }
+                            | rubber_atlas::AtlasError::Scene { .. }
+                            | rubber_atlas::AtlasError::Atlas { .. }
                     )
                 )
             });

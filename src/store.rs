@@ -2,6 +2,9 @@
 //! by the file's extension. Files are written to a temporary name and renamed into place, so
 //! a failed write never leaves a partial output behind.
 
+pub mod atlas_file;
+pub mod journal;
+
 use crate::error::{AtlasError, Result};
 use std::io::Write;
 use std::path::{Path, PathBuf};

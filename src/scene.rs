@@ -1,0 +1,502 @@
+//! Scenes: the TOML files (SPEC §3.2) that describe an atlas run — the body (ν, η), the grid
+//! axes α, β, κ, ε, the solver settings and the outputs wanted. Parsing checks every key and
+//! value and names the file, the key and the reason of the first problem it finds.
+
+use crate::cell::{CellOptions, Method};
+use crate::error::{AtlasError, Result};
+use crate::EllipsoidBody;
+use std::path::Path;
+use toml::{Table, Value};
+
+/// An output variable a scene may ask for (one value per cell and component).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Field {
+    ThetaMin,
+    ThetaMax,
+    Period,
+    OmegaTheta,
+    OmegaPsi,
+    RotationNumber,
+    Drift,
+    DriftRadius,
+    Bounded,
+    Motion,
+    Status,
+    ErrorEstimate,
+}
+
+impl Field {
+    /// Every field, in the order of the file.
+    pub const ALL: [Field; 12] = [
+        Field::ThetaMin,
+        Field::ThetaMax,
+        Field::Period,
+        Field::OmegaTheta,
+        Field::OmegaPsi,
+        Field::RotationNumber,
+        Field::Drift,
+        Field::DriftRadius,
+        Field::Bounded,
+        Field::Motion,
+        Field::Status,
+        Field::ErrorEstimate,
+    ];
+
+    /// The variable's name in scenes and in the HDF5 file.
+    pub fn name(self) -> &'static str {
+        match self {
+            Field::ThetaMin => "theta_min",
+            Field::ThetaMax => "theta_max",
+            Field::Period => "period",
+            Field::OmegaTheta => "omega_theta",
+            Field::OmegaPsi => "omega_psi",
+            Field::RotationNumber => "rotation_number",
+            Field::Drift => "drift",
+            Field::DriftRadius => "drift_radius",
+            Field::Bounded => "bounded",
+            Field::Motion => "motion",
+            Field::Status => "status",
+            Field::ErrorEstimate => "error_estimate",
+        }
+    }
+
+    /// The field named `name`, if any.
+    pub fn from_name(name: &str) -> Option<Field> {
+        Field::ALL.into_iter().find(|f| f.name() == name)
+    }
+
+    /// Whether the field needs the drift integrals Δζ.
+    pub fn needs_drift(self) -> bool {
+        matches!(self, Field::Drift | Field::DriftRadius | Field::Bounded)
+    }
+}
+
+/// One grid axis: strictly increasing, finite values.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Axis {
+    pub values: Vec<f64>,
+}
+
+impl Axis {
+    /// `num` values from `start` to `stop` inclusive, evenly spaced (the last one exactly
+    /// `stop`); `num = 1` needs `start = stop`.
+    pub fn linspace(start: f64, stop: f64, num: usize) -> Vec<f64> {
+        if num == 1 {
+            return vec![start];
+        }
+        let step = (stop - start) / (num - 1) as f64;
+        (0..num)
+            .map(|i| {
+                if i + 1 == num {
+                    stop
+                } else {
+                    start + step * i as f64
+                }
+            })
+            .collect()
+    }
+
+    pub fn len(&self) -> usize {
+        self.values.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.values.is_empty()
+    }
+}
+
+/// A parsed, validated scene.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    /// The scene's name (default output `atlas/<name>.h5`).
+    pub name: String,
+    /// ν = i3 / i1.
+    pub nu: f64,
+    /// η = m b3² / i1.
+    pub eta: f64,
+    pub alpha: Axis,
+    pub beta: Axis,
+    pub kappa: Axis,
+    pub energy: Axis,
+    /// Solver options (tolerance, method; drift only if an output needs it).
+    pub options: CellOptions,
+    /// The outputs asked for, in file order; `status` is always among them.
+    pub fields: Vec<Field>,
+    /// The scene file's text, kept verbatim in the atlas for provenance and for resume and
+    /// merge to check that they continue the same scene.
+    pub text: String,
+}
+
+struct Reader<'a> {
+    file: &'a str,
+}
+
+impl Reader<'_> {
+    fn error(&self, key: &str, reason: impl Into<String>) -> AtlasError {
+        AtlasError::Scene {
+            file: self.file.to_string(),
+            key: key.to_string(),
+            reason: reason.into(),
+        }
+    }
+
+    /// Refuses keys of `table` outside `known`.
+    fn only_keys(&self, table: &Table, prefix: &str, known: &[&str]) -> Result<()> {
+        match table.keys().find(|k| !known.contains(&k.as_str())) {
+            Some(k) => Err(self.error(
+                &join(prefix, k),
+                format!("unknown key (expected one of: {})", known.join(", ")),
+            )),
+            None => Ok(()),
+        }
+    }
+
+    fn table<'t>(&self, parent: &'t Table, prefix: &str, key: &str) -> Result<&'t Table> {
+        match parent.get(key) {
+            Some(Value::Table(t)) => Ok(t),
+            Some(v) => Err(self.error(
+                &join(prefix, key),
+                format!("expected a table, found {}", v.type_str()),
+            )),
+            None => Err(self.error(&join(prefix, key), "missing")),
+        }
+    }
+
+    fn number(&self, value: &Value, key: &str) -> Result<f64> {
+        let x = match value {
+            Value::Float(x) => *x,
+            Value::Integer(i) => *i as f64,
+            v => return Err(self.error(key, format!("expected a number, found {}", v.type_str()))),
+        };
+        if x.is_finite() {
+            Ok(x)
+        } else {
+            Err(self.error(key, format!("{x} is not a finite number")))
+        }
+    }
+
+    fn required_number(&self, table: &Table, prefix: &str, key: &str) -> Result<f64> {
+        let full = join(prefix, key);
+        match table.get(key) {
+            Some(v) => self.number(v, &full),
+            None => Err(self.error(&full, "missing")),
+        }
+    }
+
+    fn axis(&self, axes: &Table, key: &str) -> Result<Axis> {
+        let full = join("axes", key);
+        let values = match axes.get(key) {
+            None => return Err(self.error(&full, "missing")),
+            Some(Value::Array(items)) => {
+                if items.is_empty() {
+                    return Err(self.error(&full, "empty list of values"));
+                }
+                items
+                    .iter()
+                    .enumerate()
+                    .map(|(i, v)| self.number(v, &format!("{full}[{i}]")))
+                    .collect::<Result<Vec<_>>>()?
+            }
+            Some(Value::Table(t)) => {
+                self.only_keys(t, &full, &["start", "stop", "num"])?;
+                let start = self.required_number(t, &full, "start")?;
+                let stop = self.required_number(t, &full, "stop")?;
+                let num = match t.get("num") {
+                    Some(Value::Integer(n)) if *n >= 1 => *n as usize,
+                    Some(Value::Integer(n)) => {
+                        return Err(self.error(&join(&full, "num"), format!("{n} must be >= 1")))
+                    }
+                    Some(v) => {
+                        return Err(self.error(
+                            &join(&full, "num"),
+                            format!("expected an integer, found {}", v.type_str()),
+                        ))
+                    }
+                    None => return Err(self.error(&join(&full, "num"), "missing")),
+                };
+                if num > 1_000_000 {
+                    return Err(self.error(&join(&full, "num"), format!("{num} is over 1000000")));
+                }
+                if stop < start {
+                    return Err(self.error(
+                        &full,
+                        format!("inverted axis: stop {stop} is below start {start}"),
+                    ));
+                }
+                if num > 1 && stop == start {
+                    return Err(self.error(
+                        &full,
+                        format!("empty axis: start = stop = {start} with num = {num}"),
+                    ));
+                }
+                if num == 1 && stop != start {
+                    return Err(self.error(
+                        &full,
+                        "num = 1 needs start = stop (or give a list of values)",
+                    ));
+                }
+                Axis::linspace(start, stop, num)
+            }
+            Some(v) => {
+                return Err(self.error(
+                    &full,
+                    format!(
+                        "expected a list of values or {{ start, stop, num }}, found {}",
+                        v.type_str()
+                    ),
+                ))
+            }
+        };
+        if let Some(i) = values.windows(2).position(|w| w[1] <= w[0]) {
+            return Err(self.error(
+                &full,
+                format!(
+                    "values must be strictly increasing ({} is followed by {})",
+                    values[i],
+                    values[i + 1]
+                ),
+            ));
+        }
+        Ok(Axis { values })
+    }
+}
+
+fn join(prefix: &str, key: &str) -> String {
+    if prefix.is_empty() {
+        key.to_string()
+    } else {
+        format!("{prefix}.{key}")
+    }
+}
+
+/// A parameter error from the library, told as a scene error at `key`.
+fn parameter_error(reader: &Reader<'_>, key: &str, e: AtlasError) -> AtlasError {
+    match e {
+        AtlasError::InvalidParameter { value, reason, .. } => {
+            reader.error(key, format!("{value} {reason}"))
+        }
+        e => reader.error(key, e.to_string()),
+    }
+}
+
+impl Scene {
+    /// Reads and checks the scene file at `path`.
+    pub fn from_file(path: &Path) -> Result<Scene> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| AtlasError::Scene {
+            file: file.clone(),
+            key: "(file)".into(),
+            reason: e.to_string(),
+        })?;
+        Scene::parse(&text, &file)
+    }
+
+    /// Parses and checks a scene's text; `file` names it in errors.
+    pub fn parse(text: &str, file: &str) -> Result<Scene> {
+        let reader = Reader { file };
+        let root: Table = text.parse().map_err(|e: toml::de::Error| {
+            let line = match e.span() {
+                Some(span) => format!(
+                    "line {}",
+                    text[..span.start.min(text.len())].matches('\n').count() + 1
+                ),
+                None => "(syntax)".into(),
+            };
+            reader.error(&line, e.message().replace('\n', " "))
+        })?;
+        reader.only_keys(&root, "", &["name", "body", "axes", "solver", "outputs"])?;
+
+        let name = match root.get("name") {
+            Some(Value::String(s)) => s.clone(),
+            Some(v) => {
+                return Err(
+                    reader.error("name", format!("expected a string, found {}", v.type_str()))
+                )
+            }
+            None => return Err(reader.error("name", "missing")),
+        };
+        if name.is_empty()
+            || !name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
+            || name.starts_with('.')
+        {
+            return Err(reader.error(
+                "name",
+                format!(
+                    "{name:?} must be non-empty and use only letters, digits, '-', '_' and '.'"
+                ),
+            ));
+        }
+
+        let body = reader.table(&root, "", "body")?;
+        reader.only_keys(body, "body", &["nu", "eta"])?;
+        let nu = reader.required_number(body, "body", "nu")?;
+        let eta = reader.required_number(body, "body", "eta")?;
+
+        let axes = reader.table(&root, "", "axes")?;
+        reader.only_keys(axes, "axes", &["alpha", "beta", "kappa", "energy"])?;
+        let alpha = reader.axis(axes, "alpha")?;
+        let beta = reader.axis(axes, "beta")?;
+        let kappa = reader.axis(axes, "kappa")?;
+        let energy = reader.axis(axes, "energy")?;
+        // Every body of the grid must be valid: check the extremes of each axis.
+        for &a in &[alpha.values[0], *alpha.values.last().unwrap()] {
+            for &b in &[beta.values[0], *beta.values.last().unwrap()] {
+                if let Err(e) = EllipsoidBody::ellipsoid(a, b, nu, eta) {
+                    let key = match &e {
+                        AtlasError::InvalidParameter { name, .. } => match *name {
+                            "alpha" | "beta" => format!("axes.{name}"),
+                            other => format!("body.{other}"),
+                        },
+                        _ => "body".into(),
+                    };
+                    return Err(parameter_error(&reader, &key, e));
+                }
+            }
+        }
+
+        let mut options = CellOptions::default();
+        if let Some(v) = root.get("solver") {
+            let Value::Table(solver) = v else {
+                return Err(reader.error(
+                    "solver",
+                    format!("expected a table, found {}", v.type_str()),
+                ));
+            };
+            reader.only_keys(solver, "solver", &["tolerance", "method", "resonance_tol"])?;
+            if solver.contains_key("tolerance") {
+                options.tol = reader.required_number(solver, "solver", "tolerance")?;
+            }
+            if solver.contains_key("resonance_tol") {
+                options.resonance_tol =
+                    reader.required_number(solver, "solver", "resonance_tol")?;
+            }
+            match solver.get("method") {
+                None => {}
+                Some(Value::String(m)) if m == "quadrature" => options.method = Method::Quadrature,
+                Some(Value::String(m)) if m == "ode" => options.method = Method::Ode,
+                Some(v) => {
+                    return Err(reader.error(
+                        "solver.method",
+                        format!("{v} is not \"quadrature\" or \"ode\""),
+                    ))
+                }
+            }
+            if let Err(e) = options.validate() {
+                let key = match &e {
+                    AtlasError::InvalidParameter { name: "tol", .. } => "solver.tolerance",
+                    _ => "solver.resonance_tol",
+                };
+                return Err(parameter_error(&reader, key, e));
+            }
+        }
+
+        let mut fields: Vec<Field> = Field::ALL.to_vec();
+        if let Some(v) = root.get("outputs") {
+            let Value::Table(outputs) = v else {
+                return Err(reader.error(
+                    "outputs",
+                    format!("expected a table, found {}", v.type_str()),
+                ));
+            };
+            reader.only_keys(outputs, "outputs", &["fields"])?;
+            match outputs.get("fields") {
+                None => {}
+                Some(Value::Array(items)) => {
+                    if items.is_empty() {
+                        return Err(reader.error("outputs.fields", "empty list"));
+                    }
+                    fields.clear();
+                    for (i, item) in items.iter().enumerate() {
+                        let key = format!("outputs.fields[{i}]");
+                        let Value::String(s) = item else {
+                            return Err(reader.error(
+                                &key,
+                                format!("expected a string, found {}", item.type_str()),
+                            ));
+                        };
+                        let field = Field::from_name(s).ok_or_else(|| {
+                            let names: Vec<&str> = Field::ALL.iter().map(|f| f.name()).collect();
+                            reader.error(
+                                &key,
+                                format!("unknown field {s:?} (known: {})", names.join(", ")),
+                            )
+                        })?;
+                        if fields.contains(&field) {
+                            return Err(reader.error(&key, format!("{s:?} is listed twice")));
+                        }
+                        fields.push(field);
+                    }
+                    if !fields.contains(&Field::Status) {
+                        fields.push(Field::Status);
+                    }
+                    fields.sort();
+                }
+                Some(v) => {
+                    return Err(reader.error(
+                        "outputs.fields",
+                        format!("expected a list of strings, found {}", v.type_str()),
+                    ))
+                }
+            }
+        }
+        options.drift = fields.iter().any(|f| f.needs_drift());
+
+        Ok(Scene {
+            name,
+            nu,
+            eta,
+            alpha,
+            beta,
+            kappa,
+            energy,
+            options,
+            fields,
+            text: text.to_string(),
+        })
+    }
+
+    /// The shape of the grid: (n_α, n_β, n_κ, n_ε).
+    pub fn shape(&self) -> [usize; 4] {
+        [
+            self.alpha.len(),
+            self.beta.len(),
+            self.kappa.len(),
+            self.energy.len(),
+        ]
+    }
+
+    /// The number of cells of the grid.
+    pub fn cells(&self) -> usize {
+        self.shape().iter().product()
+    }
+
+    /// The body at grid point (i_α, i_β).
+    pub fn body(&self, ia: usize, ib: usize) -> EllipsoidBody {
+        EllipsoidBody::ellipsoid(
+            self.alpha.values[ia],
+            self.beta.values[ib],
+            self.nu,
+            self.eta,
+        )
+        .expect("the scene's bodies were checked when it was parsed")
+    }
+
+    /// A 64-bit fingerprint of the scene's text and of the program version: resume and merge
+    /// only continue work of the same scene computed by the same program.
+    pub fn fingerprint(&self) -> u64 {
+        let mut hash = fnv1a(0xcbf2_9ce4_8422_2325, self.text.as_bytes());
+        hash = fnv1a(hash, env!("CARGO_PKG_VERSION").as_bytes());
+        hash
+    }
+}
+
+/// FNV-1a over `bytes`, continuing from `hash`.
+pub fn fnv1a(mut hash: u64, bytes: &[u8]) -> u64 {
+    for &b in bytes {
+        hash ^= u64::from(b);
+        hash = hash.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    hash
+}

@@ -1,0 +1,448 @@
+//! A whole atlas run (`rubber-atlas run`) and the merge of shards (`rubber-atlas merge`):
+//! the work units of the scene (or of one shard) are computed slice by slice into the resume
+//! journal, then written to the HDF5 file, which is renamed into place only when complete.
+//! Memory stays at one slice's worth whatever the grid.
+
+use crate::atlas::{
+    self, compute_rows, status_flag, Block, Shard, Unit, Variable, COMPONENT_SLOTS,
+};
+use crate::error::{AtlasError, Result};
+use crate::scene::Scene;
+use crate::store::atlas_file::{AtlasFile, AttrValue};
+use crate::store::journal::Journal;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// What the caller is told while a run goes on.
+pub trait Progress: Sync {
+    /// The run starts: `total` cells in this run (or shard), `done` of them already in the
+    /// journal of an interrupted run.
+    fn begin(&self, _total: u64, _done: u64) {}
+    /// `cells` more cells are done.
+    fn advance(&self, _cells: u64) {}
+    /// Every unit is computed; the HDF5 file is being written.
+    fn writing(&self) {}
+}
+
+/// A progress sink that says nothing.
+pub struct Silent;
+impl Progress for Silent {}
+
+/// Counts over the cells and components of a run.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Summary {
+    /// Cells in the file (or in the shard).
+    pub cells: u64,
+    /// Components over those cells.
+    pub components: u64,
+    /// Cells by `cell_status`: ok, no_motion, failed.
+    pub cells_by_status: [u64; 3],
+    /// Components by `status`: ok, tolerance_not_reached, fixed_point, separatrix.
+    pub components_by_status: [u64; 4],
+    /// Work units of this run, and how many of them an interrupted run had finished.
+    pub units: usize,
+    pub units_resumed: usize,
+    /// Cells computed by this invocation (0 for a merge).
+    pub cells_computed: u64,
+    /// Wall time, seconds.
+    pub seconds: f64,
+}
+
+impl Summary {
+    fn count(&mut self, variables: &[Variable], block: &Block) {
+        self.cells += block.cells as u64;
+        if let Some(status) = block.flags(variables, "cell_status") {
+            for &s in status {
+                self.cells_by_status[usize::from(s.min(2))] += 1;
+            }
+        }
+        if let Some(n) = block.flags(variables, "n_components") {
+            self.components += n
+                .iter()
+                .map(|&k| u64::from(k).min(COMPONENT_SLOTS as u64))
+                .sum::<u64>();
+        }
+        if let Some(status) = block.flags(variables, "status") {
+            for &s in status {
+                if s <= status_flag::SEPARATRIX {
+                    self.components_by_status[usize::from(s)] += 1;
+                }
+            }
+        }
+    }
+}
+
+/// How to run a scene.
+#[derive(Debug, Clone)]
+pub struct RunRequest {
+    pub out: PathBuf,
+    /// Continue an interrupted run from its journal.
+    pub resume: bool,
+    /// Replace an existing output, and discard an interrupted run's journal.
+    pub force: bool,
+    pub shard: Shard,
+    /// Attributes the caller adds to the file's root (command line, creation time).
+    pub attributes: Vec<(String, AttrValue)>,
+}
+
+fn atlas_error(path: &Path, reason: impl Into<String>) -> AtlasError {
+    AtlasError::Atlas {
+        path: path.display().to_string(),
+        reason: reason.into(),
+    }
+}
+
+/// `<out>.partial.h5`: where the file is written before it is renamed into place.
+fn temporary_path(out: &Path) -> PathBuf {
+    let mut name = out
+        .file_name()
+        .map(|n| n.to_os_string())
+        .unwrap_or_default();
+    name.push(".partial.h5");
+    out.with_file_name(name)
+}
+
+/// The root attributes every atlas file carries: provenance and the scene.
+fn scene_attributes(scene: &Scene, shard: Shard, units: usize) -> Vec<(String, AttrValue)> {
+    let text = |s: &str| AttrValue::Text(s.to_string());
+    vec![
+        (
+            "title".into(),
+            text(&format!("rubber-atlas atlas of scene {}", scene.name)),
+        ),
+        ("program".into(), text("rubber-atlas")),
+        ("program_version".into(), text(env!("CARGO_PKG_VERSION"))),
+        ("git_commit".into(), text(env!("RUBBER_ATLAS_GIT_COMMIT"))),
+        ("scene_name".into(), text(&scene.name)),
+        ("scene".into(), text(&scene.text)),
+        (
+            "scene_fingerprint".into(),
+            text(&format!("{:016x}", scene.fingerprint())),
+        ),
+        ("nu".into(), AttrValue::Number(scene.nu)),
+        ("eta".into(), AttrValue::Number(scene.eta)),
+        ("tolerance".into(), AttrValue::Number(scene.options.tol)),
+        (
+            "method".into(),
+            text(match scene.options.method {
+                crate::cell::Method::Quadrature => "quadrature",
+                crate::cell::Method::Ode => "ode",
+            }),
+        ),
+        (
+            "resonance_tol".into(),
+            AttrValue::Number(scene.options.resonance_tol),
+        ),
+        ("shard_index".into(), AttrValue::Integer(shard.index as i64)),
+        ("shard_count".into(), AttrValue::Integer(shard.count as i64)),
+        ("unit_count".into(), AttrValue::Integer(units as i64)),
+    ]
+}
+
+fn borrowed(attributes: &[(String, AttrValue)]) -> Vec<(&str, AttrValue)> {
+    attributes
+        .iter()
+        .map(|(k, v)| (k.as_str(), v.clone()))
+        .collect()
+}
+
+/// Runs `scene` as `request` says; returns the summary.
+pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Result<Summary> {
+    let started = Instant::now();
+    let out = &request.out;
+    if out.exists() && !request.force {
+        return Err(atlas_error(
+            out,
+            "exists; use --force to overwrite it (a finished run has nothing to resume)",
+        ));
+    }
+    let fingerprint = scene.fingerprint();
+    let journal_dir = Journal::dir_for(out);
+    let journal = if journal_dir.exists() {
+        if request.force {
+            std::fs::remove_dir_all(&journal_dir)
+                .map_err(|e| atlas_error(&journal_dir, e.to_string()))?;
+            Journal::create(&journal_dir, fingerprint, &scene.text)?
+        } else if request.resume {
+            Journal::open(&journal_dir, fingerprint)?
+        } else {
+            return Err(atlas_error(
+                &journal_dir,
+                "an interrupted run of this output left its journal here; \
+                 use --resume to continue it or --force to start over",
+            ));
+        }
+    } else {
+        Journal::create(&journal_dir, fingerprint, &scene.text)?
+    };
+
+    let variables = atlas::variables(&scene.fields);
+    let all_units = atlas::units(scene.shape());
+    let mine = &all_units[request.shard.units(all_units.len())];
+    let cells_of = |u: &Unit| u.rows.len() * scene.energy.len();
+    let listed = journal.listed_units()?;
+    let done: Vec<bool> = mine
+        .iter()
+        .map(|u| {
+            listed.contains(&u.index) && journal.read(u.index, &variables, cells_of(u)).is_some()
+        })
+        .collect();
+    let total: u64 = mine.iter().map(|u| cells_of(u) as u64).sum();
+    let done_cells: u64 = mine
+        .iter()
+        .zip(&done)
+        .filter(|(_, &d)| d)
+        .map(|(u, _)| cells_of(u) as u64)
+        .sum();
+    let mut summary = Summary {
+        units: mine.len(),
+        units_resumed: done.iter().filter(|&&d| d).count(),
+        ..Summary::default()
+    };
+    progress.begin(total, done_cells);
+
+    // Slice by slice: the units of one (α, β) still to do, their rows computed together.
+    let advance = |cells: usize| progress.advance(cells as u64);
+    let mut i = 0;
+    while i < mine.len() {
+        let slice = (mine[i].alpha_index, mine[i].beta_index);
+        let mut todo: Vec<&Unit> = Vec::new();
+        while i < mine.len() && (mine[i].alpha_index, mine[i].beta_index) == slice {
+            if !done[i] {
+                todo.push(&mine[i]);
+            }
+            i += 1;
+        }
+        if todo.is_empty() {
+            continue;
+        }
+        let rows: Vec<usize> = todo.iter().flat_map(|u| u.rows.clone()).collect();
+        let mut block = compute_rows(scene, &variables, slice.0, slice.1, &rows, &advance);
+        summary.cells_computed += block.cells as u64;
+        for u in todo {
+            let part = block.take_front(&variables, cells_of(u));
+            journal.write(u.index, &part)?;
+        }
+    }
+
+    progress.writing();
+    let tmp = temporary_path(out);
+    if tmp.exists() {
+        std::fs::remove_file(&tmp).map_err(|e| atlas_error(&tmp, e.to_string()))?;
+    }
+    let mut attributes = scene_attributes(scene, request.shard, all_units.len());
+    attributes.extend(request.attributes.iter().cloned());
+    let written = (|| -> Result<()> {
+        let file = AtlasFile::create(&tmp, scene, &variables, &borrowed(&attributes))?;
+        write_by_slice(
+            &file,
+            &variables,
+            mine,
+            |u| {
+                Ok(match journal.read(u.index, &variables, cells_of(u)) {
+                    Some(b) => b,
+                    // Damaged since it was written (a disk error): compute it again.
+                    None => {
+                        let rows: Vec<usize> = u.rows.clone().collect();
+                        compute_rows(
+                            scene,
+                            &variables,
+                            u.alpha_index,
+                            u.beta_index,
+                            &rows,
+                            &|_| {},
+                        )
+                    }
+                })
+            },
+            &mut summary,
+        )?;
+        file.close()
+    })();
+    if let Err(e) = written {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(e);
+    }
+    std::fs::rename(&tmp, out).map_err(|e| atlas_error(out, e.to_string()))?;
+    journal.remove()?;
+    summary.seconds = started.elapsed().as_secs_f64();
+    Ok(summary)
+}
+
+/// Merges the shard files `shards` of one scene into `out`; the arrays equal those of a
+/// single run bit for bit. Refuses shards of different scenes or program versions,
+/// duplicates, and missing parts.
+pub fn merge(
+    shards: &[PathBuf],
+    out: &Path,
+    force: bool,
+    extra_attributes: &[(String, AttrValue)],
+) -> Result<Summary> {
+    let started = Instant::now();
+    if out.exists() && !force {
+        return Err(atlas_error(out, "exists; use --force to overwrite it"));
+    }
+    if shards.is_empty() {
+        return Err(atlas_error(out, "no shard files given"));
+    }
+    // The scene, from the first shard; every shard must carry the same one.
+    let first = shards[0].as_path();
+    let scene_text = read_root_text(first, "scene")?;
+    let scene = Scene::parse(&scene_text, &first.display().to_string())?;
+    let variables = atlas::variables(&scene.fields);
+    let all_units = atlas::units(scene.shape());
+    let fingerprint = format!("{:016x}", scene.fingerprint());
+    let mut by_index: Vec<Option<(PathBuf, AtlasFile)>> = Vec::new();
+    let mut count = None;
+    for path in shards {
+        let file = AtlasFile::open(path, &scene, &variables)?;
+        if file.text_attribute("scene_fingerprint").as_deref() != Some(fingerprint.as_str()) {
+            return Err(atlas_error(
+                path,
+                format!(
+                    "is not a shard of the same scene as {} (or was made by another version)",
+                    first.display()
+                ),
+            ));
+        }
+        let (Some(index), Some(n)) = (
+            file.integer_attribute("shard_index"),
+            file.integer_attribute("shard_count"),
+        ) else {
+            return Err(atlas_error(path, "has no shard_index / shard_count"));
+        };
+        let n = n as usize;
+        if *count.get_or_insert(n) != n {
+            return Err(atlas_error(
+                path,
+                format!(
+                    "is shard {index}/{n}, but the first shard is of {}",
+                    count.unwrap()
+                ),
+            ));
+        }
+        by_index.resize_with(n, || None);
+        let slot = &mut by_index[index as usize - 1];
+        if let Some((other, _)) = slot {
+            return Err(atlas_error(
+                path,
+                format!(
+                    "shard {index}/{n} is given twice (also {})",
+                    other.display()
+                ),
+            ));
+        }
+        *slot = Some((path.clone(), file));
+    }
+    let missing: Vec<String> = by_index
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| s.is_none())
+        .map(|(i, _)| format!("{}/{}", i + 1, by_index.len()))
+        .collect();
+    if !missing.is_empty() {
+        return Err(atlas_error(
+            out,
+            format!("shards missing: {}", missing.join(", ")),
+        ));
+    }
+
+    let tmp = temporary_path(out);
+    if tmp.exists() {
+        std::fs::remove_file(&tmp).map_err(|e| atlas_error(&tmp, e.to_string()))?;
+    }
+    let mut attributes = scene_attributes(&scene, Shard::WHOLE, all_units.len());
+    // Provenance of the computation: the first shard's program and commit.
+    let (_, first_file) = by_index[0].as_ref().unwrap();
+    for key in ["program_version", "git_commit"] {
+        if let Some(v) = first_file.text_attribute(key) {
+            attributes.retain(|(k, _)| k != key);
+            attributes.push((key.into(), AttrValue::Text(v)));
+        }
+    }
+    attributes.push((
+        "merged_from".into(),
+        AttrValue::Text(
+            by_index
+                .iter()
+                .map(|s| s.as_ref().unwrap().0.display().to_string())
+                .collect::<Vec<_>>()
+                .join("\n"),
+        ),
+    ));
+    attributes.extend(extra_attributes.iter().cloned());
+    let mut summary = Summary {
+        units: all_units.len(),
+        ..Summary::default()
+    };
+    let n = by_index.len();
+    let written = (|| -> Result<()> {
+        let file = AtlasFile::create(&tmp, &scene, &variables, &borrowed(&attributes))?;
+        for (i, shard) in by_index.iter().enumerate() {
+            let (_, source) = shard.as_ref().unwrap();
+            let range = Shard {
+                index: i + 1,
+                count: n,
+            }
+            .units(all_units.len());
+            // Read a shard slice by slice too: one chunk read per slice.
+            for part in slice_runs(&all_units[range]) {
+                let merged = joined(part);
+                let block = source.read_unit(&merged)?;
+                summary.count(&variables, &block);
+                file.write_unit(&merged, &block)?;
+            }
+        }
+        file.close()
+    })();
+    if let Err(e) = written {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(e);
+    }
+    std::fs::rename(&tmp, out).map_err(|e| atlas_error(out, e.to_string()))?;
+    summary.seconds = started.elapsed().as_secs_f64();
+    Ok(summary)
+}
+
+/// Consecutive runs of units of one (α, β) slice.
+fn slice_runs(units: &[Unit]) -> impl Iterator<Item = &[Unit]> {
+    units.chunk_by(|a, b| (a.alpha_index, a.beta_index) == (b.alpha_index, b.beta_index))
+}
+
+/// The consecutive units `run` of one slice as one unit (their rows joined).
+fn joined(run: &[Unit]) -> Unit {
+    Unit {
+        index: run[0].index,
+        alpha_index: run[0].alpha_index,
+        beta_index: run[0].beta_index,
+        rows: run[0].rows.start..run[run.len() - 1].rows.end,
+    }
+}
+
+/// Writes `units` to `file` one slice at a time (one write per chunk: a write per unit would
+/// read, inflate and deflate the slice's chunk again for every unit), counting into `summary`.
+fn write_by_slice(
+    file: &AtlasFile,
+    variables: &[Variable],
+    units: &[Unit],
+    mut block_of: impl FnMut(&Unit) -> Result<Block>,
+    summary: &mut Summary,
+) -> Result<()> {
+    for run in slice_runs(units) {
+        let mut slice = Block::empty(variables, 0);
+        for u in run {
+            slice.append(block_of(u)?);
+        }
+        summary.count(variables, &slice);
+        file.write_unit(&joined(run), &slice)?;
+    }
+    Ok(())
+}
+
+fn read_root_text(path: &Path, name: &str) -> Result<String> {
+    let file = hdf5::File::open(path).map_err(|e| atlas_error(path, e.to_string()))?;
+    file.attr(name)
+        .and_then(|a| a.read_scalar::<hdf5::types::VarLenUnicode>())
+        .map(|s| s.as_str().to_string())
+        .map_err(|_| atlas_error(path, format!("has no {name} attribute: not an atlas file")))
+}
