@@ -1,0 +1,461 @@
+//! `rubber-atlas run` and `merge` end to end, through the binary: bad scenes are refused with
+//! one line and nothing written; 1 and 2 threads give identical arrays; a run killed with
+//! SIGKILL at several points and resumed equals an uninterrupted run bit for bit and
+//! recomputes no finished unit; three shards merged equal a single run bit for bit.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+const BIN: &str = env!("CARGO_BIN_EXE_rubber-atlas");
+
+fn scene_text(name: &str, method: &str, grid: &str) -> String {
+    format!(
+        r#"name = "{name}"
+[body]
+nu = 0.5
+eta = 0.5
+[axes]
+{grid}
+[solver]
+tolerance = 1e-8
+method = "{method}"
+"#
+    )
+}
+
+/// A small quadrature scene: 2 × 2 slices of 24 × 40 cells over both diagram sides.
+fn small_scene(dir: &Path) -> PathBuf {
+    let path = dir.join("small.toml");
+    std::fs::write(
+        &path,
+        scene_text(
+            "small",
+            "quadrature",
+            "alpha = [0.2, 0.5]\nbeta = [0.8, 3.0]\n\
+             kappa = { start = 0.0, stop = 1.5, num = 24 }\n\
+             energy = { start = 0.5, stop = 4.0, num = 40 }",
+        ),
+    )
+    .unwrap();
+    path
+}
+
+fn run(args: &[&str]) -> Output {
+    Command::new(BIN).args(args).output().unwrap()
+}
+
+fn ok(output: &Output) -> String {
+    assert!(
+        output.status.success(),
+        "exit {:?}: {}",
+        output.status,
+        String::from_utf8_lossy(&output.stderr)
+    );
+    String::from_utf8_lossy(&output.stdout).into_owned()
+}
+
+/// Every dataset of an atlas file as raw bytes, by name.
+fn arrays(path: &Path) -> Vec<(String, Vec<u8>)> {
+    let file = hdf5::File::open(path).unwrap();
+    let mut out = Vec::new();
+    for name in file.member_names().unwrap() {
+        let ds = file.dataset(&name).unwrap();
+        let dtype = ds.dtype().unwrap();
+        let bytes: Vec<u8> = if dtype.is::<f64>() {
+            ds.read_raw::<f64>()
+                .unwrap()
+                .iter()
+                .flat_map(|x| x.to_bits().to_le_bytes())
+                .collect()
+        } else if dtype.is::<u8>() {
+            ds.read_raw::<u8>().unwrap()
+        } else if dtype.is::<i32>() {
+            ds.read_raw::<i32>()
+                .unwrap()
+                .iter()
+                .flat_map(|x| x.to_le_bytes())
+                .collect()
+        } else {
+            panic!("unexpected type of {name}");
+        };
+        out.push((name, bytes));
+    }
+    out.sort();
+    out
+}
+
+fn assert_same_arrays(a: &Path, b: &Path) {
+    let (x, y) = (arrays(a), arrays(b));
+    let names = |v: &[(String, Vec<u8>)]| v.iter().map(|(n, _)| n.clone()).collect::<Vec<_>>();
+    assert_eq!(names(&x), names(&y));
+    for ((name, p), (_, q)) in x.iter().zip(&y) {
+        assert!(p == q, "{name} differs between {a:?} and {b:?}");
+    }
+}
+
+#[test]
+fn bad_scenes_are_refused_with_one_line_and_nothing_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = std::fs::read_to_string(small_scene(dir.path())).unwrap();
+    let cases: [(&str, &str, &str); 8] = [
+        ("nu = 0.5", "nu = 0.5\ncolour = 1", "body.colour"),
+        ("eta = 0.5", "eta = \"big\"", "body.eta"),
+        ("alpha = [0.2, 0.5]", "alpha = []", "axes.alpha"),
+        (
+            "start = 0.0, stop = 1.5",
+            "start = 1.5, stop = 0.0",
+            "axes.kappa",
+        ),
+        ("alpha = [0.2, 0.5]", "alpha = [0.2, 1.5]", "axes.alpha"),
+        ("tolerance = 1e-8", "tolerance = 2.0", "solver.tolerance"),
+        (
+            "method = \"quadrature\"",
+            "method = \"rk4\"",
+            "solver.method",
+        ),
+        ("num = 40", "num = 0", "axes.energy.num"),
+    ];
+    for (from, to, key) in cases {
+        let path = dir.path().join("bad.toml");
+        assert!(good.contains(from));
+        std::fs::write(&path, good.replacen(from, to, 1)).unwrap();
+        let out = dir.path().join("bad.h5");
+        let output = run(&[
+            "run",
+            path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{to}: {stderr}");
+        assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
+        assert!(
+            stderr.contains("bad.toml") && stderr.contains(key),
+            "{key}: {stderr}"
+        );
+        assert!(!stderr.contains("panicked"));
+        let left: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.starts_with("bad.h5"))
+            .collect();
+        assert!(left.is_empty(), "{to}: left {left:?}");
+    }
+}
+
+#[test]
+fn an_existing_output_is_kept_without_force_and_threads_do_not_change_a_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = small_scene(dir.path());
+    let (one, two) = (dir.path().join("one.h5"), dir.path().join("two.h5"));
+    let s = scene.to_str().unwrap();
+    ok(&run(&[
+        "run",
+        s,
+        "--out",
+        one.to_str().unwrap(),
+        "--threads",
+        "1",
+    ]));
+    let summary = ok(&run(&[
+        "run",
+        s,
+        "--out",
+        two.to_str().unwrap(),
+        "--threads",
+        "2",
+    ]));
+    assert!(summary.contains("cells: 3840"), "{summary}");
+    assert_same_arrays(&one, &two);
+
+    let before = std::fs::read(&one).unwrap();
+    let again = run(&["run", s, "--out", one.to_str().unwrap()]);
+    assert_eq!(again.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&again.stderr).contains("--force"));
+    assert_eq!(std::fs::read(&one).unwrap(), before);
+    ok(&run(&[
+        "run",
+        s,
+        "--out",
+        one.to_str().unwrap(),
+        "--force",
+        "--quiet",
+    ]));
+    assert_same_arrays(&one, &two);
+}
+
+#[test]
+fn atlas_values_equal_the_cell_command() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = small_scene(dir.path());
+    let out = dir.path().join("a.h5");
+    ok(&run(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]));
+    let file = hdf5::File::open(&out).unwrap();
+    let n = file
+        .dataset("rotation_number")
+        .unwrap()
+        .read_raw::<f64>()
+        .unwrap();
+    let count = file
+        .dataset("n_components")
+        .unwrap()
+        .read_raw::<u8>()
+        .unwrap();
+    let (alphas, betas) = ([0.2, 0.5], [0.8, 3.0]);
+    let kappa = |i: usize| if i == 23 { 1.5 } else { 1.5 / 23.0 * i as f64 };
+    let energy = |j: usize| {
+        if j == 39 {
+            4.0
+        } else {
+            0.5 + 3.5 / 39.0 * j as f64
+        }
+    };
+    let mut checked = 0;
+    for (ia, ib, ik, ie) in [
+        (0, 0, 5, 20),
+        (1, 1, 12, 30),
+        (1, 0, 23, 39),
+        (0, 1, 0, 25),
+        (1, 1, 7, 11),
+    ] {
+        let cell = ((ia * 2 + ib) * 24 + ik) * 40 + ie;
+        let output = run(&[
+            "cell",
+            "--alpha",
+            &alphas[ia].to_string(),
+            "--beta",
+            &betas[ib].to_string(),
+            "--nu",
+            "0.5",
+            "--eta",
+            "0.5",
+            "--kappa",
+            &format!("{:?}", kappa(ik)),
+            "--energy",
+            &format!("{:?}", energy(ie)),
+            "--tol",
+            "1e-8",
+            "--json",
+        ]);
+        let json: serde_json::Value = serde_json::from_str(&ok(&output)).unwrap();
+        let components = json["components"].as_array().unwrap();
+        assert_eq!(components.len(), count[cell] as usize);
+        for (slot, c) in components.iter().enumerate() {
+            let expected = c["rotation_number"].as_f64().unwrap();
+            assert_eq!(
+                n[cell * 3 + slot].to_bits(),
+                expected.to_bits(),
+                "cell {cell}"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked >= 4);
+}
+
+/// A scene slow enough to be killed part-way: the ODE method, 6 slices of one unit each.
+fn slow_scene(dir: &Path) -> PathBuf {
+    let path = dir.join("slow.toml");
+    std::fs::write(
+        &path,
+        scene_text(
+            "slow",
+            "ode",
+            "alpha = [0.3, 0.5]\nbeta = [0.8, 2.0, 3.0]\n\
+             kappa = { start = 0.05, stop = 1.5, num = 16 }\n\
+             energy = { start = 1.0, stop = 4.0, num = 64 }",
+        ),
+    )
+    .unwrap();
+    path
+}
+
+fn unit_files(journal: &Path) -> usize {
+    std::fs::read_dir(journal).map_or(0, |d| {
+        d.filter(|e| {
+            let name = e.as_ref().unwrap().file_name();
+            let name = name.to_string_lossy();
+            name.starts_with("unit-") && name.ends_with(".bin")
+        })
+        .count()
+    })
+}
+
+#[test]
+fn a_run_killed_at_any_point_resumes_to_the_same_arrays() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = slow_scene(dir.path());
+    let s = scene.to_str().unwrap();
+    let reference = dir.path().join("reference.h5");
+    let summary = ok(&run(&["run", s, "--out", reference.to_str().unwrap()]));
+    let total_units: usize = summary
+        .lines()
+        .find_map(|l| l.strip_prefix("units: "))
+        .and_then(|l| l.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .unwrap();
+    assert!(total_units >= 4, "{summary}");
+
+    // Kill after 0, 1, half and all units are in the journal (the last one while the file
+    // is being written, or just before).
+    let mut resumed_somewhere = false;
+    for kill_after in [0, 1, total_units / 2, total_units] {
+        let out = dir.path().join(format!("killed-{kill_after}.h5"));
+        let journal = dir.path().join(format!("killed-{kill_after}.h5.partial.d"));
+        let mut child = Command::new(BIN)
+            .args(["run", s, "--out", out.to_str().unwrap(), "--quiet"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        let start = Instant::now();
+        while unit_files(&journal) < kill_after
+            && start.elapsed() < Duration::from_secs(60)
+            && child.try_wait().unwrap().is_none()
+        {
+            std::thread::sleep(Duration::from_millis(2));
+        }
+        child.kill().unwrap(); // SIGKILL
+        let status = child.wait().unwrap();
+        if status.success() {
+            // It finished before the kill landed: nothing to resume at this point.
+            continue;
+        }
+        assert!(!out.exists(), "a killed run left {out:?} as if complete");
+        let done = unit_files(&journal);
+        eprintln!("killed after {done} of {total_units} units (asked {kill_after})");
+        let resume = ok(&run(&[
+            "run",
+            s,
+            "--out",
+            out.to_str().unwrap(),
+            "--resume",
+        ]));
+        let line = resume.lines().find(|l| l.starts_with("units: ")).unwrap();
+        assert!(
+            line.contains(&format!(
+                "({done} resumed from an interrupted run, {} computed now)",
+                total_units - done
+            )),
+            "after {done} units: {line}"
+        );
+        resumed_somewhere |= done > 0;
+        assert_same_arrays(&reference, &out);
+        assert!(!journal.exists());
+    }
+    assert!(resumed_somewhere, "no kill landed part-way");
+
+    // Without --resume or --force an interrupted run's journal is not silently thrown away.
+    let out = dir.path().join("left.h5");
+    let mut child = Command::new(BIN)
+        .args(["run", s, "--out", out.to_str().unwrap(), "--quiet"])
+        .spawn()
+        .unwrap();
+    let journal = dir.path().join("left.h5.partial.d");
+    while unit_files(&journal) < 1 {
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let again = run(&["run", s, "--out", out.to_str().unwrap()]);
+    assert_eq!(again.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&again.stderr).contains("--resume"));
+}
+
+#[test]
+fn three_shards_merged_equal_a_single_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = small_scene(dir.path());
+    let s = scene.to_str().unwrap();
+    let single = dir.path().join("single.h5");
+    ok(&run(&[
+        "run",
+        s,
+        "--out",
+        single.to_str().unwrap(),
+        "--quiet",
+    ]));
+    let shards: Vec<PathBuf> = (1..=3)
+        .map(|i| {
+            let path = dir.path().join(format!("shard-{i}.h5"));
+            ok(&run(&[
+                "run",
+                s,
+                "--out",
+                path.to_str().unwrap(),
+                "--shard",
+                &format!("{i}/3"),
+                "--quiet",
+            ]));
+            path
+        })
+        .collect();
+    let merged = dir.path().join("merged.h5");
+    let mut args = vec!["merge".to_string()];
+    // In another order than made: the shards know their index.
+    for i in [2, 0, 1] {
+        args.push(shards[i].to_str().unwrap().to_string());
+    }
+    args.extend(["--out".to_string(), merged.to_str().unwrap().to_string()]);
+    let output = Command::new(BIN).args(&args).output().unwrap();
+    ok(&output);
+    assert_same_arrays(&single, &merged);
+
+    // Missing parts, a duplicate, a shard of another scene: refused, nothing written.
+    let refused = dir.path().join("refused.h5");
+    let r = refused.to_str().unwrap();
+    let missing = run(&[
+        "merge",
+        shards[0].to_str().unwrap(),
+        shards[2].to_str().unwrap(),
+        "--out",
+        r,
+    ]);
+    assert_eq!(missing.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&missing.stderr).contains("missing: 2/3"));
+    let twice = run(&[
+        "merge",
+        shards[0].to_str().unwrap(),
+        shards[0].to_str().unwrap(),
+        shards[2].to_str().unwrap(),
+        "--out",
+        r,
+    ]);
+    assert_eq!(twice.status.code(), Some(2));
+    let other_scene = dir.path().join("other.toml");
+    std::fs::write(
+        &other_scene,
+        std::fs::read_to_string(&scene)
+            .unwrap()
+            .replace("num = 40", "num = 41"),
+    )
+    .unwrap();
+    let other = dir.path().join("other-2.h5");
+    ok(&run(&[
+        "run",
+        other_scene.to_str().unwrap(),
+        "--out",
+        other.to_str().unwrap(),
+        "--shard",
+        "2/3",
+        "--quiet",
+    ]));
+    let mixed = run(&[
+        "merge",
+        shards[0].to_str().unwrap(),
+        other.to_str().unwrap(),
+        shards[2].to_str().unwrap(),
+        "--out",
+        r,
+    ]);
+    assert_eq!(mixed.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&mixed.stderr).contains("same scene"));
+    assert!(!refused.exists());
+}
