@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# The main job on a shipped body (until atlas runs exist): the critical set of the paper's
-# type (c) ellipsoid, and the N = -1/7 trajectory of the paper's Fig. xy, with a picture.
+# The main job: the demo atlas (atlas/demo.toml: the paper's type (c) ellipsoid over its
+# (kappa, energy) plane, 401 x 401 cells, all outputs) with a progress bar, opened in xarray
+# and drawn; then the critical set and the paper's Fig. xy trajectory of the same body.
 # Installs what is missing first (scripts/setup.sh). Output: atlas/out/.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -10,8 +11,17 @@ echo "quickstart: building rubber-atlas (release)"
 cargo build --release --quiet
 bin=target/release/rubber-atlas
 mkdir -p atlas/out
-# The body of the paper's Figs. php, res and xy (atlas/paper-c.body).
-. atlas/paper-c.body
+echo "quickstart: rubber-atlas run atlas/demo.toml --out atlas/out/demo.h5 --force"
+"$bin" run atlas/demo.toml --out atlas/out/demo.h5 --force
+echo "quickstart: opening atlas/out/demo.h5 in xarray"
+(cd scripts && ../.venv/bin/python -c "
+from atlas_io import open_atlas
+ds = open_atlas('../atlas/out/demo.h5')
+print(ds)
+")
+(cd scripts && ../.venv/bin/python plot_atlas.py ../atlas/out/demo.h5 --out ../atlas/out/demo.png)
+# The same body (the paper's Figs. php, res and xy): diagram type (c).
+alpha=0.5 beta=3 nu=0.5 eta=0.5
 echo "quickstart: rubber-atlas diagram --alpha $alpha --beta $beta --nu $nu --eta $eta"
 "$bin" diagram --alpha "$alpha" --beta "$beta" --nu "$nu" --eta "$eta" --out atlas/out/paper-c-diagram.h5
 echo "quickstart: trajectory of Fig. xy (kappa = 0.8, theta0 = 0.4670288, 7 periods), reduced and full model"
@@ -21,4 +31,4 @@ for model in reduced full; do
     --out "atlas/out/paper-xy-$model.h5"
 done
 .venv/bin/python scripts/plot_trajectory.py atlas/out/paper-xy-reduced.h5 --out atlas/out/paper-xy.png
-echo "quickstart: done; see atlas/out/ (paper-c-diagram.h5, paper-xy-*.h5, paper-xy.png)"
+echo "quickstart: done; see atlas/out/ (demo.h5, demo.png, paper-c-diagram.h5, paper-xy-*.h5, paper-xy.png)"

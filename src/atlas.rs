@@ -327,6 +327,32 @@ impl Block {
         }
     }
 
+    /// The blocks one after the other (allocated once: growing by appends would leave the
+    /// heap fragmented with slice-sized holes).
+    pub fn concat(variables: &[Variable], blocks: Vec<Block>) -> Block {
+        let cells: usize = blocks.iter().map(|b| b.cells).sum();
+        let mut columns: Vec<Column> = variables
+            .iter()
+            .map(|v| {
+                let n = if v.kind == Kind::CellFlag {
+                    cells
+                } else {
+                    cells * COMPONENT_SLOTS
+                };
+                match v.kind {
+                    Kind::Value => Column::F64(Vec::with_capacity(n)),
+                    Kind::Flag | Kind::CellFlag => Column::U8(Vec::with_capacity(n)),
+                }
+            })
+            .collect();
+        for b in blocks {
+            for (a, c) in columns.iter_mut().zip(b.columns) {
+                a.append(c);
+            }
+        }
+        Block { cells, columns }
+    }
+
     /// Appends the cells of `other` (the rows that follow).
     pub fn append(&mut self, other: Block) {
         self.cells += other.cells;
@@ -335,26 +361,29 @@ impl Block {
         }
     }
 
-    /// Splits off the first `cells` cells (per-component columns: `cells` × slots values).
-    pub fn take_front(&mut self, variables: &[Variable], cells: usize) -> Block {
+    /// A copy of the cells `cells`.
+    pub fn range(&self, variables: &[Variable], cells: Range<usize>) -> Block {
         let columns = self
             .columns
-            .iter_mut()
+            .iter()
             .zip(variables)
             .map(|(c, v)| {
-                let n = if v.kind == Kind::CellFlag {
-                    cells
+                let width = if v.kind == Kind::CellFlag {
+                    1
                 } else {
-                    cells * COMPONENT_SLOTS
+                    COMPONENT_SLOTS
                 };
+                let r = cells.start * width..cells.end * width;
                 match c {
-                    Column::F64(x) => Column::F64(x.drain(..n).collect()),
-                    Column::U8(x) => Column::U8(x.drain(..n).collect()),
+                    Column::F64(x) => Column::F64(x[r].to_vec()),
+                    Column::U8(x) => Column::U8(x[r].to_vec()),
                 }
             })
             .collect();
-        self.cells -= cells;
-        Block { cells, columns }
+        Block {
+            cells: cells.len(),
+            columns,
+        }
     }
 
     /// The u8 values of the variable `name`, if it is among `variables`.
@@ -377,11 +406,17 @@ pub struct Unit {
     pub rows: Range<usize>,
 }
 
+/// κ-rows per work unit: about [`UNIT_CELLS`] cells. A unit is also one chunk of the file.
+pub fn rows_per_unit(shape: [usize; 4]) -> usize {
+    let [_, _, nk, ne] = shape;
+    UNIT_CELLS.div_ceil(ne.max(1)).clamp(1, nk.max(1))
+}
+
 /// The grid's work units, slice after slice (α slowest), each of about [`UNIT_CELLS`] cells
 /// (whole κ-rows). The split depends on the grid alone, never on threads or shards.
 pub fn units(shape: [usize; 4]) -> Vec<Unit> {
-    let [na, nb, nk, ne] = shape;
-    let rows_per_unit = UNIT_CELLS.div_ceil(ne).clamp(1, nk.max(1));
+    let [na, nb, nk, _] = shape;
+    let rows_per_unit = rows_per_unit(shape);
     let mut out = Vec::new();
     for ia in 0..na {
         for ib in 0..nb {
@@ -473,11 +508,7 @@ pub fn compute_rows(
             block
         })
         .collect();
-    let mut all = Block::empty(variables, 0);
-    for b in blocks {
-        all.append(b);
-    }
-    all
+    Block::concat(variables, blocks)
 }
 
 fn fill_cell(

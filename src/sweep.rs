@@ -8,8 +8,9 @@ use crate::atlas::{
 };
 use crate::error::{AtlasError, Result};
 use crate::scene::Scene;
-use crate::store::atlas_file::{AtlasFile, AttrValue};
+use crate::store::atlas_file::{encode_unit, AtlasFile, AttrValue, EncodedUnit};
 use crate::store::journal::Journal;
+use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -49,6 +50,22 @@ pub struct Summary {
 }
 
 impl Summary {
+    fn add(&mut self, other: &Summary) {
+        self.cells += other.cells;
+        self.components += other.components;
+        self.cells_computed += other.cells_computed;
+        for (a, b) in self.cells_by_status.iter_mut().zip(other.cells_by_status) {
+            *a += b;
+        }
+        for (a, b) in self
+            .components_by_status
+            .iter_mut()
+            .zip(other.components_by_status)
+        {
+            *a += b;
+        }
+    }
+
     fn count(&mut self, variables: &[Variable], block: &Block) {
         self.cells += block.cells as u64;
         if let Some(status) = block.flags(variables, "cell_status") {
@@ -201,62 +218,61 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
     };
     progress.begin(total, done_cells);
 
-    // Slice by slice: the units of one (α, β) still to do, their rows computed together.
-    let advance = |cells: usize| progress.advance(cells as u64);
-    let mut i = 0;
-    while i < mine.len() {
-        let slice = (mine[i].alpha_index, mine[i].beta_index);
-        let mut todo: Vec<&Unit> = Vec::new();
-        while i < mine.len() && (mine[i].alpha_index, mine[i].beta_index) == slice {
-            if !done[i] {
-                todo.push(&mine[i]);
-            }
-            i += 1;
-        }
-        if todo.is_empty() {
-            continue;
-        }
-        let rows: Vec<usize> = todo.iter().flat_map(|u| u.rows.clone()).collect();
-        let mut block = compute_rows(scene, &variables, slice.0, slice.1, &rows, &advance);
-        summary.cells_computed += block.cells as u64;
-        for u in todo {
-            let part = block.take_front(&variables, cells_of(u));
-            journal.write(u.index, &part)?;
-        }
-    }
-
-    progress.writing();
+    // Unit by unit, the units of one (α, β) slice in parallel (and within each unit its κ-rows,
+    // one at a time, so that no thread idles at a slice's end): compute, keep in the journal,
+    // encode as the file stores it; then the slice's chunks are written in order. The file is
+    // written afresh by every invocation: the journal, not the file, survives a kill.
     let tmp = temporary_path(out);
     if tmp.exists() {
         std::fs::remove_file(&tmp).map_err(|e| atlas_error(&tmp, e.to_string()))?;
     }
     let mut attributes = scene_attributes(scene, request.shard, all_units.len());
     attributes.extend(request.attributes.iter().cloned());
+    let advance = |cells: usize| progress.advance(cells as u64);
+    let shape = scene.shape();
     let written = (|| -> Result<()> {
         let file = AtlasFile::create(&tmp, scene, &variables, &borrowed(&attributes))?;
-        write_by_slice(
-            &file,
-            &variables,
-            mine,
-            |u| {
-                Ok(match journal.read(u.index, &variables, cells_of(u)) {
-                    Some(b) => b,
-                    // Damaged since it was written (a disk error): compute it again.
-                    None => {
-                        let rows: Vec<usize> = u.rows.clone().collect();
-                        compute_rows(
-                            scene,
-                            &variables,
-                            u.alpha_index,
-                            u.beta_index,
-                            &rows,
-                            &|_| {},
-                        )
-                    }
+        let mut first = 0;
+        for run in slice_runs(mine) {
+            let run_done = &done[first..first + run.len()];
+            first += run.len();
+            let encoded = run
+                .par_iter()
+                .zip(run_done)
+                .map(|(u, &was_done)| -> Result<(EncodedUnit, Summary)> {
+                    let mut part = Summary::default();
+                    let journaled = if was_done {
+                        journal.read(u.index, &variables, cells_of(u))
+                    } else {
+                        None
+                    };
+                    let block = match journaled {
+                        Some(b) => b,
+                        None => {
+                            let rows: Vec<usize> = u.rows.clone().collect();
+                            let b = compute_rows(
+                                scene,
+                                &variables,
+                                u.alpha_index,
+                                u.beta_index,
+                                &rows,
+                                &advance,
+                            );
+                            journal.write(u.index, &b, &variables, 0..b.cells)?;
+                            part.cells_computed = b.cells as u64;
+                            b
+                        }
+                    };
+                    part.count(&variables, &block);
+                    Ok((encode_unit(&variables, &block, shape), part))
                 })
-            },
-            &mut summary,
-        )?;
+                .collect::<Result<Vec<_>>>()?;
+            for (u, (chunks, part)) in run.iter().zip(encoded) {
+                file.write_encoded(u, &chunks)?;
+                summary.add(&part);
+            }
+        }
+        progress.writing();
         file.close()
     })();
     if let Err(e) = written {
@@ -385,12 +401,10 @@ pub fn merge(
                 count: n,
             }
             .units(all_units.len());
-            // Read a shard slice by slice too: one chunk read per slice.
-            for part in slice_runs(&all_units[range]) {
-                let merged = joined(part);
-                let block = source.read_unit(&merged)?;
+            for u in &all_units[range] {
+                let block = source.read_unit(u)?;
                 summary.count(&variables, &block);
-                file.write_unit(&merged, &block)?;
+                file.write_encoded(u, &encode_unit(&variables, &block, scene.shape()))?;
             }
         }
         file.close()
@@ -407,36 +421,6 @@ pub fn merge(
 /// Consecutive runs of units of one (α, β) slice.
 fn slice_runs(units: &[Unit]) -> impl Iterator<Item = &[Unit]> {
     units.chunk_by(|a, b| (a.alpha_index, a.beta_index) == (b.alpha_index, b.beta_index))
-}
-
-/// The consecutive units `run` of one slice as one unit (their rows joined).
-fn joined(run: &[Unit]) -> Unit {
-    Unit {
-        index: run[0].index,
-        alpha_index: run[0].alpha_index,
-        beta_index: run[0].beta_index,
-        rows: run[0].rows.start..run[run.len() - 1].rows.end,
-    }
-}
-
-/// Writes `units` to `file` one slice at a time (one write per chunk: a write per unit would
-/// read, inflate and deflate the slice's chunk again for every unit), counting into `summary`.
-fn write_by_slice(
-    file: &AtlasFile,
-    variables: &[Variable],
-    units: &[Unit],
-    mut block_of: impl FnMut(&Unit) -> Result<Block>,
-    summary: &mut Summary,
-) -> Result<()> {
-    for run in slice_runs(units) {
-        let mut slice = Block::empty(variables, 0);
-        for u in run {
-            slice.append(block_of(u)?);
-        }
-        summary.count(variables, &slice);
-        file.write_unit(&joined(run), &slice)?;
-    }
-    Ok(())
 }
 
 fn read_root_text(path: &Path, name: &str) -> Result<String> {

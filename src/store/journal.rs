@@ -5,7 +5,6 @@
 
 use crate::atlas::{Block, Column, Kind, Variable, COMPONENT_SLOTS};
 use crate::error::{AtlasError, Result};
-use crate::scene::fnv1a;
 use std::collections::BTreeSet;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -98,20 +97,54 @@ impl Journal {
         Ok(out)
     }
 
-    /// Stores a finished unit.
-    pub fn write(&self, index: usize, block: &Block) -> Result<()> {
-        let mut bytes = Vec::new();
-        bytes.extend_from_slice(MAGIC);
-        bytes.extend_from_slice(&self.fingerprint.to_le_bytes());
-        bytes.extend_from_slice(&(index as u64).to_le_bytes());
-        bytes.extend_from_slice(&(block.cells as u64).to_le_bytes());
-        bytes.extend_from_slice(&(block.columns.len() as u64).to_le_bytes());
-        for c in &block.columns {
-            bytes.extend_from_slice(&c.to_le_bytes());
-        }
-        let sum = fnv1a(0xcbf2_9ce4_8422_2325, &bytes);
-        bytes.extend_from_slice(&sum.to_le_bytes());
-        write_atomically(&self.unit_path(index), &bytes)
+    /// Stores the finished unit `index`: the cells `cells` of `block`.
+    pub fn write(
+        &self,
+        index: usize,
+        block: &Block,
+        variables: &[Variable],
+        cells: std::ops::Range<usize>,
+    ) -> Result<()> {
+        let path = self.unit_path(index);
+        let tmp = path.with_extension("bin.tmp");
+        let write = || -> std::io::Result<()> {
+            let file = std::fs::File::create(&tmp)?;
+            let mut w = Checked {
+                inner: std::io::BufWriter::with_capacity(1 << 16, file),
+                crc: crc32fast::Hasher::new(),
+            };
+            w.put(MAGIC)?;
+            for word in [
+                self.fingerprint,
+                index as u64,
+                cells.len() as u64,
+                variables.len() as u64,
+            ] {
+                w.put(&word.to_le_bytes())?;
+            }
+            let mut buffer = Vec::new();
+            for (v, c) in variables.iter().zip(&block.columns) {
+                let width = if v.kind == Kind::CellFlag {
+                    1
+                } else {
+                    COMPONENT_SLOTS
+                };
+                let range = cells.start * width..cells.end * width;
+                match c {
+                    Column::U8(x) => w.put(&x[range])?,
+                    Column::F64(x) => {
+                        buffer.clear();
+                        buffer.extend(x[range].iter().flat_map(|v| v.to_le_bytes()));
+                        w.put(&buffer)?;
+                    }
+                }
+            }
+            let sum = u64::from(w.crc.clone().finalize());
+            w.inner.write_all(&sum.to_le_bytes())?;
+            w.inner.flush()
+        };
+        write().map_err(|e| io_error(&tmp, e))?;
+        std::fs::rename(&tmp, &path).map_err(|e| io_error(&path, e))
     }
 
     /// A unit read back, if its file is there, whole and of this scene; None otherwise (a
@@ -134,7 +167,7 @@ impl Journal {
         cells: usize,
     ) -> Option<Block> {
         let (body, sum) = bytes.split_at_checked(bytes.len().checked_sub(8)?)?;
-        if fnv1a(0xcbf2_9ce4_8422_2325, body) != u64::from_le_bytes(sum.try_into().ok()?) {
+        if u64::from(crc32fast::hash(body)) != u64::from_le_bytes(sum.try_into().ok()?) {
             return None;
         }
         let word = |at: usize| -> Option<u64> {
@@ -193,4 +226,17 @@ fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
     file.write_all(bytes).map_err(|e| io_error(&tmp, e))?;
     drop(file);
     std::fs::rename(&tmp, path).map_err(|e| io_error(path, e))
+}
+
+/// A writer that keeps a CRC-32 of what passes through.
+struct Checked<W: Write> {
+    inner: W,
+    crc: crc32fast::Hasher,
+}
+
+impl<W: Write> Checked<W> {
+    fn put(&mut self, bytes: &[u8]) -> std::io::Result<()> {
+        self.crc.update(bytes);
+        self.inner.write_all(bytes)
+    }
 }

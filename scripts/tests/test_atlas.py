@@ -1,0 +1,121 @@
+"""The demo atlas (atlas/demo.toml) as a user opens it: h5py and xarray see named dimensions
+with their coordinates, CF attributes and provenance; a random sample of cells equals
+`rubber-atlas cell` for the same parameters, bit for bit; the plot script draws it."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "scripts"))
+
+from atlas_io import DIMENSIONS, components, flag_names, open_atlas  # noqa: E402
+from plot_atlas import plot  # noqa: E402
+
+BIN = os.environ.get("RUBBER_ATLAS_BIN", str(ROOT / "target" / "release" / "rubber-atlas"))
+SCENE = ROOT / "atlas" / "demo.toml"
+
+
+@pytest.fixture(scope="module")
+def demo(tmp_path_factory):
+    out = tmp_path_factory.mktemp("atlas") / "demo.h5"
+    subprocess.run([BIN, "run", str(SCENE), "--out", str(out), "--quiet"], check=True)
+    return out
+
+
+def axis(spec):
+    if isinstance(spec, list):
+        return np.array(spec, float)
+    values = np.linspace(spec["start"], spec["stop"], spec["num"])
+    return values
+
+
+def test_h5py_sees_dimension_scales_and_cf_attributes(demo):
+    scene = tomllib.loads(SCENE.read_text())
+    with h5py.File(demo) as f:
+        for name in DIMENSIONS:
+            assert f[name].attrs["CLASS"] == b"DIMENSION_SCALE"
+        for name in ("alpha", "beta", "kappa", "energy"):
+            # The axis values are the scene's (within a rounding of the evenly spaced points).
+            np.testing.assert_allclose(f[name][:], axis(scene["axes"][name]), rtol=0, atol=1e-15)
+        for name, var in f.items():
+            if name in DIMENSIONS:
+                continue
+            assert "long_name" in var.attrs and "units" in var.attrs, name
+            dims = [var.dims[i][0].name.lstrip("/") for i in range(var.ndim)]
+            assert dims == list(DIMENSIONS[: var.ndim]), name
+            # Chunks tile one (alpha, beta) slice along kappa (whole rows of energy), compressed.
+            assert var.chunks[:2] == (1, 1) and var.chunks[3] == f["energy"].size, name
+            assert var.compression == "gzip", name
+        for name in ("status", "motion", "bounded", "cell_status"):
+            assert "flag_values" in f[name].attrs and "flag_meanings" in f[name].attrs
+        for key in ("program_version", "git_commit", "scene", "command_line", "created", "tolerance",
+                    "method", "nu", "eta"):
+            assert key in f.attrs, key
+        assert f.attrs["scene"] == SCENE.read_text()
+
+
+def test_xarray_opens_it_with_named_dimensions(demo):
+    ds = open_atlas(demo)
+    assert tuple(ds.rotation_number.dims) == DIMENSIONS
+    assert tuple(ds.n_components.dims) == DIMENSIONS[:4]
+    assert not any(d.startswith("phony_dim") for d in ds.dims)
+    assert list(ds.component.values) == [0, 1, 2]
+    assert flag_names(ds.status)[0] == "ok"
+    # The motion is where the scene says: N is finite exactly on the existing components.
+    count = ds.n_components.values
+    finite = np.isfinite(ds.rotation_number.values).sum(axis=-1)
+    np.testing.assert_array_equal(finite, np.minimum(count, 3))
+    # The paper's Fig. xy cell: κ = 0.8 near the libration of N = −1/7 has one component.
+    n = ds.rotation_number.sel(alpha=0.5, beta=3.0, kappa=0.8, component=0)
+    assert np.nanmin(n.values) < -1 / 7 < np.nanmax(n.values)
+    ds.close()
+
+
+def test_a_sample_of_cells_equals_the_cell_command(demo):
+    ds = open_atlas(demo)
+    rng = np.random.default_rng(20261121)
+    with_motion = np.argwhere(ds.n_components.values[0, 0] > 0)
+    picked = with_motion[rng.choice(len(with_motion), size=12, replace=False)]
+    fields = ["theta_min", "theta_max", "period", "omega_theta", "omega_psi", "rotation_number",
+              "drift", "drift_radius", "error_estimate", "status", "motion", "bounded"]
+    for ik, ie in picked:
+        kappa, energy = float(ds.kappa[ik]), float(ds.energy[ie])
+        out = subprocess.run(
+            [BIN, "cell", "--alpha", "0.5", "--beta", "3", "--nu", "0.5", "--eta", "0.5",
+             "--kappa", repr(kappa), "--energy", repr(energy), "--tol", "1e-10", "--json"],
+            check=True, capture_output=True, text=True,
+        ).stdout
+        expected = json.loads(out)["components"]
+        got = components(ds, 0.5, 3.0, kappa, energy)
+        assert len(got) == len(expected), (kappa, energy)
+        for g, e in zip(got, expected):
+            for name in fields:
+                if e[name] is None and name != "bounded":  # JSON null: NaN or ±inf
+                    assert not np.isfinite(g[name]), (name, kappa, energy)
+                elif isinstance(e[name], float):
+                    assert np.float64(g[name]).tobytes() == np.float64(e[name]).tobytes(), (name, kappa, energy)
+                else:
+                    assert g[name] == e[name], (name, kappa, energy)
+    ds.close()
+
+
+def test_the_plot_script_draws_the_atlas(demo, tmp_path):
+    png = tmp_path / "demo.png"
+    plot(demo, png)
+    assert png.stat().st_size > 20_000
+
+
+def test_a_partial_file_is_not_opened_as_an_atlas(tmp_path):
+    partial = tmp_path / "x.h5.partial.h5"
+    partial.write_bytes(b"")
+    with pytest.raises(ValueError, match="unfinished"):
+        open_atlas(partial)
