@@ -483,12 +483,13 @@ impl Scene {
         .expect("the scene's bodies were checked when it was parsed")
     }
 
-    /// A 64-bit fingerprint of the scene's text and of the program version: resume and merge
-    /// only continue work of the same scene computed by the same program.
+    /// A 64-bit fingerprint of the scene's text and of the program (version and git commit):
+    /// resume and merge only continue work of the same scene computed by the same program, so
+    /// that a file never mixes values from two versions of the solver.
     pub fn fingerprint(&self) -> u64 {
         let mut hash = fnv1a(0xcbf2_9ce4_8422_2325, self.text.as_bytes());
         hash = fnv1a(hash, env!("CARGO_PKG_VERSION").as_bytes());
-        hash
+        fnv1a(hash, env!("RUBBER_ATLAS_GIT_COMMIT").as_bytes())
     }
 }
 
