@@ -7,6 +7,7 @@ use rubber_atlas::atlas::Shard;
 use rubber_atlas::cell::{solve_cell, solve_component, CellOptions, CellResult, Method, Status};
 use rubber_atlas::critical::CriticalSet;
 use rubber_atlas::error::AtlasError;
+use rubber_atlas::resonance::{self, ResonanceOptions};
 use rubber_atlas::scene::Scene;
 use rubber_atlas::store::atlas_file::AttrValue;
 use rubber_atlas::store::{write_table, Column};
@@ -39,6 +40,53 @@ pub enum Command {
     Run(RunArgs),
     /// Joins the shard files of one scene (made with `run --shard I/N`) into one atlas.
     Merge(MergeArgs),
+    /// The curves of the (κ, ε) plane on which a component's rotation number is P/Q, traced
+    /// by continuation with the cell solver; with --fold, the fold κ_max of the curve of
+    /// largest κ (N = P/Q, ∂N/∂ε = 0).
+    Resonance(ResonanceArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct ResonanceArgs {
+    #[command(flatten)]
+    pub shape: ShapeArgs,
+    /// ν = i3/i1, 0 < ν <= 2.
+    #[arg(long, allow_negative_numbers = true)]
+    pub nu: f64,
+    /// η = m b3²/i1 > 0.
+    #[arg(long, allow_negative_numbers = true)]
+    pub eta: f64,
+    /// The rotation number of the curves: P/Q (e.g. 0, 1, -1/7) or a decimal.
+    #[arg(long, value_name = "P/Q", allow_hyphen_values = true)]
+    pub rotation_number: String,
+    /// The window: smallest κ (> 0; N = 0 at κ = 0).
+    #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
+    pub kappa_min: f64,
+    /// The window: largest κ.
+    #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
+    pub kappa_max: f64,
+    /// The window: smallest ε [default: the lowest minimum of V over the window].
+    #[arg(long, allow_negative_numbers = true)]
+    pub energy_min: Option<f64>,
+    /// The window: largest ε.
+    #[arg(long, default_value_t = 5.0, allow_negative_numbers = true)]
+    pub energy_max: f64,
+    /// Rows of κ (and energies per row) of the seed scan; curves are also followed between
+    /// rows, but a closed curve that crosses no row is missed.
+    #[arg(long, default_value_t = 48)]
+    pub grid: usize,
+    /// Tolerance of the cell solver (N on the curve equals P/Q to this).
+    #[arg(long, default_value_t = 1e-10, allow_negative_numbers = true)]
+    pub tol: f64,
+    /// Print the fold of the curve of largest κ as JSON {"kappa_max": …, "energy": …}.
+    #[arg(long)]
+    pub fold: bool,
+    /// Print the curves as JSON.
+    #[arg(long, conflicts_with = "out")]
+    pub json: bool,
+    /// Write the curves to FILE (.csv, .h5 or .hdf5), one row per point.
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
 }
 
 #[derive(Debug, Args)]
@@ -253,7 +301,156 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Cell(args) => cell(args),
         Command::Run(args) => run_scene(args),
         Command::Merge(args) => merge(args),
+        Command::Resonance(args) => resonance(args),
     }
+}
+
+/// P/Q or a decimal.
+fn parse_rotation_number(text: &str) -> Result<f64> {
+    let bad = || AtlasError::Atlas {
+        path: format!("--rotation-number {text}"),
+        reason: "expected P/Q with whole numbers P and Q != 0, or a number".into(),
+    };
+    let value = match text.split_once('/') {
+        Some((p, q)) => {
+            let p: i64 = p.trim().parse().map_err(|_| bad())?;
+            let q: i64 = q.trim().parse().map_err(|_| bad())?;
+            if q == 0 {
+                return Err(bad().into());
+            }
+            p as f64 / q as f64
+        }
+        None => text.trim().parse::<f64>().map_err(|_| bad())?,
+    };
+    if !value.is_finite() {
+        return Err(bad().into());
+    }
+    Ok(value)
+}
+
+fn resonance(args: ResonanceArgs) -> Result<()> {
+    let body = EllipsoidBody::ellipsoid(args.shape.alpha, args.shape.beta, args.nu, args.eta)?;
+    let target = parse_rotation_number(&args.rotation_number)?;
+    let energy_min = match args.energy_min {
+        Some(e) => e,
+        None => {
+            // The lowest minimum of V over the window's κ (V grows with |κ| at every θ).
+            let potential = EffectivePotential::new(&body, args.kappa_min.max(0.0));
+            potential
+                .critical_points()
+                .iter()
+                .map(|p| p.value)
+                .fold(f64::INFINITY, f64::min)
+        }
+    };
+    let options = ResonanceOptions {
+        target,
+        kappa: (args.kappa_min, args.kappa_max),
+        energy: (energy_min, args.energy_max),
+        grid: args.grid,
+        cell: CellOptions {
+            tol: args.tol,
+            drift: false,
+            ..CellOptions::default()
+        },
+        max_points: 20_000,
+    };
+    let header = serde_json::json!({
+        "alpha": args.shape.alpha,
+        "beta": args.shape.beta,
+        "nu": args.nu,
+        "eta": args.eta,
+        "rotation_number": target,
+        "kappa_window": [options.kappa.0, options.kappa.1],
+        "energy_window": [options.energy.0, options.energy.1],
+        "tol": args.tol,
+    });
+    if args.fold {
+        let fold = resonance::fold(&body, &options)?;
+        let mut value = header;
+        match fold {
+            Some(f) => {
+                value["kappa_max"] = serde_json::json!(f.kappa_max);
+                value["energy"] = serde_json::json!(f.energy);
+                value["fold"] = serde_json::to_value(f)?;
+            }
+            None => {
+                value["kappa_max"] = serde_json::Value::Null;
+                value["energy"] = serde_json::Value::Null;
+                value["reason"] = serde_json::json!(
+                    "no N = P/Q curve in the window, or the curve of largest kappa leaves it \
+                     through kappa_max (widen --kappa-max)"
+                );
+            }
+        }
+        println!("{}", serde_json::to_string_pretty(&value)?);
+        return Ok(());
+    }
+    let curves = resonance::trace_curves(&body, &options)?;
+    if args.json {
+        let mut value = header;
+        value["curves"] = serde_json::to_value(&curves)?;
+        println!("{}", serde_json::to_string_pretty(&value)?);
+        return Ok(());
+    }
+    if let Some(out) = &args.out {
+        let rows: Vec<(usize, usize, &resonance::CurvePoint)> = curves
+            .iter()
+            .enumerate()
+            .flat_map(|(i, c)| c.points.iter().enumerate().map(move |(j, p)| (i, j, p)))
+            .collect();
+        let col = |f: &dyn Fn(&(usize, usize, &resonance::CurvePoint)) -> f64| -> Vec<f64> {
+            rows.iter().map(f).collect()
+        };
+        let data = [
+            ("curve", col(&|r| r.0 as f64), "1", "index of the curve"),
+            ("point", col(&|r| r.1 as f64), "1", "index of the point along the curve"),
+            ("kappa", col(&|r| r.2.kappa), "paper units", "kappa"),
+            ("energy", col(&|r| r.2.energy), "paper units", "energy"),
+            ("rotation_number", col(&|r| r.2.rotation_number), "1", "rotation number N"),
+            ("error_estimate", col(&|r| r.2.error_estimate), "1", "estimated error of N"),
+            ("component", col(&|r| r.2.component as f64), "1", "component index (increasing theta_min)"),
+            ("theta_min", col(&|r| r.2.theta_min), "rad", "lower turning point"),
+            ("theta_max", col(&|r| r.2.theta_max), "rad", "upper turning point"),
+            ("well", col(&|r| r.2.well), "rad", "theta of the minimum of V inside the component"),
+            ("closed", col(&|r| f64::from(u8::from(curves[r.0].closed))), "1", "1 if the curve is closed"),
+        ];
+        let columns: Vec<Column<'_>> = data
+            .iter()
+            .map(|(name, values, units, long_name)| Column {
+                name,
+                values,
+                units,
+                long_name,
+            })
+            .collect();
+        write_table(
+            out,
+            &columns,
+            &[
+                ("header_json", header.to_string()),
+                ("command_line", command_line()),
+            ],
+        )?;
+        println!("wrote {} curves ({} points) to {}", curves.len(), rows.len(), out.display());
+        return Ok(());
+    }
+    println!(
+        "N = {target} for alpha={} beta={} nu={} eta={}: {} curve(s) in kappa [{}, {}], energy [{:.6}, {}]",
+        args.shape.alpha, args.shape.beta, args.nu, args.eta, curves.len(),
+        options.kappa.0, options.kappa.1, options.energy.0, options.energy.1
+    );
+    for (i, c) in curves.iter().enumerate() {
+        let (kmin, kmax) = c.points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p.kappa), b.max(p.kappa)));
+        let (emin, emax) = c.points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p.energy), b.max(p.energy)));
+        println!(
+            "[{i}] {} points{}, well theta = {:.6}, kappa in [{kmin:.6}, {kmax:.6}], energy in [{emin:.6}, {emax:.6}]",
+            c.points.len(),
+            if c.closed { " (closed)" } else { "" },
+            c.points[0].well
+        );
+    }
+    Ok(())
 }
 
 /// The attributes a command adds to the files it writes: its command line and the time.

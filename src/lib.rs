@@ -16,6 +16,7 @@
 //!   equilibria, ε_min.
 //! - [`torus`]: one level set (κ, ε): its components, turning points, period and precession.
 //! - [`trajectory`]: time histories from either model; [`ode`] wraps the DOP853 integrator.
+//! - [`resonance`]: curves N = p/q by continuation, and the fold κ_max.
 //! - [`scene`]: the TOML scene files of atlas runs.
 //! - [`atlas`]: the grid driver — work units, rayon over κ-rows, dense per-cell arrays.
 //! - [`store`]: CSV and HDF5 output, the atlas file and the resume journal.
@@ -36,6 +37,7 @@ pub mod ode;
 pub mod period_ode;
 pub mod quadrature;
 pub mod reduced;
+pub mod resonance;
 pub mod scene;
 pub mod store;
 pub mod sweep;
