@@ -354,6 +354,7 @@ fn resonance(args: ResonanceArgs) -> Result<()> {
             ..CellOptions::default()
         },
         max_points: 20_000,
+        max_point_error: 1e-6,
     };
     let header = serde_json::json!({
         "alpha": args.shape.alpha,
@@ -404,16 +405,56 @@ fn resonance(args: ResonanceArgs) -> Result<()> {
         };
         let data = [
             ("curve", col(&|r| r.0 as f64), "1", "index of the curve"),
-            ("point", col(&|r| r.1 as f64), "1", "index of the point along the curve"),
+            (
+                "point",
+                col(&|r| r.1 as f64),
+                "1",
+                "index of the point along the curve",
+            ),
             ("kappa", col(&|r| r.2.kappa), "paper units", "kappa"),
             ("energy", col(&|r| r.2.energy), "paper units", "energy"),
-            ("rotation_number", col(&|r| r.2.rotation_number), "1", "rotation number N"),
-            ("error_estimate", col(&|r| r.2.error_estimate), "1", "estimated error of N"),
-            ("component", col(&|r| r.2.component as f64), "1", "component index (increasing theta_min)"),
-            ("theta_min", col(&|r| r.2.theta_min), "rad", "lower turning point"),
-            ("theta_max", col(&|r| r.2.theta_max), "rad", "upper turning point"),
-            ("well", col(&|r| r.2.well), "rad", "theta of the minimum of V inside the component"),
-            ("closed", col(&|r| f64::from(u8::from(curves[r.0].closed))), "1", "1 if the curve is closed"),
+            (
+                "rotation_number",
+                col(&|r| r.2.rotation_number),
+                "1",
+                "rotation number N",
+            ),
+            (
+                "error_estimate",
+                col(&|r| r.2.error_estimate),
+                "1",
+                "estimated error of N",
+            ),
+            (
+                "component",
+                col(&|r| r.2.component as f64),
+                "1",
+                "component index (increasing theta_min)",
+            ),
+            (
+                "theta_min",
+                col(&|r| r.2.theta_min),
+                "rad",
+                "lower turning point",
+            ),
+            (
+                "theta_max",
+                col(&|r| r.2.theta_max),
+                "rad",
+                "upper turning point",
+            ),
+            (
+                "well",
+                col(&|r| r.2.well),
+                "rad",
+                "theta of the minimum of V inside the component",
+            ),
+            (
+                "closed",
+                col(&|r| f64::from(u8::from(curves[r.0].closed))),
+                "1",
+                "1 if the curve is closed",
+            ),
         ];
         let columns: Vec<Column<'_>> = data
             .iter()
@@ -432,7 +473,12 @@ fn resonance(args: ResonanceArgs) -> Result<()> {
                 ("command_line", command_line()),
             ],
         )?;
-        println!("wrote {} curves ({} points) to {}", curves.len(), rows.len(), out.display());
+        println!(
+            "wrote {} curves ({} points) to {}",
+            curves.len(),
+            rows.len(),
+            out.display()
+        );
         return Ok(());
     }
     println!(
@@ -441,8 +487,18 @@ fn resonance(args: ResonanceArgs) -> Result<()> {
         options.kappa.0, options.kappa.1, options.energy.0, options.energy.1
     );
     for (i, c) in curves.iter().enumerate() {
-        let (kmin, kmax) = c.points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p.kappa), b.max(p.kappa)));
-        let (emin, emax) = c.points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p.energy), b.max(p.energy)));
+        let (kmin, kmax) = c
+            .points
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+                (a.min(p.kappa), b.max(p.kappa))
+            });
+        let (emin, emax) = c
+            .points
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+                (a.min(p.energy), b.max(p.energy))
+            });
         println!(
             "[{i}] {} points{}, well theta = {:.6}, kappa in [{kmin:.6}, {kmax:.6}], energy in [{emin:.6}, {emax:.6}]",
             c.points.len(),

@@ -26,6 +26,10 @@ pub struct ResonanceOptions {
     pub cell: CellOptions,
     /// At most this many points per curve.
     pub max_points: usize,
+    /// The largest error estimate of N accepted on a curve point (at least the tolerance).
+    /// Curves that hug a separatrix (N → ±∞ there) are followed until N's conditioning,
+    /// which grows like 1/|ε − ε_s|, makes its error estimate exceed this.
+    pub max_point_error: f64,
 }
 
 /// One point of a resonance curve.
@@ -150,6 +154,134 @@ fn bracketed_root(
     Some(0.5 * (a + b))
 }
 
+/// The levels of the maxima of V at one κ, sorted: the separatrices. Between two of them
+/// N of one component is continuous in ε; it diverges only at a separatrix.
+fn separatrices<S: Shape>(potential: &EffectivePotential<'_, S>) -> Vec<f64> {
+    let mut v: Vec<f64> = potential
+        .critical_points()
+        .iter()
+        .filter(|p| p.kind == CriticalKind::Maximum)
+        .map(|p| p.value)
+        .collect();
+    v.sort_by(f64::total_cmp);
+    v
+}
+
+/// Where a point lies among the separatrices: the level nearest to it and on which side
+/// (+1 above, −1 below), or None if there is no separatrix. Followed from κ to κ by the
+/// nearest level (levels move continuously; at a cusp one ends, and then any side goes).
+#[derive(Debug, Clone, Copy)]
+struct Side {
+    level: f64,
+    above: bool,
+}
+
+fn side_of(levels: &[f64], energy: f64) -> Option<Side> {
+    levels
+        .iter()
+        .min_by(|a, b| (*a - energy).abs().total_cmp(&(*b - energy).abs()))
+        .map(|&level| Side {
+            level,
+            above: energy > level,
+        })
+}
+
+/// The gap between separatrices at a new κ (`levels`) on the same side of the continuation
+/// of `side`'s level: the interval in which the followed component keeps its shape.
+fn gap_for(levels: &[f64], side: Option<Side>) -> (f64, f64) {
+    let Some(side) = side else {
+        return (f64::NEG_INFINITY, f64::INFINITY);
+    };
+    let Some(i) = (0..levels.len()).min_by(|&a, &b| {
+        (levels[a] - side.level)
+            .abs()
+            .total_cmp(&(levels[b] - side.level).abs())
+    }) else {
+        return (f64::NEG_INFINITY, f64::INFINITY);
+    };
+    if side.above {
+        (
+            levels[i],
+            levels.get(i + 1).copied().unwrap_or(f64::INFINITY),
+        )
+    } else {
+        (
+            i.checked_sub(1).map_or(f64::NEG_INFINITY, |j| levels[j]),
+            levels[i],
+        )
+    }
+}
+
+/// Probe points in (lo, hi) around `around`, nearest first: steps `step`·2^j on either side,
+/// then points that halve the distance to each finite end (down to 2⁻⁵² of it), so that a root
+/// next to an end (a curve hugging a separatrix) is bracketed too.
+fn probes(lo: f64, hi: f64, around: f64, step: f64) -> Vec<f64> {
+    let mut out = Vec::new();
+    let mut d = step;
+    while around + d < hi || around - d > lo {
+        for x in [around + d, around - d] {
+            if x > lo && x < hi {
+                out.push(x);
+            }
+        }
+        d *= 2.0;
+        if !d.is_finite() || d > 1e6 {
+            break;
+        }
+    }
+    for (end, from) in [(hi, around), (lo, around)] {
+        if end.is_finite() {
+            for j in 1..=52 {
+                let x = end - (end - from) * 0.5f64.powi(j);
+                if x > lo && x < hi && x != end {
+                    out.push(x);
+                }
+            }
+        }
+    }
+    out.sort_by(|a, b| (a - around).abs().total_cmp(&(b - around).abs()));
+    out.dedup();
+    out
+}
+
+/// The root of `f` nearest `around` found on the probes (`f` is None where it is undefined),
+/// refined by regula falsi to `tol`.
+fn nearest_root(
+    f: impl Fn(f64) -> Option<f64>,
+    lo: f64,
+    hi: f64,
+    around: f64,
+    step: f64,
+    tol: f64,
+) -> Option<f64> {
+    let f0 = f(around)?;
+    if f0.abs() <= tol {
+        return Some(around);
+    }
+    // The last value seen on each side (above, below `around`).
+    let mut last = [(around, f0), (around, f0)];
+    let mut alive = [true, true];
+    for x in probes(lo, hi, around, step) {
+        let side = usize::from(x < around);
+        if !alive[side] {
+            continue;
+        }
+        let Some(fx) = f(x) else {
+            alive[side] = false;
+            if !alive[0] && !alive[1] {
+                return None;
+            }
+            continue;
+        };
+        let (xp, fp) = last[side];
+        if (fx > 0.0) != (fp > 0.0) {
+            return bracketed_root(&f, (xp, fp), (x, fx), 1e-15 * x.abs().max(1e-300), tol);
+        }
+        last[side] = (x, fx);
+    }
+    None
+}
+
 struct Tracer<'a, S: Shape> {
     body: &'a Body<S>,
     options: &'a ResonanceOptions,
@@ -163,18 +295,28 @@ impl<S: Shape> Tracer<'_, S> {
         evaluate(&potential, energy, well, &self.options.cell)
     }
 
-    fn inside(&self, kappa: f64, energy: f64) -> bool {
-        let (k, e) = (self.options.kappa, self.options.energy);
-        kappa >= k.0 && kappa <= k.1 && energy >= e.0 && energy <= e.1
+    fn tol(&self) -> f64 {
+        self.options.cell.tol.max(1e-13)
     }
 
-    /// ∇N in scaled coordinates, by central differences.
+    /// Whether `p` is on N = p/q: within the tolerance, or within N's error estimate where
+    /// that is larger (near a separatrix, where ε − V loses digits) but no more than
+    /// `max_point_error`; beyond that the curve is taken to end at the separatrix.
+    fn on_curve(&self, p: &CurvePoint) -> bool {
+        p.error_estimate <= self.options.max_point_error.max(self.tol())
+            && (p.rotation_number - self.options.target).abs() <= self.tol().max(p.error_estimate)
+    }
+
+    /// ∇N in scaled coordinates, by central differences with steps that stay well inside
+    /// the point's gap between separatrices.
     fn gradient(&self, p: &CurvePoint) -> Option<(f64, f64)> {
-        let h = 1e-6;
+        let potential = EffectivePotential::new(self.body, p.kappa);
+        let distance = side_of(&separatrices(&potential), p.energy)
+            .map_or(f64::INFINITY, |s| (p.energy - s.level).abs());
+        let h = (1e-7f64).min(0.01 * distance / self.scale.1).max(1e-15);
         let (hk, he) = (h * self.scale.0, h * self.scale.1);
         let kp = self.at(p.kappa + hk, p.energy, p.well)?;
         let km = self.at(p.kappa - hk, p.energy, p.well)?;
-        let potential = EffectivePotential::new(self.body, p.kappa);
         let ep = evaluate(&potential, p.energy + he, p.well, &self.options.cell)?;
         let em = evaluate(&potential, p.energy - he, p.well, &self.options.cell)?;
         Some((
@@ -183,34 +325,71 @@ impl<S: Shape> Tracer<'_, S> {
         ))
     }
 
-    /// Newton along ∇N from (κ, ε) back onto N = p/q.
-    fn correct(&self, kappa: f64, energy: f64, well: f64) -> Option<(CurvePoint, (f64, f64))> {
-        let (mut k, mut e) = (kappa, energy);
-        let tol = self.options.cell.tol.max(1e-13);
-        for _ in 0..8 {
-            if !self.inside(k, e) {
+    /// Back onto N = p/q from the predicted (κ, ε), along ε at fixed κ when the curve runs
+    /// more along κ, else along κ at fixed ε. The root is sought only on the previous
+    /// point's side of its nearest separatrix, probing up to 2⁻⁵² of the way to it: a curve
+    /// that hugs a separatrix is followed on its own side.
+    fn correct(
+        &self,
+        kappa: f64,
+        energy: f64,
+        from: &CurvePoint,
+        along_energy: bool,
+        step: f64,
+    ) -> Option<CurvePoint> {
+        let (k, e) = (self.options.kappa, self.options.energy);
+        let target = self.options.target;
+        let tol = self.tol();
+        let side = side_of(
+            &separatrices(&EffectivePotential::new(self.body, from.kappa)),
+            from.energy,
+        );
+        let in_gap = |levels: &[f64], x: f64| {
+            let (lo, hi) = gap_for(levels, side);
+            x > lo && x < hi
+        };
+        let point = if along_energy {
+            if kappa < k.0 || kappa > k.1 {
                 return None;
             }
-            let p = self.at(k, e, well)?;
-            let f = p.rotation_number - self.options.target;
-            let g = self.gradient(&p)?;
-            if f.abs() <= tol.max(p.error_estimate) {
-                return Some((p, g));
-            }
-            let norm = g.0 * g.0 + g.1 * g.1;
-            if norm == 0.0 || !norm.is_finite() {
+            let potential = EffectivePotential::new(self.body, kappa);
+            let (lo, hi) = gap_for(&separatrices(&potential), side);
+            let (lo, hi) = (lo.max(e.0), hi.min(e.1));
+            if lo >= hi {
                 return None;
             }
-            k -= f * g.0 / norm * self.scale.0;
-            e -= f * g.1 / norm * self.scale.1;
-        }
-        None
+            let margin = 1e-15 * lo.abs().max(hi.abs().min(1e300));
+            let around = energy.clamp(lo + margin, hi - margin);
+            let f = |x: f64| {
+                evaluate(&potential, x, from.well, &self.options.cell)
+                    .map(|p| p.rotation_number - target)
+            };
+            let root = nearest_root(f, lo, hi, around, step * self.scale.1 * 0.05, tol)?;
+            evaluate(&potential, root, from.well, &self.options.cell)?
+        } else {
+            if energy < e.0 || energy > e.1 {
+                return None;
+            }
+            let f = |x: f64| {
+                let potential = EffectivePotential::new(self.body, x);
+                if !in_gap(&separatrices(&potential), energy) {
+                    return None;
+                }
+                evaluate(&potential, energy, from.well, &self.options.cell)
+                    .map(|p| p.rotation_number - target)
+            };
+            let around = kappa.clamp(k.0, k.1);
+            let root = nearest_root(f, k.0, k.1, around, step * self.scale.0 * 0.05, tol)?;
+            self.at(root, energy, from.well)?
+        };
+        let potential = EffectivePotential::new(self.body, point.kappa);
+        (self.on_curve(&point) && in_gap(&separatrices(&potential), point.energy)).then_some(point)
     }
 
     /// The curve through `seed` (on N = p/q), followed both ways until it leaves the window,
-    /// ends (its component disappears or meets a separatrix) or closes.
+    /// ends (its component disappears, or it runs into a separatrix) or closes.
     fn trace(&self, seed: CurvePoint, gradient: (f64, f64)) -> Curve {
-        let (s_max, s_min) = (1.0 / self.options.grid as f64, 1e-7);
+        let (s_max, s_min) = (1.0 / self.options.grid as f64, 1e-9);
         let mut halves: [Vec<CurvePoint>; 2] = [Vec::new(), Vec::new()];
         let mut closed = false;
         for (half, sign) in halves.iter_mut().zip([1.0, -1.0]) {
@@ -220,19 +399,23 @@ impl<S: Shape> Tracer<'_, S> {
             while half.len() < self.options.max_points && s >= s_min {
                 let k = p.kappa + s * t.0 * self.scale.0;
                 let e = p.energy + s * t.1 * self.scale.1;
-                let Some((q, g)) = self.correct(k, e, p.well) else {
+                let along_energy = t.0.abs() >= t.1.abs();
+                let Some(q) = self.correct(k, e, &p, along_energy, s) else {
                     s *= 0.5;
                     continue;
                 };
-                let t_new = tangent(g, 1.0);
-                let t_new = if t_new.0 * t.0 + t_new.1 * t.1 < 0.0 {
-                    (-t_new.0, -t_new.1)
-                } else {
-                    t_new
-                };
-                // Too sharp a turn, or a jump to another branch: a smaller step.
                 let moved = self.distance(&p, &q);
-                if t_new.0 * t.0 + t_new.1 * t.1 < 0.9 || moved > 2.0 * s {
+                if moved == 0.0 || moved > 3.0 * s {
+                    s *= 0.5;
+                    continue;
+                }
+                let t_new = (
+                    (q.kappa - p.kappa) / self.scale.0 / moved,
+                    (q.energy - p.energy) / self.scale.1 / moved,
+                );
+                // Too sharp a turn: a smaller step (not on the first step, whose direction
+                // comes from a finite-difference gradient).
+                if !half.is_empty() && t_new.0 * t.0 + t_new.1 * t.1 < 0.8 {
                     s *= 0.5;
                     continue;
                 }
@@ -272,19 +455,57 @@ impl<S: Shape> Tracer<'_, S> {
         ((a.kappa - b.kappa) / self.scale.0).hypot((a.energy - b.energy) / self.scale.1)
     }
 
-    /// Points on N = p/q found on the rows of the seed grid: sign changes of N − p/q along ε
-    /// for each well, refined to the tolerance.
+    /// The κ of the seed rows: the grid's, and rows crowding towards every κ where the number
+    /// of critical points of V changes (a cusp, where a separatrix ends): curves that hug a
+    /// separatrix can be located in double precision only near its end, where N varies more
+    /// slowly with the distance from it.
+    fn seed_rows(&self) -> Vec<f64> {
+        let n = self.options.grid;
+        let (k0, k1) = self.options.kappa;
+        let step = (k1 - k0) / n as f64;
+        let count = |k: f64| {
+            EffectivePotential::new(self.body, k)
+                .critical_points()
+                .len()
+        };
+        let mut rows: Vec<f64> = (0..=n).map(|i| k0 + step * i as f64).collect();
+        let counts: Vec<usize> = rows.iter().map(|&k| count(k)).collect();
+        for i in 0..n {
+            if counts[i] == counts[i + 1] {
+                continue;
+            }
+            // Bisect for the change.
+            let (mut a, mut b) = (rows[i], rows[i + 1]);
+            for _ in 0..60 {
+                let m = 0.5 * (a + b);
+                if count(m) == counts[i] {
+                    a = m;
+                } else {
+                    b = m;
+                }
+            }
+            for j in 1..=12 {
+                let d = step * 0.5f64.powi(j);
+                rows.extend([a - d, b + d].into_iter().filter(|k| *k > k0 && *k < k1));
+            }
+        }
+        rows
+    }
+
+    /// Points on N = p/q on the rows of the seed grid: for every well and every gap between
+    /// critical levels, sign changes of N − p/q on the grid's energies and on points that
+    /// approach the gap's ends geometrically, refined to the tolerance.
     fn seeds(&self) -> Vec<(CurvePoint, (f64, f64))> {
         use rayon::prelude::*;
         let n = self.options.grid;
-        let (k0, k1) = self.options.kappa;
         let (e0, e1) = self.options.energy;
         let target = self.options.target;
-        (0..=n)
+        let tol = self.tol();
+        (self.seed_rows())
             .into_par_iter()
-            .flat_map_iter(|i| {
-                let kappa = k0 + (k1 - k0) * i as f64 / n as f64;
+            .flat_map_iter(|kappa| {
                 let potential = EffectivePotential::new(self.body, kappa);
+                let levels = separatrices(&potential);
                 let wells: Vec<f64> = potential
                     .critical_points()
                     .iter()
@@ -297,29 +518,49 @@ impl<S: Shape> Tracer<'_, S> {
                         evaluate(&potential, e, well, &self.options.cell)
                             .map(|p| p.rotation_number - target)
                     };
-                    let mut previous: Option<(f64, f64)> = None;
-                    for j in 0..=n {
-                        let e = e0 + (e1 - e0) * j as f64 / n as f64;
-                        let Some(fe) = f(e) else {
-                            previous = None;
+                    let mut bounds = vec![f64::NEG_INFINITY];
+                    bounds.extend(levels.iter().copied());
+                    bounds.push(f64::INFINITY);
+                    for gap in bounds.windows(2) {
+                        let (lo, hi) = (gap[0].max(e0), gap[1].min(e1));
+                        if lo >= hi {
                             continue;
-                        };
-                        if let Some((ep, fp)) = previous {
-                            if (fp > 0.0) != (fe > 0.0) {
-                                let tol = self.options.cell.tol;
-                                if let Some(root) =
-                                    bracketed_root(&f, (ep, fp), (e, fe), 1e-15 * e.abs().max(1.0), tol)
-                                {
-                                    if let Some(p) = evaluate(&potential, root, well, &self.options.cell) {
-                                        // A sign change across a separatrix is no root.
-                                        if (p.rotation_number - target).abs() <= tol.max(p.error_estimate) {
-                                            found.push(p);
+                        }
+                        let mut xs: Vec<f64> = (0..=n)
+                            .map(|j| e0 + (e1 - e0) * j as f64 / n as f64)
+                            .filter(|&x| x > lo && x < hi)
+                            .collect();
+                        let mid = 0.5 * (lo + hi);
+                        for j in 1..=52 {
+                            xs.push(hi - (hi - mid) * 0.5f64.powi(j));
+                            xs.push(lo + (mid - lo) * 0.5f64.powi(j));
+                        }
+                        xs.retain(|&x| x > lo && x < hi);
+                        xs.sort_by(f64::total_cmp);
+                        xs.dedup();
+                        let values: Vec<(f64, Option<f64>)> =
+                            xs.iter().map(|&x| (x, f(x))).collect();
+                        for w in values.windows(2) {
+                            if let [(xa, Some(fa)), (xb, Some(fb))] = w {
+                                if (*fa > 0.0) != (*fb > 0.0) {
+                                    if let Some(root) = bracketed_root(
+                                        &f,
+                                        (*xa, *fa),
+                                        (*xb, *fb),
+                                        1e-15 * xb.abs(),
+                                        tol,
+                                    ) {
+                                        if let Some(p) =
+                                            evaluate(&potential, root, well, &self.options.cell)
+                                        {
+                                            if self.on_curve(&p) {
+                                                found.push(p);
+                                            }
                                         }
                                     }
                                 }
                             }
                         }
-                        previous = Some((e, fe));
                     }
                 }
                 found
@@ -329,6 +570,13 @@ impl<S: Shape> Tracer<'_, S> {
             .filter_map(|p| self.gradient(&p).map(|g| (p, g)))
             .collect()
     }
+}
+
+/// Whether two nearby points lie on the same family of tori: both turning points within
+/// 0.1 rad (on the two sides of a separatrix the components, though close in (κ, ε), differ
+/// by a whole well at one end).
+fn same_torus(a: &CurvePoint, b: &CurvePoint) -> bool {
+    (a.theta_min - b.theta_min).abs() < 0.1 && (a.theta_max - b.theta_max).abs() < 0.1
 }
 
 fn tangent((gk, ge): (f64, f64), sign: f64) -> (f64, f64) {
@@ -347,7 +595,11 @@ fn check_window(options: &ResonanceOptions) -> Result<()> {
     let (k0, k1) = options.kappa;
     let (e0, e1) = options.energy;
     if !(k0.is_finite() && k0 > 0.0) {
-        return bad("kappa_min", k0, "must be > 0 (at kappa = 0, N = 0 everywhere)");
+        return bad(
+            "kappa_min",
+            k0,
+            "must be > 0 (at kappa = 0, N = 0 everywhere)",
+        );
     }
     if !(k1.is_finite() && k1 > k0) {
         return bad("kappa_max", k1, "must be finite and above kappa_min");
@@ -384,9 +636,9 @@ pub fn trace_curves<S: Shape>(body: &Body<S>, options: &ResonanceOptions) -> Res
     let near = 1.5 / options.grid as f64;
     for (seed, gradient) in tracer.seeds() {
         let known = curves.iter().any(|c| {
-            c.points.iter().any(|p| {
-                tracer.distance(p, &seed) < near && p.theta_min <= seed.well && seed.well <= p.theta_max
-            })
+            c.points
+                .iter()
+                .any(|p| tracer.distance(p, &seed) < near && same_torus(p, &seed))
         });
         if !known {
             curves.push(tracer.trace(seed, gradient));
@@ -400,14 +652,15 @@ pub fn trace_curves<S: Shape>(body: &Body<S>, options: &ResonanceOptions) -> Res
 /// if no curve is found, or if the curve of largest κ leaves the window through κ_max.
 pub fn fold<S: Shape>(body: &Body<S>, options: &ResonanceOptions) -> Result<Option<Fold>> {
     let curves = trace_curves(body, options)?;
-    let Some(top) = curves
+    // The point of largest κ, with its neighbours on its curve.
+    let Some((curve, index)) = curves
         .iter()
-        .flat_map(|c| c.points.iter())
-        .max_by(|a, b| a.kappa.total_cmp(&b.kappa))
-        .copied()
+        .flat_map(|c| (0..c.points.len()).map(move |i| (c, i)))
+        .max_by(|(c, i), (d, j)| c.points[*i].kappa.total_cmp(&d.points[*j].kappa))
     else {
         return Ok(None);
     };
+    let top = curve.points[index];
     let window = options.kappa.1 - options.kappa.0;
     if top.kappa >= options.kappa.1 - 2.0 * window / options.grid as f64 {
         return Ok(None);
@@ -418,27 +671,38 @@ pub fn fold<S: Shape>(body: &Body<S>, options: &ResonanceOptions) -> Result<Opti
         scale: (window, options.energy.1 - options.energy.0),
     };
     let tol = options.cell.tol.max(1e-13);
-    // κ(ε) on the curve near the top: the root of N − p/q in κ, bracketed within a few grid
-    // steps of the top (∂N/∂κ ≠ 0 at a fold in κ, so the root is simple).
-    let reach = 3.0 * window / options.grid as f64;
-    let kappa_at = |energy: f64, _start: f64| -> Option<(f64, CurvePoint)> {
+    // κ(ε) on the curve near the top: the root of N − p/q in κ nearest the last one (the
+    // line of constant ε may cross the curve again on its other branch, further off).
+    let kappa_at = |energy: f64, start: f64| -> Option<(f64, CurvePoint)> {
         let f = |k: f64| {
             tracer
                 .at(k, energy, top.well)
                 .map(|p| p.rotation_number - options.target)
         };
-        let lo = (top.kappa - reach).max(options.kappa.0);
-        let hi = top.kappa + reach;
-        let (flo, fhi) = (f(lo)?, f(hi)?);
-        if (flo > 0.0) == (fhi > 0.0) {
-            return None;
-        }
-        let k = bracketed_root(f, (lo, flo), (hi, fhi), 1e-15 * hi, tol)?;
+        let k = nearest_root(
+            f,
+            options.kappa.0,
+            options.kappa.1,
+            start,
+            1e-7 * window,
+            tol,
+        )?;
         Some((k, tracer.at(k, energy, top.well)?))
     };
-    // Golden section for the largest κ(ε), in a bracket of a few curve steps around the top.
-    let span = 4.0 * (options.energy.1 - options.energy.0) / options.grid as f64;
-    let (mut a, mut b) = (top.energy - span, top.energy + span);
+    // Golden section for the largest κ(ε) between the top's neighbours on the curve.
+    let neighbours: Vec<f64> = [index.checked_sub(1), Some(index + 1)]
+        .into_iter()
+        .flatten()
+        .filter_map(|i| curve.points.get(i).map(|p| p.energy))
+        .collect();
+    let (mut a, mut b) = neighbours
+        .iter()
+        .fold((top.energy, top.energy), |(lo, hi), &e| {
+            (lo.min(e), hi.max(e))
+        });
+    if a == b {
+        return Ok(None);
+    }
     let ratio = 0.5 * (5f64.sqrt() - 1.0);
     let mut start = top.kappa;
     let value = |e: f64, start: &mut f64| -> f64 {
