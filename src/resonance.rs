@@ -389,7 +389,11 @@ impl<S: Shape> Tracer<'_, S> {
     /// The curve through `seed` (on N = p/q), followed both ways until it leaves the window,
     /// ends (its component disappears, or it runs into a separatrix) or closes.
     fn trace(&self, seed: CurvePoint, gradient: (f64, f64)) -> Curve {
-        let (s_max, s_min) = (1.0 / self.options.grid as f64, 1e-9);
+        // Steps below s_min end the curve: where a curve can no longer be followed (it runs
+        // into a separatrix, where the points' positions are limited by N's conditioning)
+        // crawling on would only add points that say nothing new.
+        let s_max = 1.0 / self.options.grid as f64;
+        let s_min = 1e-4 * s_max;
         let mut halves: [Vec<CurvePoint>; 2] = [Vec::new(), Vec::new()];
         let mut closed = false;
         for (half, sign) in halves.iter_mut().zip([1.0, -1.0]) {
@@ -399,13 +403,17 @@ impl<S: Shape> Tracer<'_, S> {
             while half.len() < self.options.max_points && s >= s_min {
                 let k = p.kappa + s * t.0 * self.scale.0;
                 let e = p.energy + s * t.1 * self.scale.1;
-                let along_energy = t.0.abs() >= t.1.abs();
+                // Solve along ε unless the curve runs nearly along ε: along ε the corrector
+                // stays between the separatrices at the new κ, which a curve hugging one needs.
+                let along_energy = t.0.abs() >= 0.2;
                 let Some(q) = self.correct(k, e, &p, along_energy, s) else {
                     s *= 0.5;
                     continue;
                 };
+                // The corrected point should be about a step away: much nearer, the corrector
+                // fell back onto the last point; much further, it jumped to another branch.
                 let moved = self.distance(&p, &q);
-                if moved == 0.0 || moved > 3.0 * s {
+                if moved < 0.25 * s || moved > 3.0 * s {
                     s *= 0.5;
                     continue;
                 }
@@ -426,6 +434,7 @@ impl<S: Shape> Tracer<'_, S> {
                 // Back at the seed, away from the window's edge: a closed curve.
                 if half.len() > 3
                     && self.distance(&p, &seed) < 0.75 * s
+                    && same_torus(&p, &seed)
                     && self.edge_distance(&seed) > 2.0 * s_max
                 {
                     closed = true;
@@ -644,7 +653,27 @@ pub fn trace_curves<S: Shape>(body: &Body<S>, options: &ResonanceOptions) -> Res
             curves.push(tracer.trace(seed, gradient));
         }
     }
-    Ok(curves)
+    // A curve traced from a seed that an earlier curve did not reach may run on over that
+    // curve: keep the longer of two curves that mostly coincide.
+    curves.sort_by_key(|c| std::cmp::Reverse(c.points.len()));
+    let mut kept: Vec<Curve> = Vec::new();
+    for c in curves {
+        let covered = c
+            .points
+            .iter()
+            .filter(|p| {
+                kept.iter().any(|k| {
+                    k.points
+                        .iter()
+                        .any(|q| tracer.distance(p, q) < near && same_torus(p, q))
+                })
+            })
+            .count();
+        if 2 * covered < c.points.len() {
+            kept.push(c);
+        }
+    }
+    Ok(kept)
 }
 
 /// The fold of the N = p/q curve of largest κ: the point of largest κ on the traced curves,
