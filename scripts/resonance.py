@@ -105,24 +105,29 @@ def extract(path: str | Path, wanted: list[Fraction] | None = None, qmax: int = 
     return curves
 
 
-def refine(curves: list[Curve], nu: float, eta: float, tol: float = 1e-10, grid: int = 24) -> list[Curve]:
-    """The same resonances traced by `rubber-atlas resonance` in a window around each body's
-    extracted curves: points on N = p/q to the solver's tolerance."""
+def refine(curves: list[Curve], nu: float, eta: float, window: tuple[float, float, float, float] | None = None,
+           tol: float = 1e-10, grid: int = 24) -> list[Curve]:
+    """The same resonances traced by `rubber-atlas resonance`, for each body and p/q of
+    `curves`: points on N = p/q to the solver's tolerance. The window (κ_min, κ_max, ε_min,
+    ε_max) is the atlas's (κ > 0), or by default the curves' bounding box with a margin."""
     out = []
     groups: dict[tuple, list[Curve]] = {}
     for c in curves:
         groups.setdefault((c.alpha, c.beta, c.target), []).append(c)
     for (alpha, beta, target), group in groups.items():
-        k = np.concatenate([c.kappa for c in group])
-        e = np.concatenate([c.energy for c in group])
-        pad_k, pad_e = 0.05 * (np.ptp(k) + 0.1), 0.05 * (np.ptp(e) + 0.1)
+        if window is None:
+            k = np.concatenate([c.kappa for c in group])
+            e = np.concatenate([c.energy for c in group])
+            pad_k, pad_e = 0.25 * (np.ptp(k) + 0.1), 0.25 * (np.ptp(e) + 0.1)
+            box = (max(k.min() - pad_k, 1e-3), k.max() + pad_k, e.min() - pad_e, e.max() + pad_e)
+        else:
+            box = (max(window[0], 1e-3), window[1], window[2], window[3])
         args = [
             BIN, "resonance", "--alpha", repr(float(alpha)), "--beta", repr(float(beta)), "--nu", repr(float(nu)),
-            "--eta", repr(float(eta)),
-            "--rotation-number", f"{target.numerator}/{target.denominator}",
-            "--kappa-min", repr(float(max(k.min() - pad_k, 1e-3))), "--kappa-max", repr(float(k.max() + pad_k)),
-            "--energy-min", repr(float(e.min() - pad_e)), "--energy-max", repr(float(e.max() + pad_e)),
-            "--grid", str(grid), "--tol", repr(tol), "--json",
+            "--eta", repr(float(eta)), "--rotation-number", f"{target.numerator}/{target.denominator}",
+            "--kappa-min", repr(float(box[0])), "--kappa-max", repr(float(box[1])),
+            "--energy-min", repr(float(box[2])), "--energy-max", repr(float(box[3])),
+            "--grid", str(grid), "--tol", repr(float(tol)), "--json",
         ]
         result = json.loads(subprocess.run(args, check=True, capture_output=True, text=True).stdout)
         for traced in result["curves"]:
@@ -130,8 +135,18 @@ def refine(curves: list[Curve], nu: float, eta: float, tol: float = 1e-10, grid:
             out.append(Curve(alpha, beta, target, int(pts[0]["component"]),
                              np.array([p["kappa"] for p in pts]), np.array([p["energy"] for p in pts]),
                              source="refined", extra={"rotation_number": np.array([p["rotation_number"] for p in pts]),
-                                                      "error_estimate": np.array([p["error_estimate"] for p in pts])}))
+                                                      "error_estimate": np.array([p["error_estimate"] for p in pts]),
+                                                      "component": np.array([p["component"] for p in pts])}))
     return out
+
+
+def atlas_window(path: str | Path) -> tuple[float, float, float, float]:
+    """The (κ_min, κ_max, ε_min, ε_max) of an atlas, with κ_min > 0."""
+    ds = open_atlas(path)
+    k, e = ds.kappa.values, ds.energy.values
+    ds.close()
+    positive = k[k > 0]
+    return float(positive.min()), float(k.max()), float(e.min()), float(e.max())
 
 
 COLUMNS = ["alpha", "beta", "p", "q", "target", "component", "curve", "point", "kappa", "energy", "source"]
@@ -139,8 +154,11 @@ COLUMNS = ["alpha", "beta", "p", "q", "target", "component", "curve", "point", "
 
 def rows(curves: list[Curve]):
     for i, c in enumerate(curves):
+        # The component index of each point (it can change along a traced curve where
+        # another component appears below it), else the contoured slot.
+        slots = c.extra.get("component", np.full(len(c.kappa), c.component))
         for j, (k, e) in enumerate(zip(c.kappa, c.energy)):
-            yield [c.alpha, c.beta, c.target.numerator, c.target.denominator, float(c.target), c.component, i, j,
+            yield [c.alpha, c.beta, c.target.numerator, c.target.denominator, float(c.target), int(slots[j]), i, j,
                    float(k), float(e), c.source]
 
 
@@ -194,7 +212,7 @@ def main() -> None:
         ds = open_atlas(args.atlas)
         nu, eta, tol = float(ds.attrs["nu"]), float(ds.attrs["eta"]), float(ds.attrs["tolerance"])
         ds.close()
-        curves = refine(curves, nu, eta, tol=max(tol, 1e-12))
+        curves = refine(curves, nu, eta, window=atlas_window(args.atlas), tol=max(tol, 1e-12))
     save(curves, args.out)
     print(f"wrote {len(curves)} curves ({sum(len(c.kappa) for c in curves)} points) to {args.out}")
 
