@@ -47,10 +47,20 @@ impl Start {
                 "this level set has fewer components"
             },
         })?;
+        // A libration starts at its lower turning point at rest. A rotation (κ = 0, rolling
+        // over the top) has no turning point: it starts at the top of U, where it is cut,
+        // moving forwards with ½ B θ̇² = ε − U.
+        let theta_dot0 = if c.kind == MotionKind::Rotation {
+            let potential = EffectivePotential::new(body, kappa);
+            let gap = energy - potential.value(crate::Angle::new(c.theta_min()));
+            (2.0 * gap.max(0.0) / body.reduced_inertia(c.theta_min())).sqrt()
+        } else {
+            0.0
+        };
         Ok(Self {
             kappa,
             theta0: c.theta_min(),
-            theta_dot0: 0.0,
+            theta_dot0,
         })
     }
 

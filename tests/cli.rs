@@ -332,3 +332,46 @@ fn cell_refuses_bad_input() {
         assert!(!err.contains("panicked"));
     }
 }
+
+#[test]
+fn a_trajectory_started_by_energy_on_a_rotation_rolls_over_the_top_once_per_period() {
+    // κ = 0 above ε_min = 1.5 (type b body): rolling over the top. The start is the top of U
+    // with ½ B θ̇² = ε − U there; after one period θ has advanced by 2π and θ̇ is back.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("rot.csv");
+    let o = run(&[
+        "trajectory",
+        "--alpha",
+        "0.5",
+        "--beta",
+        "1.1",
+        "--nu",
+        "0.5",
+        "--eta",
+        "0.5",
+        "--kappa",
+        "0",
+        "--energy",
+        "1.76",
+        "--periods",
+        "1",
+        "--samples",
+        "400",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&out).unwrap();
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with('t'))
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    let (first, last) = (&rows[0], &rows[rows.len() - 1]);
+    assert!(first[2] > 0.3, "θ̇(0) = {}", first[2]);
+    assert!(
+        (last[1] - first[1] - std::f64::consts::TAU).abs() < 1e-8,
+        "{first:?} {last:?}"
+    );
+    assert!((last[2] - first[2]).abs() < 1e-8);
+}
