@@ -127,6 +127,7 @@ fn integer_curves_lie_ever_closer_to_sigma_u_and_are_on_resonance() {
             }
         }
     }
+    eprintln!("distances from the separatrix: above (κ = 1.06) {above:?}, below (κ = 1.05) {below:?}");
     // Above the separatrix N = 1, 2, 3 lie ever closer to it; below it, N = 1 and 2.
     assert!(
         above[0] > above[1] && above[1] > above[2] && above[2] > 0.0,
@@ -139,6 +140,7 @@ fn integer_curves_lie_ever_closer_to_sigma_u_and_are_on_resonance() {
 fn the_fold_agrees_with_a_brute_force_scan() {
     let body = body();
     let f = fold(&body, &options(0.0)).unwrap().expect("a fold");
+    eprintln!("fold {f:?}");
     assert!(f.kappa_error < 1e-6, "{f:?}");
     assert!(f.rotation_number.abs() < 1e-9);
     // The same fold from another seed grid and a tighter tolerance: within 1e-6.
