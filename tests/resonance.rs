@@ -127,7 +127,9 @@ fn integer_curves_lie_ever_closer_to_sigma_u_and_are_on_resonance() {
             }
         }
     }
-    eprintln!("distances from the separatrix: above (κ = 1.06) {above:?}, below (κ = 1.05) {below:?}");
+    eprintln!(
+        "distances from the separatrix: above (κ = 1.06) {above:?}, below (κ = 1.05) {below:?}"
+    );
     // Above the separatrix N = 1, 2, 3 lie ever closer to it; below it, N = 1 and 2.
     assert!(
         above[0] > above[1] && above[1] > above[2] && above[2] > 0.0,
