@@ -560,6 +560,34 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_cell_the_solver_refuses_is_marked_failed_and_the_block_goes_on() {
+        let body = crate::EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 0.5).unwrap();
+        let potential = EffectivePotential::new(&body, 0.8);
+        let variables = variables(&Field::ALL);
+        let mut block = Block::empty(&variables, 3);
+        let options = CellOptions::default();
+        // A NaN energy makes the solver return an error; the cells around it are solved.
+        for (cell, energy) in [2.5, f64::NAN, 0.1].into_iter().enumerate() {
+            fill_cell(&mut block, &variables, cell, &potential, energy, &options);
+        }
+        let status = block.flags(&variables, "cell_status").unwrap();
+        assert_eq!(
+            status,
+            &[cell_status::OK, cell_status::FAILED, cell_status::NO_MOTION]
+        );
+        let count = block.flags(&variables, "n_components").unwrap();
+        assert_eq!(count, &[1, 0, 0]);
+        let Column::F64(n) = &block.columns[variables
+            .iter()
+            .position(|v| v.name == "rotation_number")
+            .unwrap()]
+        else {
+            panic!("rotation_number is f64")
+        };
+        assert!(n[0].is_finite() && n[3..].iter().all(|x| x.is_nan()));
+    }
+
+    #[test]
     fn units_cover_the_grid_once_and_shards_partition_them() {
         let shape = [2, 3, 50, 100];
         let all = units(shape);
