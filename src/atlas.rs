@@ -297,14 +297,6 @@ impl Column {
             _ => unreachable!("columns of one variable have one type"),
         }
     }
-
-    /// The values as little-endian bytes (for the resume journal).
-    pub fn to_le_bytes(&self) -> Vec<u8> {
-        match self {
-            Column::F64(v) => v.iter().flat_map(|x| x.to_le_bytes()).collect(),
-            Column::U8(v) => v.clone(),
-        }
-    }
 }
 
 /// The values of every variable over a block of cells in (κ, ε) row-major order, with the
@@ -351,39 +343,6 @@ impl Block {
             }
         }
         Block { cells, columns }
-    }
-
-    /// Appends the cells of `other` (the rows that follow).
-    pub fn append(&mut self, other: Block) {
-        self.cells += other.cells;
-        for (a, b) in self.columns.iter_mut().zip(other.columns) {
-            a.append(b);
-        }
-    }
-
-    /// A copy of the cells `cells`.
-    pub fn range(&self, variables: &[Variable], cells: Range<usize>) -> Block {
-        let columns = self
-            .columns
-            .iter()
-            .zip(variables)
-            .map(|(c, v)| {
-                let width = if v.kind == Kind::CellFlag {
-                    1
-                } else {
-                    COMPONENT_SLOTS
-                };
-                let r = cells.start * width..cells.end * width;
-                match c {
-                    Column::F64(x) => Column::F64(x[r].to_vec()),
-                    Column::U8(x) => Column::U8(x[r].to_vec()),
-                }
-            })
-            .collect();
-        Block {
-            cells: cells.len(),
-            columns,
-        }
     }
 
     /// The u8 values of the variable `name`, if it is among `variables`.

@@ -50,6 +50,26 @@ pub struct Summary {
 }
 
 impl Summary {
+    /// Words of a unit's counts in the journal.
+    const WORDS: usize = 9;
+
+    /// The counts of a unit, for the journal.
+    fn words(&self) -> [u64; Self::WORDS] {
+        let [a, b, c] = self.cells_by_status;
+        let [d, e, f, g] = self.components_by_status;
+        [self.cells, self.components, a, b, c, d, e, f, g]
+    }
+
+    fn from_words(w: &[u64]) -> Summary {
+        Summary {
+            cells: w[0],
+            components: w[1],
+            cells_by_status: [w[2], w[3], w[4]],
+            components_by_status: [w[5], w[6], w[7], w[8]],
+            ..Summary::default()
+        }
+    }
+
     fn add(&mut self, other: &Summary) {
         self.cells += other.cells;
         self.components += other.components;
@@ -201,7 +221,10 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
     let done: Vec<bool> = mine
         .iter()
         .map(|u| {
-            listed.contains(&u.index) && journal.read(u.index, &variables, cells_of(u)).is_some()
+            listed.contains(&u.index)
+                && journal
+                    .read(u.index, variables.len(), Summary::WORDS)
+                    .is_some()
         })
         .collect();
     let total: u64 = mine.iter().map(|u| cells_of(u) as u64).sum();
@@ -240,31 +263,30 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
                 .par_iter()
                 .zip(run_done)
                 .map(|(u, &was_done)| -> Result<(EncodedUnit, Summary)> {
-                    let mut part = Summary::default();
-                    let journaled = if was_done {
-                        journal.read(u.index, &variables, cells_of(u))
-                    } else {
-                        None
-                    };
-                    let block = match journaled {
-                        Some(b) => b,
-                        None => {
-                            let rows: Vec<usize> = u.rows.clone().collect();
-                            let b = compute_rows(
-                                scene,
-                                &variables,
-                                u.alpha_index,
-                                u.beta_index,
-                                &rows,
-                                &advance,
-                            );
-                            journal.write(u.index, &b, &variables, 0..b.cells)?;
-                            part.cells_computed = b.cells as u64;
-                            b
+                    // A unit of the journal is taken as it was stored; a unit read back damaged
+                    // (a disk error since it was checked) is computed again.
+                    if was_done {
+                        if let Some((chunks, words)) =
+                            journal.read(u.index, variables.len(), Summary::WORDS)
+                        {
+                            return Ok((chunks, Summary::from_words(&words)));
                         }
-                    };
+                    }
+                    let rows: Vec<usize> = u.rows.clone().collect();
+                    let block = compute_rows(
+                        scene,
+                        &variables,
+                        u.alpha_index,
+                        u.beta_index,
+                        &rows,
+                        &advance,
+                    );
+                    let mut part = Summary::default();
                     part.count(&variables, &block);
-                    Ok((encode_unit(&variables, &block, shape), part))
+                    let chunks = encode_unit(&variables, &block, shape);
+                    journal.write(u.index, &chunks, &part.words())?;
+                    part.cells_computed = block.cells as u64;
+                    Ok((chunks, part))
                 })
                 .collect::<Result<Vec<_>>>()?;
             for (u, (chunks, part)) in run.iter().zip(encoded) {

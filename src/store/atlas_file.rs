@@ -360,6 +360,18 @@ pub struct EncodedUnit {
     chunks: Vec<Vec<u8>>,
 }
 
+impl EncodedUnit {
+    /// The stored chunks, one per variable.
+    pub fn chunks(&self) -> &[Vec<u8>] {
+        &self.chunks
+    }
+
+    /// Chunks read back (from the resume journal).
+    pub fn from_chunks(chunks: Vec<Vec<u8>>) -> Self {
+        Self { chunks }
+    }
+}
+
 /// Encodes `block`, the values of one unit of a grid of shape `shape`, chunk by chunk as
 /// HDF5's shuffle and deflate filters would (a unit is one chunk of every variable). Done in
 /// the worker threads: HDF5 runs its filters on the one thread that writes, which cost a

@@ -1,10 +1,12 @@
 //! The resume journal: a directory next to the output where every finished work unit is kept
-//! as one small file, written under a temporary name and renamed into place, with a checksum.
+//! as one small file — its chunks as the atlas file stores them (shuffled, deflated) and its
+//! counts for the run's summary — written under a temporary name and renamed into place, with
+//! a checksum.
 //! A run killed at any moment leaves only whole, verifiable units behind; `--resume` keeps
 //! them and computes the rest. The atlas file itself appears only when every unit is done.
 
-use crate::atlas::{Block, Column, Kind, Variable, COMPONENT_SLOTS};
 use crate::error::{AtlasError, Result};
+use crate::store::atlas_file::EncodedUnit;
 use std::collections::BTreeSet;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -97,14 +99,9 @@ impl Journal {
         Ok(out)
     }
 
-    /// Stores the finished unit `index`: the cells `cells` of `block`.
-    pub fn write(
-        &self,
-        index: usize,
-        block: &Block,
-        variables: &[Variable],
-        cells: std::ops::Range<usize>,
-    ) -> Result<()> {
+    /// Stores the finished unit `index`: its encoded chunks and its counts (`counts`, a
+    /// fixed number of words that the caller defines).
+    pub fn write(&self, index: usize, encoded: &EncodedUnit, counts: &[u64]) -> Result<()> {
         let path = self.unit_path(index);
         let tmp = path.with_extension("bin.tmp");
         let write = || -> std::io::Result<()> {
@@ -114,30 +111,21 @@ impl Journal {
                 crc: crc32fast::Hasher::new(),
             };
             w.put(MAGIC)?;
+            let chunks = encoded.chunks();
             for word in [
                 self.fingerprint,
                 index as u64,
-                cells.len() as u64,
-                variables.len() as u64,
+                counts.len() as u64,
+                chunks.len() as u64,
             ] {
                 w.put(&word.to_le_bytes())?;
             }
-            let mut buffer = Vec::new();
-            for (v, c) in variables.iter().zip(&block.columns) {
-                let width = if v.kind == Kind::CellFlag {
-                    1
-                } else {
-                    COMPONENT_SLOTS
-                };
-                let range = cells.start * width..cells.end * width;
-                match c {
-                    Column::U8(x) => w.put(&x[range])?,
-                    Column::F64(x) => {
-                        buffer.clear();
-                        buffer.extend(x[range].iter().flat_map(|v| v.to_le_bytes()));
-                        w.put(&buffer)?;
-                    }
-                }
+            for c in counts {
+                w.put(&c.to_le_bytes())?;
+            }
+            for chunk in chunks {
+                w.put(&(chunk.len() as u64).to_le_bytes())?;
+                w.put(chunk)?;
             }
             let sum = u64::from(w.crc.clone().finalize());
             w.inner.write_all(&sum.to_le_bytes())?;
@@ -147,25 +135,31 @@ impl Journal {
         std::fs::rename(&tmp, &path).map_err(|e| io_error(&path, e))
     }
 
-    /// A unit read back, if its file is there, whole and of this scene; None otherwise (a
-    /// damaged file is removed, and the unit is computed again).
-    pub fn read(&self, index: usize, variables: &[Variable], cells: usize) -> Option<Block> {
+    /// A unit read back — its chunks and counts — if its file is there, whole, of this scene,
+    /// with `chunks` chunks and `counts` counts; None otherwise (a damaged file is removed, and
+    /// the unit is computed again).
+    pub fn read(
+        &self,
+        index: usize,
+        chunks: usize,
+        counts: usize,
+    ) -> Option<(EncodedUnit, Vec<u64>)> {
         let path = self.unit_path(index);
         let bytes = std::fs::read(&path).ok()?;
-        let block = self.decode(&bytes, index, variables, cells);
-        if block.is_none() {
+        let unit = self.decode(&bytes, index, chunks, counts);
+        if unit.is_none() {
             let _ = std::fs::remove_file(&path);
         }
-        block
+        unit
     }
 
     fn decode(
         &self,
         bytes: &[u8],
         index: usize,
-        variables: &[Variable],
-        cells: usize,
-    ) -> Option<Block> {
+        chunks: usize,
+        counts: usize,
+    ) -> Option<(EncodedUnit, Vec<u64>)> {
         let (body, sum) = bytes.split_at_checked(bytes.len().checked_sub(8)?)?;
         if u64::from(crc32fast::hash(body)) != u64::from_le_bytes(sum.try_into().ok()?) {
             return None;
@@ -176,36 +170,25 @@ impl Journal {
         if body.get(..8)? != MAGIC
             || word(8)? != self.fingerprint
             || word(16)? != index as u64
-            || word(24)? != cells as u64
-            || word(32)? != variables.len() as u64
+            || word(24)? != counts as u64
+            || word(32)? != chunks as u64
         {
             return None;
         }
         let mut at = 40;
-        let mut columns = Vec::with_capacity(variables.len());
-        for v in variables {
-            let n = match v.kind {
-                Kind::CellFlag => cells,
-                Kind::Value | Kind::Flag => cells * COMPONENT_SLOTS,
-            };
-            columns.push(match v.kind {
-                Kind::Value => {
-                    let raw = body.get(at..at + 8 * n)?;
-                    at += 8 * n;
-                    Column::F64(
-                        raw.chunks_exact(8)
-                            .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
-                            .collect(),
-                    )
-                }
-                Kind::Flag | Kind::CellFlag => {
-                    let raw = body.get(at..at + n)?;
-                    at += n;
-                    Column::U8(raw.to_vec())
-                }
-            });
+        let mut values = Vec::with_capacity(counts);
+        for _ in 0..counts {
+            values.push(word(at)?);
+            at += 8;
         }
-        (at == body.len()).then_some(Block { cells, columns })
+        let mut data = Vec::with_capacity(chunks);
+        for _ in 0..chunks {
+            let len = usize::try_from(word(at)?).ok()?;
+            at += 8;
+            data.push(body.get(at..at.checked_add(len)?)?.to_vec());
+            at += len;
+        }
+        (at == body.len()).then(|| (EncodedUnit::from_chunks(data), values))
     }
 
     /// Removes the journal (after the atlas file is in place).
