@@ -347,6 +347,15 @@ fn a_run_killed_at_any_point_resumes_to_the_same_arrays() {
             "after {done} units: {line}"
         );
         resumed_somewhere |= done > 0;
+        // The summary counts all cells, those of the journal included.
+        for prefix in ["cells: ", "components by status: "] {
+            let line = |text: &str| {
+                text.lines()
+                    .find(|l| l.starts_with(prefix))
+                    .map(str::to_owned)
+            };
+            assert_eq!(line(&resume), line(&summary), "{prefix}");
+        }
         assert_same_arrays(&reference, &out);
         assert!(!journal.exists());
     }
