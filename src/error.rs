@@ -44,6 +44,16 @@ pub enum AtlasError {
     Atlas { path: String, reason: String },
 }
 
+impl AtlasError {
+    /// An [`AtlasError::Atlas`] naming `path`.
+    pub(crate) fn atlas(path: &std::path::Path, reason: impl std::fmt::Display) -> Self {
+        AtlasError::Atlas {
+            path: path.display().to_string(),
+            reason: reason.to_string(),
+        }
+    }
+}
+
 /// Shorthand for results of this crate.
 pub type Result<T> = std::result::Result<T, AtlasError>;
 

@@ -504,7 +504,7 @@ impl<S: Shape> Tracer<'_, S> {
     /// Points on N = p/q on the rows of the seed grid: for every well and every gap between
     /// critical levels, sign changes of N − p/q on the grid's energies and on points that
     /// approach the gap's ends geometrically, refined to the tolerance.
-    fn seeds(&self) -> Vec<(CurvePoint, (f64, f64))> {
+    fn seeds(&self) -> Vec<CurvePoint> {
         use rayon::prelude::*;
         let n = self.options.grid;
         let (e0, e1) = self.options.energy;
@@ -574,9 +574,6 @@ impl<S: Shape> Tracer<'_, S> {
                 }
                 found
             })
-            .collect::<Vec<_>>()
-            .into_iter()
-            .filter_map(|p| self.gradient(&p).map(|g| (p, g)))
             .collect()
     }
 }
@@ -643,14 +640,17 @@ pub fn trace_curves<S: Shape>(body: &Body<S>, options: &ResonanceOptions) -> Res
     };
     let mut curves: Vec<Curve> = Vec::new();
     let near = 1.5 / options.grid as f64;
-    for (seed, gradient) in tracer.seeds() {
+    for seed in tracer.seeds() {
         let known = curves.iter().any(|c| {
             c.points
                 .iter()
                 .any(|p| tracer.distance(p, &seed) < near && same_torus(p, &seed))
         });
+        // The gradient (four more solves) only for the seeds that start a curve.
         if !known {
-            curves.push(tracer.trace(seed, gradient));
+            if let Some(gradient) = tracer.gradient(&seed) {
+                curves.push(tracer.trace(seed, gradient));
+            }
         }
     }
     // A curve traced from a seed that an earlier curve did not reach may run on over that

@@ -51,13 +51,19 @@ fn output_error(path: &Path, e: impl std::fmt::Display) -> AtlasError {
     }
 }
 
-fn temp_path(path: &Path) -> PathBuf {
+/// `path` with `suffix` appended to its file name (`x.h5` → `x.h5<suffix>`), in the same
+/// directory: where an output is written before it is renamed into place.
+pub(crate) fn with_suffix(path: &Path, suffix: &str) -> PathBuf {
     let mut name = path
         .file_name()
         .map(|n| n.to_os_string())
         .unwrap_or_default();
-    name.push(format!(".partial-{}", std::process::id()));
+    name.push(suffix);
     path.with_file_name(name)
+}
+
+fn temp_path(path: &Path) -> PathBuf {
+    with_suffix(path, &format!(".partial-{}", std::process::id()))
 }
 
 /// Writes equal-length columns to `path` (CSV: a header line, then rows with shortest

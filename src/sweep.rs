@@ -74,6 +74,7 @@ impl Summary {
         self.cells += other.cells;
         self.components += other.components;
         self.cells_computed += other.cells_computed;
+        self.units_resumed += other.units_resumed;
         for (a, b) in self.cells_by_status.iter_mut().zip(other.cells_by_status) {
             *a += b;
         }
@@ -122,21 +123,9 @@ pub struct RunRequest {
     pub attributes: Vec<(String, AttrValue)>,
 }
 
-fn atlas_error(path: &Path, reason: impl Into<String>) -> AtlasError {
-    AtlasError::Atlas {
-        path: path.display().to_string(),
-        reason: reason.into(),
-    }
-}
-
 /// `<out>.partial.h5`: where the file is written before it is renamed into place.
 fn temporary_path(out: &Path) -> PathBuf {
-    let mut name = out
-        .file_name()
-        .map(|n| n.to_os_string())
-        .unwrap_or_default();
-    name.push(".partial.h5");
-    out.with_file_name(name)
+    crate::store::with_suffix(out, ".partial.h5")
 }
 
 /// The root attributes every atlas file carries: provenance and the scene.
@@ -188,7 +177,7 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
     let started = Instant::now();
     let out = &request.out;
     if out.exists() && !request.force {
-        return Err(atlas_error(
+        return Err(AtlasError::atlas(
             out,
             "exists; use --force to overwrite it (a finished run has nothing to resume)",
         ));
@@ -198,12 +187,12 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
     let journal = if journal_dir.exists() {
         if request.force {
             std::fs::remove_dir_all(&journal_dir)
-                .map_err(|e| atlas_error(&journal_dir, e.to_string()))?;
+                .map_err(|e| AtlasError::atlas(&journal_dir, e))?;
             Journal::create(&journal_dir, fingerprint, &scene.text)?
         } else if request.resume {
             Journal::open(&journal_dir, fingerprint)?
         } else {
-            return Err(atlas_error(
+            return Err(AtlasError::atlas(
                 &journal_dir,
                 "an interrupted run of this output left its journal here; \
                  use --resume to continue it or --force to start over",
@@ -217,16 +206,10 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
     let all_units = atlas::units(scene.shape());
     let mine = &all_units[request.shard.units(all_units.len())];
     let cells_of = |u: &Unit| u.rows.len() * scene.energy.len();
+    // Units with a file in the journal; each is checked when it is read, below, and computed
+    // again if its file turns out damaged.
     let listed = journal.listed_units()?;
-    let done: Vec<bool> = mine
-        .iter()
-        .map(|u| {
-            listed.contains(&u.index)
-                && journal
-                    .read(u.index, variables.len(), Summary::WORDS)
-                    .is_some()
-        })
-        .collect();
+    let done: Vec<bool> = mine.iter().map(|u| listed.contains(&u.index)).collect();
     let total: u64 = mine.iter().map(|u| cells_of(u) as u64).sum();
     let done_cells: u64 = mine
         .iter()
@@ -236,7 +219,6 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
         .sum();
     let mut summary = Summary {
         units: mine.len(),
-        units_resumed: done.iter().filter(|&&d| d).count(),
         ..Summary::default()
     };
     progress.begin(total, done_cells);
@@ -247,7 +229,7 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
     // written afresh by every invocation: the journal, not the file, survives a kill.
     let tmp = temporary_path(out);
     if tmp.exists() {
-        std::fs::remove_file(&tmp).map_err(|e| atlas_error(&tmp, e.to_string()))?;
+        std::fs::remove_file(&tmp).map_err(|e| AtlasError::atlas(&tmp, e))?;
     }
     let mut attributes = scene_attributes(scene, request.shard, all_units.len());
     attributes.extend(request.attributes.iter().cloned());
@@ -263,13 +245,15 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
                 .par_iter()
                 .zip(run_done)
                 .map(|(u, &was_done)| -> Result<(EncodedUnit, Summary)> {
-                    // A unit of the journal is taken as it was stored; a unit read back damaged
-                    // (a disk error since it was checked) is computed again.
+                    // A unit of the journal is taken as it was stored; a damaged one (torn by
+                    // a power loss) is computed again.
                     if was_done {
                         if let Some((chunks, words)) =
                             journal.read(u.index, variables.len(), Summary::WORDS)
                         {
-                            return Ok((chunks, Summary::from_words(&words)));
+                            let mut part = Summary::from_words(&words);
+                            part.units_resumed = 1;
+                            return Ok((chunks, part));
                         }
                     }
                     let rows: Vec<usize> = u.rows.clone().collect();
@@ -301,7 +285,7 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
         let _ = std::fs::remove_file(&tmp);
         return Err(e);
     }
-    std::fs::rename(&tmp, out).map_err(|e| atlas_error(out, e.to_string()))?;
+    std::fs::rename(&tmp, out).map_err(|e| AtlasError::atlas(out, e))?;
     journal.remove()?;
     summary.seconds = started.elapsed().as_secs_f64();
     Ok(summary)
@@ -318,10 +302,13 @@ pub fn merge(
 ) -> Result<Summary> {
     let started = Instant::now();
     if out.exists() && !force {
-        return Err(atlas_error(out, "exists; use --force to overwrite it"));
+        return Err(AtlasError::atlas(
+            out,
+            "exists; use --force to overwrite it",
+        ));
     }
     if shards.is_empty() {
-        return Err(atlas_error(out, "no shard files given"));
+        return Err(AtlasError::atlas(out, "no shard files given"));
     }
     // The scene, from the first shard; every shard must carry the same one.
     let first = shards[0].as_path();
@@ -335,7 +322,7 @@ pub fn merge(
     for path in shards {
         let file = AtlasFile::open(path, &scene, &variables)?;
         if file.text_attribute("scene_fingerprint").as_deref() != Some(fingerprint.as_str()) {
-            return Err(atlas_error(
+            return Err(AtlasError::atlas(
                 path,
                 format!(
                     "is not a shard of the same scene as {} (or was made by another version)",
@@ -347,11 +334,11 @@ pub fn merge(
             file.integer_attribute("shard_index"),
             file.integer_attribute("shard_count"),
         ) else {
-            return Err(atlas_error(path, "has no shard_index / shard_count"));
+            return Err(AtlasError::atlas(path, "has no shard_index / shard_count"));
         };
         let n = n as usize;
         if *count.get_or_insert(n) != n {
-            return Err(atlas_error(
+            return Err(AtlasError::atlas(
                 path,
                 format!(
                     "is shard {index}/{n}, but the first shard is of {}",
@@ -362,7 +349,7 @@ pub fn merge(
         by_index.resize_with(n, || None);
         let slot = &mut by_index[index as usize - 1];
         if let Some((other, _)) = slot {
-            return Err(atlas_error(
+            return Err(AtlasError::atlas(
                 path,
                 format!(
                     "shard {index}/{n} is given twice (also {})",
@@ -379,7 +366,7 @@ pub fn merge(
         .map(|(i, _)| format!("{}/{}", i + 1, by_index.len()))
         .collect();
     if !missing.is_empty() {
-        return Err(atlas_error(
+        return Err(AtlasError::atlas(
             out,
             format!("shards missing: {}", missing.join(", ")),
         ));
@@ -387,7 +374,7 @@ pub fn merge(
 
     let tmp = temporary_path(out);
     if tmp.exists() {
-        std::fs::remove_file(&tmp).map_err(|e| atlas_error(&tmp, e.to_string()))?;
+        std::fs::remove_file(&tmp).map_err(|e| AtlasError::atlas(&tmp, e))?;
     }
     let mut attributes = scene_attributes(&scene, Shard::WHOLE, all_units.len());
     // Provenance of the computation: the first shard's program and commit.
@@ -435,7 +422,7 @@ pub fn merge(
         let _ = std::fs::remove_file(&tmp);
         return Err(e);
     }
-    std::fs::rename(&tmp, out).map_err(|e| atlas_error(out, e.to_string()))?;
+    std::fs::rename(&tmp, out).map_err(|e| AtlasError::atlas(out, e))?;
     summary.seconds = started.elapsed().as_secs_f64();
     Ok(summary)
 }
@@ -446,9 +433,9 @@ fn slice_runs(units: &[Unit]) -> impl Iterator<Item = &[Unit]> {
 }
 
 fn read_root_text(path: &Path, name: &str) -> Result<String> {
-    let file = hdf5::File::open(path).map_err(|e| atlas_error(path, e.to_string()))?;
+    let file = hdf5::File::open(path).map_err(|e| AtlasError::atlas(path, e))?;
     file.attr(name)
         .and_then(|a| a.read_scalar::<hdf5::types::VarLenUnicode>())
         .map(|s| s.as_str().to_string())
-        .map_err(|_| atlas_error(path, format!("has no {name} attribute: not an atlas file")))
+        .map_err(|_| AtlasError::atlas(path, format!("has no {name} attribute: not an atlas file")))
 }

@@ -35,12 +35,8 @@ fields = ["rotation_number", "drift_radius", "bounded", "status", "error_estimat
 
 
 @pytest.fixture(scope="module")
-def atlas(tmp_path_factory):
-    d = tmp_path_factory.mktemp("hyp")
-    (d / "hyp.toml").write_text(SCENE)
-    out = d / "hyp.h5"
-    subprocess.run([BIN, "run", str(d / "hyp.toml"), "--out", str(out), "--quiet"], check=True)
-    return out
+def atlas(make_atlas):
+    return make_atlas("hyp", SCENE)
 
 
 def test_verdicts_by_case_and_kappa_max(atlas, tmp_path):

@@ -36,12 +36,8 @@ fields = ["theta_min", "theta_max", "rotation_number", "status", "error_estimate
 
 
 @pytest.fixture(scope="module")
-def atlas(tmp_path_factory):
-    d = tmp_path_factory.mktemp("res")
-    (d / "res.toml").write_text(SCENE)
-    out = d / "res.h5"
-    subprocess.run([BIN, "run", str(d / "res.toml"), "--out", str(out), "--quiet"], check=True)
-    return out
+def atlas(make_atlas):
+    return make_atlas("res", SCENE)
 
 
 def test_contoured_and_traced_n0_agree_and_traced_points_are_on_resonance(atlas, tmp_path):

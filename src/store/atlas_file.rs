@@ -59,13 +59,6 @@ pub struct AtlasFile {
     shape: [usize; 4],
 }
 
-fn h5_error(path: &Path, e: impl std::fmt::Display) -> AtlasError {
-    AtlasError::Atlas {
-        path: path.display().to_string(),
-        reason: e.to_string(),
-    }
-}
-
 fn text_attr(loc: &hdf5::Location, name: &str, value: &str) -> hdf5::Result<()> {
     let v: VarLenUnicode = value
         .parse()
@@ -111,7 +104,8 @@ impl AtlasFile {
         variables: &[Variable],
         attributes: &[(&str, AttrValue)],
     ) -> Result<AtlasFile> {
-        Self::create_inner(path, scene, variables, attributes).map_err(|e| h5_error(path, e))
+        Self::create_inner(path, scene, variables, attributes)
+            .map_err(|e| AtlasError::atlas(path, e))
     }
 
     fn create_inner(
@@ -255,7 +249,7 @@ impl AtlasFile {
                 shape: scene.shape(),
             })
         };
-        inner().map_err(|e| h5_error(path, e))
+        inner().map_err(|e| AtlasError::atlas(path, e))
     }
 
     /// A text attribute of the root, if present.
@@ -303,7 +297,7 @@ impl AtlasFile {
                 )
             });
             if status < 0 {
-                return Err(h5_error(
+                return Err(AtlasError::atlas(
                     &self.path,
                     format!("H5Dwrite_chunk failed for {}", v.name),
                 ));
@@ -341,17 +335,17 @@ impl AtlasFile {
                 columns,
             })
         };
-        read().map_err(|e| h5_error(&self.path, e))
+        read().map_err(|e| AtlasError::atlas(&self.path, e))
     }
 
     /// Flushes and closes the file, and flushes it to disk.
     pub fn close(self) -> Result<()> {
         let path = self.path.clone();
         drop(self.datasets);
-        self.file.close().map_err(|e| h5_error(&path, e))?;
+        self.file.close().map_err(|e| AtlasError::atlas(&path, e))?;
         std::fs::File::open(&path)
             .and_then(|f| f.sync_all())
-            .map_err(|e| h5_error(&path, e))
+            .map_err(|e| AtlasError::atlas(&path, e))
     }
 }
 

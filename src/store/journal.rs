@@ -21,28 +21,17 @@ pub struct Journal {
     fingerprint: u64,
 }
 
-fn io_error(path: &Path, e: impl std::fmt::Display) -> AtlasError {
-    AtlasError::Atlas {
-        path: path.display().to_string(),
-        reason: e.to_string(),
-    }
-}
-
 impl Journal {
     /// The journal directory of the output `out`: `<out>.partial.d`.
     pub fn dir_for(out: &Path) -> PathBuf {
-        let mut name = out
-            .file_name()
-            .map(|n| n.to_os_string())
-            .unwrap_or_default();
-        name.push(".partial.d");
-        out.with_file_name(name)
+        crate::store::with_suffix(out, ".partial.d")
     }
 
     /// Starts an empty journal (the directory must not exist).
     pub fn create(dir: &Path, fingerprint: u64, scene_text: &str) -> Result<Journal> {
-        std::fs::create_dir(dir).map_err(|e| io_error(dir, e))?;
-        std::fs::write(dir.join("scene.toml"), scene_text).map_err(|e| io_error(dir, e))?;
+        std::fs::create_dir(dir).map_err(|e| AtlasError::atlas(dir, e))?;
+        std::fs::write(dir.join("scene.toml"), scene_text)
+            .map_err(|e| AtlasError::atlas(dir, e))?;
         write_atomically(
             &dir.join(FINGERPRINT_FILE),
             format!("{fingerprint:016x}\n").as_bytes(),
@@ -56,8 +45,9 @@ impl Journal {
     /// Opens an existing journal; refuses one of another scene or program version.
     pub fn open(dir: &Path, fingerprint: u64) -> Result<Journal> {
         let path = dir.join(FINGERPRINT_FILE);
-        let text = std::fs::read_to_string(&path).map_err(|e| io_error(&path, e))?;
-        let found = u64::from_str_radix(text.trim(), 16).map_err(|e| io_error(&path, e))?;
+        let text = std::fs::read_to_string(&path).map_err(|e| AtlasError::atlas(&path, e))?;
+        let found =
+            u64::from_str_radix(text.trim(), 16).map_err(|e| AtlasError::atlas(&path, e))?;
         if found != fingerprint {
             return Err(AtlasError::Atlas {
                 path: dir.display().to_string(),
@@ -84,8 +74,8 @@ impl Journal {
     /// The units with a file in the journal (not yet verified; [`Journal::read`] checks).
     pub fn listed_units(&self) -> Result<BTreeSet<usize>> {
         let mut out = BTreeSet::new();
-        for entry in std::fs::read_dir(&self.dir).map_err(|e| io_error(&self.dir, e))? {
-            let entry = entry.map_err(|e| io_error(&self.dir, e))?;
+        for entry in std::fs::read_dir(&self.dir).map_err(|e| AtlasError::atlas(&self.dir, e))? {
+            let entry = entry.map_err(|e| AtlasError::atlas(&self.dir, e))?;
             let name = entry.file_name();
             let name = name.to_string_lossy();
             if let Some(i) = name
@@ -131,8 +121,8 @@ impl Journal {
             w.inner.write_all(&sum.to_le_bytes())?;
             w.inner.flush()
         };
-        write().map_err(|e| io_error(&tmp, e))?;
-        std::fs::rename(&tmp, &path).map_err(|e| io_error(&path, e))
+        write().map_err(|e| AtlasError::atlas(&tmp, e))?;
+        std::fs::rename(&tmp, &path).map_err(|e| AtlasError::atlas(&path, e))
     }
 
     /// A unit read back — its chunks and counts — if its file is there, whole, of this scene,
@@ -193,7 +183,7 @@ impl Journal {
 
     /// Removes the journal (after the atlas file is in place).
     pub fn remove(self) -> Result<()> {
-        std::fs::remove_dir_all(&self.dir).map_err(|e| io_error(&self.dir, e))
+        std::fs::remove_dir_all(&self.dir).map_err(|e| AtlasError::atlas(&self.dir, e))
     }
 }
 
@@ -205,10 +195,11 @@ fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
     let mut tmp = path.as_os_str().to_os_string();
     tmp.push(".tmp");
     let tmp = PathBuf::from(tmp);
-    let mut file = std::fs::File::create(&tmp).map_err(|e| io_error(&tmp, e))?;
-    file.write_all(bytes).map_err(|e| io_error(&tmp, e))?;
+    let mut file = std::fs::File::create(&tmp).map_err(|e| AtlasError::atlas(&tmp, e))?;
+    file.write_all(bytes)
+        .map_err(|e| AtlasError::atlas(&tmp, e))?;
     drop(file);
-    std::fs::rename(&tmp, path).map_err(|e| io_error(path, e))
+    std::fs::rename(&tmp, path).map_err(|e| AtlasError::atlas(path, e))
 }
 
 /// A writer that keeps a CRC-32 of what passes through.
