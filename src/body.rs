@@ -137,6 +137,22 @@ pub trait Shape: Send + Sync {
         ((ux - uy) / sin_diff, (ux.abs() + uy.abs()) / sin_diff.abs())
     }
 
+    /// U′(θ) / sinθ = χ2 − χ1 cosθ: the horizontal offset of the contact point per unit
+    /// sinθ. It stays finite at the poles, and |r|² = U² + U′² (the contact point seen from
+    /// the centre of mass has the vertical part −U and the horizontal part −U′), so
+    /// B − J² = sin²θ ((1 − ν)/η + (U′/sinθ)²) without cancellation.
+    #[inline]
+    fn potential_prime_over_sin_at(&self, a: Angle) -> f64 {
+        let (c1, c2) = self.chi(a.theta());
+        c2 - c1 * a.cos
+    }
+
+    /// The smallest angular scale (in radians) on which U, B and J vary: numerical rules
+    /// need steps below it before their convergence tests can be trusted.
+    fn angular_feature_scale(&self) -> f64 {
+        1.0
+    }
+
     /// U and |r|² together (shapes override this to share work between the two).
     #[inline]
     fn potential_and_contact_distance_sq_at(&self, a: Angle) -> (f64, f64) {
@@ -262,6 +278,18 @@ impl Shape for Ellipsoid {
     #[inline]
     fn potential_prime_at(&self, a: Angle) -> f64 {
         a.sin * ((self.beta * self.beta - 1.0) * a.cos / self.centre_height_at(a) - self.alpha)
+    }
+
+    /// Z varies on the scale β near the equator of a prolate ellipsoid and 1/β near the
+    /// poles of an oblate one.
+    fn angular_feature_scale(&self) -> f64 {
+        self.beta.min(1.0 / self.beta)
+    }
+
+    /// U′/sinθ = (β² − 1) cosθ / Z − α.
+    #[inline]
+    fn potential_prime_over_sin_at(&self, a: Angle) -> f64 {
+        (self.beta * self.beta - 1.0) * a.cos / self.centre_height_at(a) - self.alpha
     }
 
     #[inline]

@@ -14,6 +14,8 @@
 //!   reference for everything reduced.
 //! - [`critical`]: the critical set of paper §4 — diagram types, permanent rotations, the cusp,
 //!   equilibria, ε_min.
+//! - [`limits`]: the edges of the (κ, ε) plane — the high-energy limit N∞(λ), the bottom of
+//!   each well, κ → 0 and the separatrices.
 //! - [`torus`]: one level set (κ, ε): its components, turning points, period and precession.
 //! - [`trajectory`]: time histories from either model; [`ode`] wraps the DOP853 integrator.
 //! - [`resonance`]: curves N = p/q by continuation, and the fold κ_max.
@@ -33,6 +35,7 @@ pub mod cell;
 pub mod critical;
 pub mod error;
 pub mod full;
+pub mod limits;
 pub mod ode;
 pub mod period_ode;
 pub mod quadrature;

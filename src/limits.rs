@@ -1,0 +1,321 @@
+//! The limits that bound the (κ, ε) plane (SPEC §4): the high-energy limit N∞(λ) of the
+//! rotation number at fixed λ = κ/√ε, the linearised N at the bottom of each well (stable
+//! permanent rotations, `s1`), and the known limits at κ → 0 and at a separatrix. The
+//! verdict on the boundedness hypothesis ([`crate::verdict`]) closes the plane with them.
+//!
+//! **High energy.** With λ fixed and ε → ∞, time scaled by √ε, the reduced system (`eqsys`)
+//! tends to B θ′²/2 + λ²/(2 sin²θ) = 1, ψ′ = −λ cosθ/(J sin²θ) (`dpsi`): U drops out of the
+//! energy, B and J stay. The rotation number of that system is
+//! N∞(λ) = (λ/π) ∫ cosθ √B / (J sinθ √(2 sin²θ − λ²)) dθ over sinθ ≥ λ/√2.
+//! Because |r|² = U² + U′², one has √B/J − 1 = sin²θ H(cosθ) with
+//! H = ((1 − ν)/η + (U′/sinθ)²) / (J (√B + J)), smooth on [−1, 1]; the constant part of √B/J
+//! integrates to 0 (θ → π − θ), and x = cosθ = x₀ sin u with x₀ = √(1 − λ²/2) turns the rest
+//! into an integral with no singularity at all:
+//! N∞(λ) = λ x₀ / (√2 π) ∫_{0}^{π/2} sin u [H(x₀ sin u) − H(−x₀ sin u)] du.
+//! Its integrand is even and π-periodic in u, so the trapezoid rule converges geometrically.
+//! At λ → 0, N∞/λ → (1/(√2 π)) ∫_0^{π/2} sin u [H(sin u) − H(−sin u)] du (the slope); at
+//! λ = √2 the torus shrinks to θ = π/2, where ψ̇ = 0, and N∞ = 0.
+
+use crate::body::{Angle, Body, Shape};
+use crate::error::{check_range, Result};
+use crate::torus::{CriticalKind, CriticalPoint, EffectivePotential};
+use serde::Serialize;
+use std::f64::consts::{FRAC_PI_2, PI, SQRT_2};
+
+/// A value with a bound on its absolute error.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Estimate {
+    pub value: f64,
+    pub error: f64,
+}
+
+/// The rotation number tends to these at κ → 0 (SPEC §4): a libration that passes near the
+/// pole θ = 0 only winds ψ by −π per passage (N → +1/2), one near θ = π only by +π
+/// (N → −1/2), and one that passes near both (a κ = 0 rotation over the top, ε > ε_min) has
+/// the two passages cancel, N = O(κ) → 0. The verdict uses these as the κ → 0 edge of the
+/// plane; tests check them against cells at κ = 1e-7.
+pub fn small_kappa_limit(near_zero_pole: bool, near_pi_pole: bool) -> f64 {
+    match (near_zero_pole, near_pi_pole) {
+        (true, false) => 0.5,
+        (false, true) => -0.5,
+        _ => 0.0,
+    }
+}
+
+/// At a separatrix (ε → the level of a maximum θ_s of V) the period grows like
+/// −log|ε − V(θ_s)| while ψ advances at ψ̇(θ_s) for most of it: N → −sign(ψ̇(θ_s)) ∞, unless
+/// ψ̇(θ_s) = 0 (θ_s = π/2 or κ = 0). Every integer of that sign is then a resonance arbitrarily
+/// close to the separatrix. Returns the sign (−1, 0 or +1) of that limit.
+pub fn separatrix_limit_sign<S: Shape>(
+    potential: &EffectivePotential<'_, S>,
+    saddle: &CriticalPoint,
+) -> f64 {
+    let rate = potential.psi_rate(saddle.site.angle());
+    if rate == 0.0 {
+        0.0
+    } else {
+        -rate.signum()
+    }
+}
+
+/// N at the bottom of a well: the linearised ratio at the stable permanent rotation θ0
+/// (`s1`), N = −ψ̇(θ0)/ω0 with ψ̇ = −κ cosθ0/(J sin²θ0) (`dpsi`) and ω0² = V″(θ0)/B(θ0).
+/// It tends to +1/2 as θ0 → 0 and −1/2 as θ0 → π along a branch that ends at a pole
+/// (κ ∝ sin²θ0 there, V″ → 4U″). `None` unless `minimum` is a minimum with V″ > 0.
+pub fn bottom_rotation_number<S: Shape>(
+    potential: &EffectivePotential<'_, S>,
+    minimum: &CriticalPoint,
+) -> Option<f64> {
+    if minimum.kind != CriticalKind::Minimum || minimum.curvature.is_nan() {
+        return None;
+    }
+    let a = minimum.site.angle();
+    if potential.kappa == 0.0 {
+        return Some(0.0);
+    }
+    if minimum.curvature <= 0.0 {
+        return None;
+    }
+    let red = potential.body.reduction_at(a);
+    let omega = (minimum.curvature / red.reduced_inertia).sqrt();
+    Some(-potential.psi_rate(a) / omega)
+}
+
+/// H(x) = (√B/J − 1) / sin²θ at cosθ = x: ((1 − ν)/η + (U′/sinθ)²) / (J (√B + J)).
+#[inline]
+fn excess_ratio<S: Shape>(body: &Body<S>, x: f64) -> (f64, f64) {
+    let sin = ((1.0 - x) * (1.0 + x)).max(0.0).sqrt();
+    let a = Angle { sin, cos: x };
+    let red = body.reduction_at(a);
+    let q = body.shape.potential_prime_over_sin_at(a);
+    let num = (1.0 - body.nu) / body.eta + q * q;
+    let j = red.integral_factor;
+    let h = num / (j * (red.reduced_inertia.sqrt() + j));
+    // Its rounding: a few ulps of each factor.
+    (h, 16.0 * f64::EPSILON * h.abs())
+}
+
+/// The fewest trapezoid intervals before the convergence test is trusted: H varies on the
+/// shape's own angular scale (β near the equator of a prolate ellipsoid, 1/β near the poles
+/// of an oblate one), and a coarser rule could agree with itself without seeing it.
+fn first_intervals<S: Shape>(body: &Body<S>) -> usize {
+    let scale = body.shape.angular_feature_scale().clamp(1e-6, 1.0);
+    (32.0 / scale).ceil() as usize
+}
+
+/// ∫_0^{π/2} sin u [H(x₀ sin u) − H(−x₀ sin u)] du by the trapezoid rule, doubled until two
+/// successive differences are below `abs_tol`; returns the value and a bound on its error
+/// (the last difference plus the rounding of the sum).
+fn odd_part_integral<S: Shape>(body: &Body<S>, x0: f64, abs_tol: f64) -> Estimate {
+    let g = |u: f64| -> (f64, f64) {
+        let s = u.sin();
+        let (hp, ep) = excess_ratio(body, x0 * s);
+        let (hm, em) = excess_ratio(body, -x0 * s);
+        (s * (hp - hm), s * (hp.abs() + hm.abs() + ep + em))
+    };
+    const MAX_INTERVALS: usize = 1 << 22;
+    let mut m = first_intervals(body).next_power_of_two();
+    let h0 = FRAC_PI_2 / m as f64;
+    let (end, end_abs) = g(FRAC_PI_2);
+    let (mut sum, mut abs) = (0.5 * end, 0.5 * end_abs);
+    for k in 1..m {
+        let (v, a) = g(k as f64 * h0);
+        sum += v;
+        abs += a;
+    }
+    let mut value = sum * h0;
+    let mut last_diff = f64::INFINITY;
+    loop {
+        let h = FRAC_PI_2 / m as f64;
+        let (mut add, mut add_abs) = (0.0, 0.0);
+        for k in 0..m {
+            let (v, a) = g((k as f64 + 0.5) * h);
+            add += v;
+            add_abs += a;
+        }
+        sum += add;
+        abs += add_abs;
+        m *= 2;
+        let next = sum * FRAC_PI_2 / m as f64;
+        let diff = (next - value).abs();
+        let rounding = 8.0 * f64::EPSILON * abs * FRAC_PI_2 / m as f64;
+        value = next;
+        if (diff <= abs_tol && last_diff <= abs_tol.max(diff * 16.0)) || m >= MAX_INTERVALS {
+            return Estimate {
+                value,
+                error: diff + rounding,
+            };
+        }
+        last_diff = diff;
+    }
+}
+
+/// N∞(λ): the rotation number in the limit ε → ∞ at fixed λ = κ/√ε, for 0 ≤ λ ≤ √2 (the
+/// allowed set is sinθ ≥ λ/√2), to the absolute accuracy `tol`.
+pub fn high_energy_rotation_number<S: Shape>(
+    body: &Body<S>,
+    lambda: f64,
+    tol: f64,
+) -> Result<Estimate> {
+    check_range(
+        "lambda",
+        lambda,
+        Some((0.0, true)),
+        Some((SQRT_2, true)),
+        "must satisfy 0 <= lambda <= sqrt(2) (no motion above: kappa^2/2 <= energy)",
+    )?;
+    let x0 = ((1.0 - lambda / SQRT_2) * (1.0 + lambda / SQRT_2)).max(0.0).sqrt();
+    let factor = lambda * x0 / (SQRT_2 * PI);
+    if factor == 0.0 {
+        return Ok(Estimate {
+            value: 0.0,
+            error: 0.0,
+        });
+    }
+    let integral = odd_part_integral(body, x0, 0.25 * tol / factor);
+    Ok(Estimate {
+        value: factor * integral.value,
+        error: factor * integral.error + 4.0 * f64::EPSILON * (factor * integral.value).abs(),
+    })
+}
+
+/// lim N∞(λ)/λ as λ → 0: how N tends to 0 at fixed κ as ε → ∞ (N ≈ slope · κ/√ε).
+pub fn high_energy_slope<S: Shape>(body: &Body<S>, tol: f64) -> Estimate {
+    let factor = 1.0 / (SQRT_2 * PI);
+    let integral = odd_part_integral(body, 1.0, 0.25 * tol / factor);
+    Estimate {
+        value: factor * integral.value,
+        error: factor * integral.error,
+    }
+}
+
+/// The high-energy limit of one body: the slope of N∞ at λ → 0 and its extrema over
+/// 0 < λ < √2 (SPEC §4 contract `high_energy`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct HighEnergyLimit {
+    /// lim N∞(λ)/λ as λ → 0.
+    pub slope: f64,
+    /// min N∞ (0 when N∞ ≥ 0: reached at λ → 0 and λ = √2).
+    pub n_min: f64,
+    /// Where N∞ is smallest (None when N∞ ≡ 0).
+    pub lambda_at_min: Option<f64>,
+    /// max N∞ (0 when N∞ ≤ 0).
+    pub n_max: f64,
+    /// Where N∞ is largest (None when N∞ ≡ 0).
+    pub lambda_at_max: Option<f64>,
+    /// Bound on the error of `slope`.
+    pub slope_error: f64,
+    /// Bound on the error of `n_min` and `n_max` (quadrature and location).
+    pub extrema_error: f64,
+}
+
+/// Number of λ samples in the scan for the extrema of N∞ before each is refined.
+const EXTREMA_SCAN: usize = 96;
+
+impl HighEnergyLimit {
+    /// Slope and extrema of N∞ to the accuracy `tol` (values; λ to √tol or better).
+    pub fn of<S: Shape>(body: &Body<S>, tol: f64) -> Result<Self> {
+        check_range(
+            "tol",
+            tol,
+            Some((1e-15, true)),
+            Some((0.1, true)),
+            "must satisfy 1e-15 <= tol <= 0.1",
+        )?;
+        let slope = high_energy_slope(body, tol);
+        let n = |l: f64| high_energy_rotation_number(body, l, tol);
+        let lambdas: Vec<f64> = (0..=EXTREMA_SCAN)
+            .map(|i| SQRT_2 * i as f64 / EXTREMA_SCAN as f64)
+            .collect();
+        let values: Vec<Estimate> = lambdas.iter().map(|&l| n(l)).collect::<Result<_>>()?;
+        let max_error = values.iter().map(|e| e.error).fold(0.0, f64::max);
+        let flat = values.iter().all(|v| v.value.abs() <= v.error);
+        let mut extrema_error = max_error;
+        let mut refine = |sign: f64| -> Result<(f64, Option<f64>)> {
+            if flat {
+                return Ok((0.0, None));
+            }
+            let i = (1..EXTREMA_SCAN)
+                .max_by(|&a, &b| (sign * values[a].value).total_cmp(&(sign * values[b].value)))
+                .expect("the scan has interior points");
+            if sign * values[i].value <= 0.0 {
+                // No interior value of this sign: the extremum is the limit 0 at λ → 0.
+                return Ok((0.0, Some(0.0)));
+            }
+            let (l, v) = golden_max(
+                |l| n(l).map(|e| sign * e.value).unwrap_or(f64::NEG_INFINITY),
+                lambdas[i - 1],
+                lambdas[i + 1],
+                1e-10,
+            );
+            extrema_error = extrema_error.max(n(l)?.error);
+            Ok((sign * v, Some(l)))
+        };
+        let (n_max, lambda_at_max) = refine(1.0)?;
+        let (n_min, lambda_at_min) = refine(-1.0)?;
+        Ok(Self {
+            slope: slope.value,
+            n_min,
+            lambda_at_min,
+            n_max,
+            lambda_at_max,
+            slope_error: slope.error,
+            extrema_error,
+        })
+    }
+}
+
+/// The maximum of a unimodal `f` on [a, b] by golden-section search to |b − a| ≤ `xtol`:
+/// (argmax, max).
+pub fn golden_max(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64, xtol: f64) -> (f64, f64) {
+    let ratio = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut c, mut d) = (b - ratio * (b - a), a + ratio * (b - a));
+    let (mut fc, mut fd) = (f(c), f(d));
+    while (b - a).abs() > xtol {
+        if fc > fd {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - ratio * (b - a);
+            fc = f(c);
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + ratio * (b - a);
+            fd = f(d);
+        }
+    }
+    if fc > fd {
+        (c, fc)
+    } else {
+        (d, fd)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::EllipsoidBody;
+
+    #[test]
+    fn symmetric_body_has_no_high_energy_rotation() {
+        let body = EllipsoidBody::ellipsoid(0.0, 0.5, 0.5, 0.5).unwrap();
+        let lim = HighEnergyLimit::of(&body, 1e-12).unwrap();
+        assert_eq!((lim.n_min, lim.n_max, lim.slope), (0.0, 0.0, 0.0));
+        assert!(lim.lambda_at_min.is_none());
+    }
+
+    #[test]
+    fn lambda_out_of_range_is_refused() {
+        let body = EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 0.5).unwrap();
+        assert!(high_energy_rotation_number(&body, 1.5, 1e-10).is_err());
+        assert!(high_energy_rotation_number(&body, f64::NAN, 1e-10).is_err());
+        assert_eq!(
+            high_energy_rotation_number(&body, SQRT_2, 1e-10)
+                .unwrap()
+                .value,
+            0.0
+        );
+    }
+}

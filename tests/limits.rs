@@ -1,0 +1,162 @@
+//! The limits of the (κ, ε) plane (src/limits.rs) against cells solved by the quadrature of
+//! src/torus.rs at finite κ and ε: the high-energy limit N∞(λ) against cells at ε = 10⁸ …
+//! 10¹², its slope against N·√ε/κ at fixed κ, the bottom of each well against
+//! small-amplitude cells, and the κ → 0 limits against cells at κ = 1e-7.
+
+use rubber_atlas::cell::{solve_cell, CellOptions};
+use rubber_atlas::limits::{
+    bottom_rotation_number, high_energy_rotation_number, high_energy_slope, small_kappa_limit,
+    HighEnergyLimit,
+};
+use rubber_atlas::torus::{CriticalKind, EffectivePotential};
+use rubber_atlas::EllipsoidBody;
+
+/// The bodies: the paper's type (c), the issue's counterexamples (a prolate type (a) and the
+/// strongly oblate α = 0.9, β = 20), extreme shapes and masses.
+const BODIES: [(f64, f64, f64, f64); 7] = [
+    (0.5, 3.0, 0.5, 0.5),
+    (0.5, 0.5, 0.5, 0.5),
+    (0.9, 20.0, 0.5, 0.5),
+    (0.2, 0.05, 1.2, 3.0),
+    (0.7, 1.1, 2.0, 0.1),
+    (0.3, 300.0, 0.1, 30.0),
+    (0.999, 2.0, 0.5, 0.5),
+];
+
+fn options(tol: f64) -> CellOptions {
+    CellOptions {
+        tol,
+        drift: false,
+        ..CellOptions::default()
+    }
+}
+
+/// The only component's N at (κ, ε).
+fn cell_n(body: &EllipsoidBody, kappa: f64, energy: f64) -> (f64, f64) {
+    let r = solve_cell(body, kappa, energy, &options(1e-12)).unwrap();
+    assert_eq!(r.components.len(), 1, "κ = {kappa}, ε = {energy}");
+    let c = &r.components[0];
+    (c.rotation_number, c.error_estimate)
+}
+
+#[test]
+fn high_energy_limit_is_where_cells_converge() {
+    for (alpha, beta, nu, eta) in BODIES {
+        let body = EllipsoidBody::ellipsoid(alpha, beta, nu, eta).unwrap();
+        for lambda in [0.02, 0.06399, 0.3, 0.9, 1.3, 1.41] {
+            let limit = high_energy_rotation_number(&body, lambda, 1e-13).unwrap();
+            assert!(limit.error < 1e-12, "{limit:?}");
+            let mut diffs = Vec::new();
+            for energy in [1e8, 1e10, 1e12] {
+                let (n, err) = cell_n(&body, lambda * f64::sqrt(energy), energy);
+                diffs.push(((n - limit.value).abs(), err + limit.error));
+            }
+            let ctx = format!("α = {alpha}, β = {beta}, λ = {lambda}: {limit:?}, {diffs:?}");
+            // N(ε) − N∞ = O(1/ε): from 1e8 to 1e12 the gap shrinks 10⁴-fold down to the
+            // solvers' own error. FLOOR: at ε = 1e12 and β = 300 the cell solver strays by
+            // 2e-12 from N∞ against its estimate of 1.7e-13 (rounding of ε − V with
+            // V ≈ 1e12; issue 12), while N∞ itself is stable to 1e-14 across tolerances.
+            const FLOOR: f64 = 5e-12;
+            assert!(diffs[0].0 < 1e-5, "{ctx}");
+            assert!(diffs[2].0 <= 1e-3 * diffs[0].0 + 2.0 * diffs[2].1 + FLOOR, "{ctx}");
+            assert!(diffs[1].0 <= 0.1 * diffs[0].0 + 2.0 * diffs[1].1 + FLOOR, "{ctx}");
+        }
+    }
+}
+
+#[test]
+fn slope_is_the_rate_at_which_n_vanishes_at_fixed_kappa() {
+    for (alpha, beta, nu, eta) in BODIES {
+        let body = EllipsoidBody::ellipsoid(alpha, beta, nu, eta).unwrap();
+        let slope = high_energy_slope(&body, 1e-13);
+        // N∞(λ)/λ → slope as λ → 0, and cells at ε = 1e12 follow it. The linear regime
+        // starts where the orbit stays out of the poles' features, λ ≪ 1/β² for β > 1.
+        let linear = 1e-4 / beta.max(1.0).powi(2);
+        let tiny = high_energy_rotation_number(&body, linear, 1e-15).unwrap();
+        assert!(
+            (tiny.value / linear - slope.value).abs() <= 1e-3 * (1.0 + slope.value.abs()),
+            "α = {alpha}, β = {beta}: {tiny:?} vs {slope:?}"
+        );
+        let (n, err) = cell_n(&body, linear * 1e6, 1e12);
+        assert!(
+            (n / linear - slope.value).abs() <= 1e-3 * (1.0 + slope.value.abs()) + err / linear,
+            "α = {alpha}, β = {beta}: N·√ε/κ = {} vs slope {slope:?}",
+            n / linear
+        );
+    }
+}
+
+#[test]
+fn extrema_of_the_limit_match_the_strongly_oblate_body() {
+    // SPEC §4: cells along λ = 0.06399 at ε = 1e4 … 1e16 give N → −1.7611358 for
+    // α = 0.9, β = 20, ν = η = 0.5: below −1, so N = −1 is crossed at every large κ.
+    let body = EllipsoidBody::ellipsoid(0.9, 20.0, 0.5, 0.5).unwrap();
+    let lim = HighEnergyLimit::of(&body, 1e-12).unwrap();
+    assert!((lim.n_min + 1.7611358).abs() < 2e-7, "{lim:?}");
+    let at = lim.lambda_at_min.unwrap();
+    assert!((at - 0.064).abs() < 0.01, "{lim:?}");
+    // A minimum: N∞ is larger on either side, and the cell there agrees.
+    for d in [-1e-3, 1e-3] {
+        let side = high_energy_rotation_number(&body, at + d, 1e-12).unwrap();
+        assert!(side.value > lim.n_min, "{side:?} {lim:?}");
+    }
+    let (n, _) = cell_n(&body, at * 1e6, 1e12);
+    assert!((n - lim.n_min).abs() < 1e-9, "{n} vs {lim:?}");
+}
+
+#[test]
+fn bottom_limit_is_the_small_amplitude_limit_of_cells() {
+    for (alpha, beta, nu, eta) in BODIES {
+        let body = EllipsoidBody::ellipsoid(alpha, beta, nu, eta).unwrap();
+        for kappa in [1e-3, 0.3, 1.0, 4.0, 50.0] {
+            let potential = EffectivePotential::new(&body, kappa);
+            for m in potential
+                .critical_points()
+                .iter()
+                .filter(|p| p.kind == CriticalKind::Minimum)
+            {
+                let nb = bottom_rotation_number(&potential, m).unwrap();
+                // N(ε) − N_bottom = O(ε − V_min): two amplitudes, the gap shrinks with it.
+                let gap = |rel: f64| {
+                    let energy = m.value + rel * m.value.abs().max(1.0);
+                    let r = solve_cell(&body, kappa, energy, &options(1e-12)).unwrap();
+                    let c = r
+                        .components
+                        .iter()
+                        .find(|c| c.theta_min <= m.site.theta && m.site.theta <= c.theta_max)
+                        .unwrap();
+                    (c.rotation_number - nb).abs()
+                };
+                let (g1, g2) = (gap(1e-6), gap(1e-8));
+                let ctx = format!("α = {alpha}, β = {beta}, κ = {kappa}: N_b = {nb}, {g1}, {g2}");
+                assert!(g1 < 1e-3 * (1.0 + nb.abs()), "{ctx}");
+                assert!(g2 <= 0.02 * g1 + 1e-11, "{ctx}");
+            }
+        }
+    }
+}
+
+#[test]
+fn small_kappa_limits_match_cells() {
+    // α = 0.5, β = 0.5 (type (a)): U is highest at θ = 0 (1.5) and lowest near θ = 2;
+    // below ε_min = 1.5 the κ = 0 librations pass through θ = π only, above it both poles.
+    let body = EllipsoidBody::ellipsoid(0.5, 0.5, 0.5, 0.5).unwrap();
+    let (n, _) = cell_n(&body, 1e-7, 1.0);
+    assert!((n - small_kappa_limit(false, true)).abs() < 1e-6, "{n}");
+    let (n, _) = cell_n(&body, 1e-7, 3.0);
+    assert!((n - small_kappa_limit(true, true)).abs() < 1e-6, "{n}");
+    // The paper's type (c) body: the well of σ_s0 around θ = 0 at ε < U(θ*).
+    let body = EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 0.5).unwrap();
+    let r = solve_cell(&body, 1e-7, 2.0, &options(1e-12)).unwrap();
+    let near_zero = r.components.iter().find(|c| c.theta_max < 1.0).unwrap();
+    assert!((near_zero.rotation_number - small_kappa_limit(true, false)).abs() < 1e-6);
+    // On the bottom curve the same limits: the branch σ_s0 ends at θ0 = 0 with N = +1/2.
+    let potential = EffectivePotential::new(&body, 1e-6);
+    let m = potential
+        .critical_points()
+        .iter()
+        .find(|p| p.kind == CriticalKind::Minimum && p.site.theta < 0.1)
+        .unwrap();
+    let nb = bottom_rotation_number(&potential, m).unwrap();
+    assert!((nb - 0.5).abs() < 1e-5, "{nb}");
+}
