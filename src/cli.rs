@@ -14,6 +14,7 @@ use rubber_atlas::store::{write_table, Column};
 use rubber_atlas::sweep::{self, RunRequest};
 use rubber_atlas::torus::EffectivePotential;
 use rubber_atlas::trajectory::{integrate, Model, Start};
+use rubber_atlas::verdict::{self, VerdictOptions};
 use rubber_atlas::EllipsoidBody;
 use std::path::PathBuf;
 
@@ -44,6 +45,63 @@ pub enum Command {
     /// by continuation with the cell solver; with --fold, the fold κ_max of the curve of
     /// largest κ (N = P/Q, ∂N/∂ε = 0).
     Resonance(ResonanceArgs),
+    /// The paper's boundedness hypothesis for one body over the whole (κ, ε) plane: its case,
+    /// whether it holds, κ_max, counterexamples on integer resonances and the high-energy
+    /// limit N∞(λ); with --boundaries, the β at which the verdict changes for one α.
+    Verdict(VerdictArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct VerdictArgs {
+    /// α = a/b3: displacement of the centre of mass along the axis, 0 <= α < 1.
+    #[arg(long, allow_negative_numbers = true)]
+    pub alpha: f64,
+    /// β = b1/b3 (not with --boundaries).
+    #[arg(
+        long,
+        allow_negative_numbers = true,
+        required_unless_present = "boundaries",
+        conflicts_with = "boundaries"
+    )]
+    pub beta: Option<f64>,
+    /// ν = i3/i1, 0 < ν <= 2.
+    #[arg(long, allow_negative_numbers = true)]
+    pub nu: f64,
+    /// η = m b3²/i1 > 0.
+    #[arg(long, allow_negative_numbers = true)]
+    pub eta: f64,
+    /// The β at which the verdict changes along β at this α, each by root-finding.
+    #[arg(long)]
+    pub boundaries: bool,
+    /// Smallest β searched by --boundaries.
+    #[arg(
+        long,
+        default_value_t = 0.05,
+        allow_negative_numbers = true,
+        requires = "boundaries"
+    )]
+    pub beta_min: f64,
+    /// Largest β searched by --boundaries.
+    #[arg(
+        long,
+        default_value_t = 50.0,
+        allow_negative_numbers = true,
+        requires = "boundaries"
+    )]
+    pub beta_max: f64,
+    /// Log-spaced β of the scan behind --boundaries (the line β² = 1 + α is added).
+    #[arg(long, default_value_t = 48, requires = "boundaries")]
+    pub scan: usize,
+    /// Tolerance of the cell solver (N at a counterexample equals the integer to this).
+    #[arg(long, default_value_t = 1e-10, allow_negative_numbers = true)]
+    pub tol: f64,
+    /// κ-lines of each kind and energies per line of the sampling (doubling it halves the
+    /// spacing).
+    #[arg(long, default_value_t = 64)]
+    pub resolution: usize,
+    /// Print one JSON object (SPEC §4 contract).
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[derive(Debug, Args)]
@@ -302,6 +360,136 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Run(args) => run_scene(args),
         Command::Merge(args) => merge(args),
         Command::Resonance(args) => resonance(args),
+        Command::Verdict(args) => verdict(args),
+    }
+}
+
+fn verdict(args: VerdictArgs) -> Result<()> {
+    let options = VerdictOptions {
+        tol: args.tol,
+        resolution: args.resolution,
+    };
+    if args.boundaries {
+        let found = verdict::boundaries(
+            args.alpha,
+            args.nu,
+            args.eta,
+            &verdict::BoundaryOptions {
+                beta_min: args.beta_min,
+                beta_max: args.beta_max,
+                scan: args.scan,
+                verdict: options,
+            },
+        )?;
+        if args.json {
+            println!("{}", serde_json::to_string_pretty(&found)?);
+        } else {
+            println!(
+                "alpha = {} (nu = {}, eta = {}): the verdict along beta in [{}, {}]",
+                found.alpha, found.nu, found.eta, found.beta_range[0], found.beta_range[1]
+            );
+            let side = |c: verdict::Case, h: Option<bool>| match h {
+                None => "not covered".to_string(),
+                Some(h) => format!(
+                    "case {} {}",
+                    serde_json::to_value(c)
+                        .unwrap_or_default()
+                        .as_str()
+                        .unwrap_or("?"),
+                    if h { "holds" } else { "fails" }
+                ),
+            };
+            for b in &found.boundaries {
+                println!(
+                    "  beta = {:.10} +- {:.1e}: {} below, {} above ({})",
+                    b.beta,
+                    b.error,
+                    side(b.case_below, b.holds_below),
+                    side(b.case_above, b.holds_above),
+                    b.quantity
+                );
+            }
+        }
+        return Ok(());
+    }
+    let beta = args.beta.unwrap_or(1.0);
+    let body = EllipsoidBody::ellipsoid(args.alpha, beta, args.nu, args.eta)?;
+    let v = verdict::verdict(&body, &options)?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&v)?);
+        return Ok(());
+    }
+    print_verdict(&v);
+    Ok(())
+}
+
+fn print_verdict(v: &verdict::Verdict) {
+    use verdict::Case;
+    println!(
+        "ellipsoid alpha = {}, beta = {} (nu = {}, eta = {}): diagram type ({})",
+        v.alpha,
+        v.beta,
+        v.nu,
+        v.eta,
+        v.diagram_type.label()
+    );
+    let case = match v.case {
+        Case::One => "case 1 (beta^2 < 1 + alpha): bounded for every kappa != 0",
+        Case::Two => "case 2 (beta^2 > 1 + alpha, alpha > 0): bounded for kappa > kappa_max",
+        Case::NotCovered => {
+            "not covered by the hypothesis (alpha = 0 with beta >= 1, or beta^2 = 1 + alpha)"
+        }
+    };
+    println!("  hypothesis: {case}");
+    if let (Some(k), Some(e)) = (v.kappa_max, v.kappa_max_error) {
+        println!("  kappa_max = {k:.10} (+- {e:.1e}), the fold of the N = 0 curve beside sigma_u");
+    }
+    let h = &v.high_energy;
+    let at = |l: Option<f64>| l.map_or("-".to_string(), |l| format!("{l:.6}"));
+    println!(
+        "  high energy: N_inf(lambda) ~ {:.6e} lambda at lambda -> 0; min {:.10} at lambda = {}; max {:.10} at lambda = {}",
+        h.slope,
+        h.n_min,
+        at(h.lambda_at_min),
+        h.n_max,
+        at(h.lambda_at_max)
+    );
+    match v.holds {
+        None => println!("  verdict: not covered"),
+        Some(true) => println!("  verdict: HOLDS (fail margin {:.3e})", v.fail_margin),
+        Some(false) => println!("  verdict: FAILS (fail margin {:.3e})", v.fail_margin),
+    }
+    if let Some(reason) = &v.evidence.limit_failure {
+        println!("  by the limit: {reason}");
+    }
+    for c in &v.counterexamples {
+        println!(
+            "  counterexample: N = {} at kappa = {:.12}, energy = {:.12} (N = {:.3e} +- {:.1e}, theta in [{:.6}, {:.6}], drift {:.6} per period)",
+            c.integer,
+            c.kappa,
+            c.energy,
+            c.rotation_number,
+            c.error_estimate,
+            c.theta_min,
+            c.theta_max,
+            c.drift
+        );
+    }
+    if v.holds.is_some() {
+        let e = &v.evidence;
+        println!(
+            "  evidence: {} kappa-lines from {:.3e} to {:.0e}, {} energies per line, {} tori solved, N in [{:.6}, {:.6}]",
+            e.kappa_lines,
+            e.kappa_range[0],
+            e.kappa_range[1],
+            e.energies_per_line,
+            e.components_solved,
+            e.rotation_number_range[0],
+            e.rotation_number_range[1]
+        );
+        for l in &e.limits {
+            println!("    {l}");
+        }
     }
 }
 
@@ -787,8 +975,12 @@ fn print_diagram(set: &CriticalSet) {
         println!("  equator sigma_pi2 stable for |kappa| > {k:.12}");
     }
     for b in &set.branches {
+        let bottom = b
+            .rotation_number_range
+            .map(|[lo, hi]| format!("  N at the bottom in [{lo:.6}, {hi:.6}]"))
+            .unwrap_or_default();
         println!(
-            "  branch {:<10} {:<8} theta0 in [{:.6}, {:.6}]  kappa in [{:.6}, {:.6}]  eps in [{:.6}, {:.6}]",
+            "  branch {:<10} {:<8} theta0 in [{:.6}, {:.6}]  kappa in [{:.6}, {:.6}]  eps in [{:.6}, {:.6}]{bottom}",
             b.name,
             if b.stable { "stable" } else { "unstable" },
             b.theta0_range[0],
@@ -802,7 +994,7 @@ fn print_diagram(set: &CriticalSet) {
 }
 
 /// (name, units, long_name) of the columns `diagram --out` writes, in order.
-const DIAGRAM_COLUMNS: [(&str, &str, &str); 8] = [
+const DIAGRAM_COLUMNS: [(&str, &str, &str); 9] = [
     (
         "segment",
         "1",
@@ -823,11 +1015,16 @@ const DIAGRAM_COLUMNS: [(&str, &str, &str); 8] = [
     ("stable", "1", "1 linearly stable (centre), 0 unstable"),
     ("rho_c", "b3", "radius of the circle of the centre of mass"),
     ("rho_p", "b3", "radius of the circle of the contact point"),
+    (
+        "rotation_number",
+        "1",
+        "rotation number of the small oscillations, -psi_dot/omega0 (NaN where unstable)",
+    ),
 ];
 
 fn write_diagram(out: &std::path::Path, set: &CriticalSet) -> Result<()> {
     let names = ["sigma_s0", "sigma_u", "sigma_spi", "sigma_pi2"];
-    let mut cols: [Vec<f64>; 8] = Default::default();
+    let mut cols: [Vec<f64>; 9] = Default::default();
     for (i, b) in set.branches.iter().enumerate() {
         let code = names.iter().position(|n| *n == b.name).unwrap_or(0) as f64;
         for p in &b.points {
@@ -840,6 +1037,7 @@ fn write_diagram(out: &std::path::Path, set: &CriticalSet) -> Result<()> {
                 if p.stable { 1.0 } else { 0.0 },
                 p.rho_c,
                 p.rho_p,
+                p.rotation_number.unwrap_or(f64::NAN),
             ]) {
                 col.push(v);
             }

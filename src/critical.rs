@@ -92,6 +92,9 @@ pub struct FixedPoint {
     pub rho_c: f64,
     /// Radius of the circle of the contact point, ρ_p = β² tanθ0 / Z.
     pub rho_p: f64,
+    /// The rotation number of the small oscillations about it, N = −ψ̇(θ0)/ω0 (the bottom of
+    /// the well, [`crate::limits::linearised_rotation_number`]); None where unstable.
+    pub rotation_number: Option<f64>,
 }
 
 /// A run of fixed points with one stability along one branch.
@@ -108,6 +111,9 @@ pub struct Branch {
     pub kappa_range: [f64; 2],
     /// [min, max] of ε over the run.
     pub energy_range: [f64; 2],
+    /// [min, max] of the linearised rotation number over a stable run (the bottom of the
+    /// (κ, ε) plane); None on an unstable one.
+    pub rotation_number_range: Option<[f64; 2]>,
     /// Points ordered by θ0 (by κ on σ_π/2); written by `--out`, not in the JSON summary.
     #[serde(skip)]
     pub points: Vec<FixedPoint>,
@@ -187,6 +193,7 @@ pub fn fixed_point(body: &EllipsoidBody, theta0: f64) -> FixedPoint {
         stable: sys.effective_potential_second(theta0) > 0.0,
         rho_c: z * s / c + body.shape.alpha * s,
         rho_p: b2 * s / (c * z),
+        rotation_number: crate::limits::linearised_rotation_number(body, theta0, kappa),
     }
 }
 
@@ -333,13 +340,16 @@ impl CriticalSet {
             let mut run: Vec<FixedPoint> = Vec::new();
             let push_point = |kappa: f64, run: &mut Vec<FixedPoint>, force: Option<bool>| {
                 let v2 = kappa * kappa - (beta * beta - 1.0) / beta;
+                let stable = force.unwrap_or(v2 > 0.0);
                 run.push(FixedPoint {
                     theta0: FRAC_PI_2,
                     kappa,
                     energy: 0.5 * kappa * kappa + beta,
-                    stable: force.unwrap_or(v2 > 0.0),
+                    stable,
                     rho_c: f64::INFINITY,
                     rho_p: f64::INFINITY,
+                    // ψ̇ = 0 on the equator: the librations about it do not precess.
+                    rotation_number: stable.then_some(0.0),
                 });
             };
             for i in 0..=samples {
@@ -392,12 +402,21 @@ fn make_branch(points: Vec<FixedPoint>, stable_name: &'static str) -> Branch {
                 [lo.min(x), hi.max(x)]
             })
     };
+    let rotation_number_range = stable.then(|| {
+        points
+            .iter()
+            .filter_map(|p| p.rotation_number)
+            .fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], x| {
+                [lo.min(x), hi.max(x)]
+            })
+    });
     Branch {
         name,
         stable,
         theta0_range: range(|p| p.theta0),
         kappa_range: range(|p| p.kappa),
         energy_range: range(|p| p.energy),
+        rotation_number_range,
         points,
     }
 }

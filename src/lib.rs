@@ -19,6 +19,8 @@
 //! - [`torus`]: one level set (κ, ε): its components, turning points, period and precession.
 //! - [`trajectory`]: time histories from either model; [`ode`] wraps the DOP853 integrator.
 //! - [`resonance`]: curves N = p/q by continuation, and the fold κ_max.
+//! - [`verdict`]: the boundedness hypothesis for one body over the whole (κ, ε) plane, and
+//!   the β at which its verdict changes.
 //! - [`scene`]: the TOML scene files of atlas runs.
 //! - [`atlas`]: the grid driver — work units, rayon over κ-rows, dense per-cell arrays.
 //! - [`store`]: CSV and HDF5 output, the atlas file and the resume journal.
@@ -46,6 +48,7 @@ pub mod store;
 pub mod sweep;
 pub mod torus;
 pub mod trajectory;
+pub mod verdict;
 
 pub use body::{Angle, Body, Ellipsoid, EllipsoidBody, Shape};
 pub use error::{AtlasError, Result};

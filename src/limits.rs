@@ -61,7 +61,36 @@ pub fn separatrix_limit_sign<S: Shape>(
 /// N at the bottom of a well: the linearised ratio at the stable permanent rotation θ0
 /// (`s1`), N = −ψ̇(θ0)/ω0 with ψ̇ = −κ cosθ0/(J sin²θ0) (`dpsi`) and ω0² = V″(θ0)/B(θ0).
 /// It tends to +1/2 as θ0 → 0 and −1/2 as θ0 → π along a branch that ends at a pole
-/// (κ ∝ sin²θ0 there, V″ → 4U″). `None` unless `minimum` is a minimum with V″ > 0.
+/// (κ ∝ sin²θ0 there, V″ → 4U″), which is the value returned at a pole itself. `None` where
+/// the permanent rotation is not stable (V″ ≤ 0).
+pub fn linearised_rotation_number<S: Shape>(
+    body: &Body<S>,
+    theta0: f64,
+    kappa: f64,
+) -> Option<f64> {
+    if theta0 <= 0.0 {
+        return (body.shape.potential_second(0.0) > 0.0).then_some(0.5);
+    }
+    if theta0 >= PI {
+        return (body.shape.potential_second(PI) > 0.0).then_some(-0.5);
+    }
+    let curvature =
+        crate::reduced::ReducedSystem::new(body, kappa).effective_potential_second(theta0);
+    if curvature.is_nan() || curvature <= 0.0 {
+        return None;
+    }
+    if kappa == 0.0 {
+        return Some(0.0);
+    }
+    let a = Angle::new(theta0);
+    let red = body.reduction_at(a);
+    let omega = (curvature / red.reduced_inertia).sqrt();
+    let psi_rate = -kappa * a.cos / (red.integral_factor * a.sin * a.sin);
+    Some(-psi_rate / omega)
+}
+
+/// [`linearised_rotation_number`] at a minimum of V found by the cell solver (its θ held
+/// to full precision near θ = π).
 pub fn bottom_rotation_number<S: Shape>(
     potential: &EffectivePotential<'_, S>,
     minimum: &CriticalPoint,
@@ -103,9 +132,10 @@ fn first_intervals<S: Shape>(body: &Body<S>) -> usize {
     (32.0 / scale).ceil() as usize
 }
 
-/// ∫_0^{π/2} sin u [H(x₀ sin u) − H(−x₀ sin u)] du by the trapezoid rule, doubled until two
-/// successive differences are below `abs_tol`; returns the value and a bound on its error
-/// (the last difference plus the rounding of the sum).
+/// ∫_0^{π/2} sin u [H(x₀ sin u) − H(−x₀ sin u)] du by the trapezoid rule, doubled from at
+/// least [`first_intervals`] until a doubling changes the value by at most `abs_tol`; returns
+/// the value and a bound on its error: that last change (for a geometrically converging
+/// rule the error of the finer sum is far below it) plus the rounding of the sum.
 fn odd_part_integral<S: Shape>(body: &Body<S>, x0: f64, abs_tol: f64) -> Estimate {
     let g = |u: f64| -> (f64, f64) {
         let s = u.sin();
@@ -124,7 +154,6 @@ fn odd_part_integral<S: Shape>(body: &Body<S>, x0: f64, abs_tol: f64) -> Estimat
         abs += a;
     }
     let mut value = sum * h0;
-    let mut last_diff = f64::INFINITY;
     loop {
         let h = FRAC_PI_2 / m as f64;
         let (mut add, mut add_abs) = (0.0, 0.0);
@@ -140,13 +169,12 @@ fn odd_part_integral<S: Shape>(body: &Body<S>, x0: f64, abs_tol: f64) -> Estimat
         let diff = (next - value).abs();
         let rounding = 8.0 * f64::EPSILON * abs * FRAC_PI_2 / m as f64;
         value = next;
-        if (diff <= abs_tol && last_diff <= abs_tol.max(diff * 16.0)) || m >= MAX_INTERVALS {
+        if diff <= abs_tol || m >= MAX_INTERVALS {
             return Estimate {
                 value,
                 error: diff + rounding,
             };
         }
-        last_diff = diff;
     }
 }
 
@@ -164,7 +192,9 @@ pub fn high_energy_rotation_number<S: Shape>(
         Some((SQRT_2, true)),
         "must satisfy 0 <= lambda <= sqrt(2) (no motion above: kappa^2/2 <= energy)",
     )?;
-    let x0 = ((1.0 - lambda / SQRT_2) * (1.0 + lambda / SQRT_2)).max(0.0).sqrt();
+    let x0 = ((1.0 - lambda / SQRT_2) * (1.0 + lambda / SQRT_2))
+        .max(0.0)
+        .sqrt();
     let factor = lambda * x0 / (SQRT_2 * PI);
     if factor == 0.0 {
         return Ok(Estimate {
@@ -176,6 +206,35 @@ pub fn high_energy_rotation_number<S: Shape>(
     Ok(Estimate {
         value: factor * integral.value,
         error: factor * integral.error + 4.0 * f64::EPSILON * (factor * integral.value).abs(),
+    })
+}
+
+/// Ñ(λ) = N∞(λ) / (λ x₀²) = ∫ … du / (√2 π x₀), x₀² = 1 − λ²/2: N∞ with its two zeros
+/// at the ends divided out. It has the sign of N∞ on (0, √2) and finite, generically
+/// non-zero, values at both ends (the slope at λ = 0), so a lobe of N∞ of the other sign
+/// appears exactly when min Ñ or max Ñ crosses 0: the quantity that decides it.
+pub fn normalized_high_energy_rotation_number<S: Shape>(
+    body: &Body<S>,
+    lambda: f64,
+    tol: f64,
+) -> Result<Estimate> {
+    check_range(
+        "lambda",
+        lambda,
+        Some((0.0, true)),
+        Some((SQRT_2, true)),
+        "must satisfy 0 <= lambda <= sqrt(2)",
+    )?;
+    // At λ = √2 the limit x₀ → 0, approached to O(x₀²) = 1e-16.
+    let x0 = ((1.0 - lambda / SQRT_2) * (1.0 + lambda / SQRT_2))
+        .max(0.0)
+        .sqrt()
+        .max(1e-8);
+    let factor = 1.0 / (SQRT_2 * PI * x0);
+    let integral = odd_part_integral(body, x0, 0.25 * tol / factor);
+    Ok(Estimate {
+        value: factor * integral.value,
+        error: factor * integral.error,
     })
 }
 
@@ -203,6 +262,10 @@ pub struct HighEnergyLimit {
     pub n_max: f64,
     /// Where N∞ is largest (None when N∞ ≡ 0).
     pub lambda_at_max: Option<f64>,
+    /// min and max of Ñ = N∞/(λ x₀²) over [0, √2]: N∞ takes both signs (an N = 0
+    /// resonance at every large κ) exactly when normalized_min < 0 < normalized_max.
+    pub normalized_min: f64,
+    pub normalized_max: f64,
     /// Bound on the error of `slope`.
     pub slope_error: f64,
     /// Bound on the error of `n_min` and `n_max` (quadrature and location).
@@ -212,8 +275,34 @@ pub struct HighEnergyLimit {
 /// Number of λ samples in the scan for the extrema of N∞ before each is refined.
 const EXTREMA_SCAN: usize = 96;
 
+/// N∞(λ) and Ñ(λ) from one integral, each to the absolute accuracy `tol`.
+pub fn high_energy_pair<S: Shape>(body: &Body<S>, lambda: f64, tol: f64) -> (Estimate, Estimate) {
+    let x0 = ((1.0 - lambda / SQRT_2) * (1.0 + lambda / SQRT_2))
+        .max(0.0)
+        .sqrt()
+        .max(1e-8);
+    let c = SQRT_2 * PI;
+    // Ñ = I/(c x₀) and N∞ = λ x₀ I / c = λ x₀² Ñ: I to c x₀ tol/4 serves both.
+    let i = odd_part_integral(body, x0, 0.25 * c * x0 * tol);
+    let tilde = Estimate {
+        value: i.value / (c * x0),
+        error: i.error / (c * x0),
+    };
+    let scale = lambda * x0 * x0;
+    let n = Estimate {
+        value: if lambda >= SQRT_2 {
+            0.0
+        } else {
+            scale * tilde.value
+        },
+        error: scale * tilde.error + 4.0 * f64::EPSILON * (scale * tilde.value).abs(),
+    };
+    (n, tilde)
+}
+
 impl HighEnergyLimit {
-    /// Slope and extrema of N∞ to the accuracy `tol` (values; λ to √tol or better).
+    /// Slope and extrema of N∞ and Ñ to the accuracy `tol` (values; λ to 1e-8, which moves
+    /// an extremum's value by O(1e-16)).
     pub fn of<S: Shape>(body: &Body<S>, tol: f64) -> Result<Self> {
         check_range(
             "tol",
@@ -222,43 +311,63 @@ impl HighEnergyLimit {
             Some((0.1, true)),
             "must satisfy 1e-15 <= tol <= 0.1",
         )?;
-        let slope = high_energy_slope(body, tol);
-        let n = |l: f64| high_energy_rotation_number(body, l, tol);
         let lambdas: Vec<f64> = (0..=EXTREMA_SCAN)
             .map(|i| SQRT_2 * i as f64 / EXTREMA_SCAN as f64)
             .collect();
-        let values: Vec<Estimate> = lambdas.iter().map(|&l| n(l)).collect::<Result<_>>()?;
-        let max_error = values.iter().map(|e| e.error).fold(0.0, f64::max);
-        let flat = values.iter().all(|v| v.value.abs() <= v.error);
-        let mut extrema_error = max_error;
-        let mut refine = |sign: f64| -> Result<(f64, Option<f64>)> {
-            if flat {
-                return Ok((0.0, None));
-            }
-            let i = (1..EXTREMA_SCAN)
-                .max_by(|&a, &b| (sign * values[a].value).total_cmp(&(sign * values[b].value)))
-                .expect("the scan has interior points");
-            if sign * values[i].value <= 0.0 {
-                // No interior value of this sign: the extremum is the limit 0 at λ → 0.
-                return Ok((0.0, Some(0.0)));
+        let values: Vec<(Estimate, Estimate)> = lambdas
+            .iter()
+            .map(|&l| high_energy_pair(body, l, tol))
+            .collect();
+        let slope = values[0].1;
+        let mut extrema_error = values
+            .iter()
+            .map(|(n, t)| n.error.max(t.error))
+            .fold(0.0, f64::max);
+        let flat = values.iter().all(|(n, _)| n.value.abs() <= n.error);
+        // The extremum of sign·f over the scan, refined by golden section where interior;
+        // `pick` selects N∞ (0) or Ñ (1).
+        let mut extremum = |sign: f64, pick: usize| -> (f64, Option<f64>) {
+            let get = |e: &(Estimate, Estimate)| if pick == 0 { e.0 } else { e.1 };
+            let i = (0..=EXTREMA_SCAN)
+                .max_by(|&a, &b| {
+                    (sign * get(&values[a]).value).total_cmp(&(sign * get(&values[b]).value))
+                })
+                .expect("the scan has points");
+            if i == 0 || i == EXTREMA_SCAN {
+                return (get(&values[i]).value, Some(lambdas[i]));
             }
             let (l, v) = golden_max(
-                |l| n(l).map(|e| sign * e.value).unwrap_or(f64::NEG_INFINITY),
+                |l| sign * get(&high_energy_pair(body, l, tol)).value,
                 lambdas[i - 1],
                 lambdas[i + 1],
-                1e-10,
+                1e-8,
             );
-            extrema_error = extrema_error.max(n(l)?.error);
-            Ok((sign * v, Some(l)))
+            extrema_error = extrema_error.max(get(&high_energy_pair(body, l, tol)).error);
+            (sign * v, Some(l))
         };
-        let (n_max, lambda_at_max) = refine(1.0)?;
-        let (n_min, lambda_at_min) = refine(-1.0)?;
+        let (mut n_max, mut lambda_at_max) = extremum(1.0, 0);
+        let (mut n_min, mut lambda_at_min) = extremum(-1.0, 0);
+        let (normalized_max, _) = extremum(1.0, 1);
+        let (normalized_min, _) = extremum(-1.0, 1);
+        if flat {
+            (n_max, n_min, lambda_at_max, lambda_at_min) = (0.0, 0.0, None, None);
+        }
+        // N∞ = 0 at both ends: without an interior value of a sign, that extremum is the
+        // limit 0 at λ → 0.
+        if n_max <= 0.0 && !flat {
+            (n_max, lambda_at_max) = (0.0, Some(0.0));
+        }
+        if n_min >= 0.0 && !flat {
+            (n_min, lambda_at_min) = (0.0, Some(0.0));
+        }
         Ok(Self {
             slope: slope.value,
             n_min,
             lambda_at_min,
             n_max,
             lambda_at_max,
+            normalized_min,
+            normalized_max,
             slope_error: slope.error,
             extrema_error,
         })

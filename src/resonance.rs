@@ -112,7 +112,7 @@ fn evaluate<S: Shape>(
 
 /// A root of `f` in [a, b] with f(a), f(b) of opposite signs (Illinois regula falsi), to
 /// |b − a| ≤ `xtol` or |f| ≤ `ftol`; None if `f` fails on the way.
-fn bracketed_root(
+pub(crate) fn bracketed_root(
     mut f: impl FnMut(f64) -> Option<f64>,
     (mut a, mut fa): (f64, f64),
     (mut b, mut fb): (f64, f64),

@@ -58,8 +58,14 @@ fn high_energy_limit_is_where_cells_converge() {
             // V ≈ 1e12; issue 12), while N∞ itself is stable to 1e-14 across tolerances.
             const FLOOR: f64 = 5e-12;
             assert!(diffs[0].0 < 1e-5, "{ctx}");
-            assert!(diffs[2].0 <= 1e-3 * diffs[0].0 + 2.0 * diffs[2].1 + FLOOR, "{ctx}");
-            assert!(diffs[1].0 <= 0.1 * diffs[0].0 + 2.0 * diffs[1].1 + FLOOR, "{ctx}");
+            assert!(
+                diffs[2].0 <= 1e-3 * diffs[0].0 + 2.0 * diffs[2].1 + FLOOR,
+                "{ctx}"
+            );
+            assert!(
+                diffs[1].0 <= 0.1 * diffs[0].0 + 2.0 * diffs[1].1 + FLOOR,
+                "{ctx}"
+            );
         }
     }
 }

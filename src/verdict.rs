@@ -1,0 +1,1271 @@
+//! The verdict on the paper's boundedness hypothesis (SPEC §4) for one body over the whole
+//! (κ, ε) plane: integer resonances located to the solver's tolerance, with the limits of
+//! [`crate::limits`] closing the plane at ε → ∞, at the bottom of each well and at κ → 0.
+//!
+//! The plane of one body is mapped onto a compact set: κ-lines from the smallest κ of the
+//! hypothesis's region to [`KAPPA_CEIL`] (log-spaced, plus evenly spaced ones where the
+//! critical set lives), and on each line the energy ε = V_low/(1 − q)², q ∈ [0, 1), with V_low
+//! the bottom of V at that κ, so q = 0 is the bottom of the deepest well (the linearised N)
+//! and q → 1 is ε → ∞ (N ≈ slope·κ/√ε → 0). Beyond the last line N tends to N∞(λ),
+//! λ = κ/√ε = √2 (1 − q) V… (the high-energy limit). Levels just above and below every
+//! separatrix are added, where N → ±∞.
+//!
+//! On a connected family of tori N is continuous, so an integer k lies on a resonance curve
+//! wherever two neighbouring samples of one family (same well, same gap between separatrix
+//! levels) have N − k of opposite signs, or a sample has N = k within its error. Each such
+//! pair is refined by regula falsi to N = k within the solver's tolerance, and the point is
+//! solved again with the drift: a counterexample is a point with Δζ ≠ 0 there (the centre of
+//! mass then runs away linearly, SPEC §2).
+//!
+//! The hypothesis (SPEC §4): case 1, β² < 1 + α: bounded for every κ ≠ 0; case 2,
+//! β² > 1 + α and α > 0: bounded for κ > κ_max, the top (fold) of the N = 0 curve that hugs
+//! σ_u. Other bodies (α = 0 with β ≥ 1, and β² = 1 + α exactly) are not covered.
+
+use crate::body::Shape;
+use crate::cell::{solve_component, CellOptions, Status};
+use crate::critical::{CriticalSet, DiagramType};
+use crate::error::{check_range, AtlasError, Result};
+use crate::limits::{golden_max, HighEnergyLimit};
+use crate::resonance::{self, bracketed_root, ResonanceOptions};
+use crate::torus::{CriticalKind, EffectivePotential, MotionKind};
+use crate::EllipsoidBody;
+use rayon::prelude::*;
+use serde::Serialize;
+
+/// The smallest κ-line of case 1: below it N has its κ → 0 limits (±1/2 near one pole,
+/// O(κ) across both), see [`crate::limits::small_kappa_limit`].
+pub const KAPPA_FLOOR: f64 = 1e-6;
+/// The largest κ-line: above it N differs from N∞(λ) by O(1/ε) ≤ O(1/κ²) = 1e-8.
+pub const KAPPA_CEIL: f64 = 1e4;
+/// 1 − q on the last energies of each line: ε up to 1e12 V_low.
+const HIGH_ENERGY_TAIL: [f64; 3] = [1e-3, 1e-4, 1e-6];
+/// Relative offsets of the energies probed on either side of every separatrix level.
+const SEPARATRIX_PROBES: [f64; 8] = [1e-1, 1e-2, 1e-3, 1e-5, 1e-7, 1e-9, 1e-11, 1e-13];
+/// At most this many counterexamples per integer, and integers reported.
+const PER_INTEGER: usize = 2;
+const INTEGERS_REPORTED: usize = 6;
+
+/// Which part of the hypothesis covers a body (SPEC §4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Case {
+    /// β² < 1 + α: bounded for every κ ≠ 0.
+    #[serde(rename = "1")]
+    One,
+    /// β² > 1 + α, α > 0: bounded for κ > κ_max.
+    #[serde(rename = "2")]
+    Two,
+    /// α = 0 with β ≥ 1, or β² = 1 + α exactly.
+    #[serde(rename = "not_covered")]
+    NotCovered,
+}
+
+impl Case {
+    /// The case of an ellipsoid with α ≥ 0.
+    pub fn of(alpha: f64, beta: f64) -> Self {
+        let b2 = beta * beta;
+        if b2 < 1.0 + alpha {
+            Case::One
+        } else if b2 > 1.0 + alpha && alpha > 0.0 {
+            Case::Two
+        } else {
+            Case::NotCovered
+        }
+    }
+}
+
+/// How finely the plane is sampled, and how accurately each cell is solved.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VerdictOptions {
+    /// The cell solver's tolerance (N at a counterexample equals the integer to this).
+    pub tol: f64,
+    /// κ-lines of each kind (log-spaced and evenly spaced) and base energies per line.
+    pub resolution: usize,
+}
+
+impl Default for VerdictOptions {
+    fn default() -> Self {
+        Self {
+            tol: 1e-10,
+            resolution: 64,
+        }
+    }
+}
+
+/// A point on an integer resonance where the path runs away (SPEC §4 contract).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Counterexample {
+    pub kappa: f64,
+    pub energy: f64,
+    pub rotation_number: f64,
+    pub theta_min: f64,
+    pub theta_max: f64,
+    /// The integer N is on.
+    pub integer: i64,
+    /// The solver's error estimate of N there.
+    pub error_estimate: f64,
+    /// |Δζ| over one θ-period, and its error estimate: the drift per period.
+    pub drift: f64,
+    pub drift_error: f64,
+}
+
+/// What a verdict rests on.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Evidence {
+    /// The κ range sampled by lines, [smallest, largest].
+    pub kappa_range: [f64; 2],
+    pub kappa_lines: usize,
+    /// Base energies per line (plus the well bottoms, the high-energy tail and the levels
+    /// around each separatrix).
+    pub energies_per_line: usize,
+    /// Components solved.
+    pub components_solved: usize,
+    /// [min, max] of N over the samples of the region and N∞.
+    pub rotation_number_range: [f64; 2],
+    /// Pairs of neighbouring samples with an integer between their N, and samples on an
+    /// integer within their error bar: each one a point of an integer resonance curve.
+    pub integer_brackets: usize,
+    /// Brackets whose refinement did not give a counterexample (the drift vanished there, or
+    /// the family changed shape between the samples).
+    pub refinement_failures: usize,
+    /// A failure the high-energy limit proves beyond the sampled lines (and why), when the
+    /// lines themselves may not show it: close to a boundary the resonance moves off to
+    /// κ → ∞.
+    pub limit_failure: Option<String>,
+    /// The limits that close the plane beyond the samples.
+    pub limits: Vec<&'static str>,
+}
+
+/// The verdict for one body (SPEC §4 contract of `rubber-atlas verdict`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Verdict {
+    pub alpha: f64,
+    pub beta: f64,
+    pub nu: f64,
+    pub eta: f64,
+    pub diagram_type: DiagramType,
+    pub case: Case,
+    /// true / false; None when the hypothesis does not cover the body.
+    pub holds: Option<bool>,
+    /// The fold of the N = 0 curve that hugs σ_u (case 2).
+    pub kappa_max: Option<f64>,
+    pub kappa_max_error: Option<f64>,
+    pub counterexamples: Vec<Counterexample>,
+    pub high_energy: HighEnergyLimit,
+    /// The fail margin F = max(min(sup ñ, −inf ñ), N_max − 1, −1 − N_min) over the region
+    /// (ñ = N √ε/κ, which has N's sign and stays finite where N → 0 at the edges): positive
+    /// where N reaches an integer in the region, negative where it holds. Continuous in the
+    /// body's parameters: the quantity `--boundaries` finds the roots of.
+    pub fail_margin: f64,
+    /// The terms of the fail margin (None when the body is not covered).
+    pub margins: Option<Margins>,
+    pub evidence: Evidence,
+}
+
+/// One solved component on a κ-line.
+#[derive(Debug, Clone, Copy)]
+struct Sample {
+    kappa: f64,
+    energy: f64,
+    /// Index of the base energy grid (None for bottoms, tails and separatrix probes).
+    grid: Option<usize>,
+    /// Number of separatrix levels below ε.
+    gap: usize,
+    /// Rank (by θ) of the minimum of V the component surrounds, among the line's minima.
+    well: usize,
+    /// Numbers of minima and maxima of V on the line (the family's shape).
+    shape: (usize, usize),
+    n: f64,
+    error: f64,
+}
+
+/// The q of base energy i: clustered at both ends (the bottom and ε → ∞).
+fn grid_q(i: usize, count: usize) -> f64 {
+    0.5 * (1.0 - (std::f64::consts::PI * i as f64 / count as f64).cos())
+}
+
+/// The κ-lines: log-spaced from `lo` to [`KAPPA_CEIL`], and evenly spaced from `lo` to
+/// `linear_top`, where the critical set lives.
+fn kappa_lines(lo: f64, linear_top: f64, resolution: usize) -> Vec<f64> {
+    let (l0, l1) = (lo.ln(), KAPPA_CEIL.ln());
+    let mut k: Vec<f64> = (0..=resolution)
+        .map(|i| {
+            (l0 + (l1 - l0) * i as f64 / resolution as f64)
+                .exp()
+                .min(KAPPA_CEIL)
+        })
+        .chain((0..=resolution).map(|i| lo + (linear_top - lo) * i as f64 / resolution as f64))
+        .filter(|&k| k >= lo && k <= KAPPA_CEIL)
+        .collect();
+    k.sort_by(f64::total_cmp);
+    k.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs());
+    k
+}
+
+/// The deepest minimum of V at one κ.
+fn bottom<S: Shape>(potential: &EffectivePotential<'_, S>) -> Option<f64> {
+    potential
+        .critical_points()
+        .iter()
+        .filter(|p| p.kind == CriticalKind::Minimum)
+        .map(|p| p.value)
+        .min_by(f64::total_cmp)
+}
+
+/// The energy of base grid point i at the bottom `low`: ε = low / (1 − q)².
+fn grid_energy(low: f64, q: f64) -> f64 {
+    low / ((1.0 - q) * (1.0 - q))
+}
+
+struct Sampler<'a> {
+    body: &'a EllipsoidBody,
+    cell: CellOptions,
+    energies: usize,
+}
+
+impl Sampler<'_> {
+    /// Every component at every sampled energy of the κ-line.
+    fn line(&self, kappa: f64) -> Vec<Sample> {
+        let potential = EffectivePotential::new(self.body, kappa);
+        let minima: Vec<f64> = potential
+            .critical_points()
+            .iter()
+            .filter(|p| p.kind == CriticalKind::Minimum)
+            .map(|p| p.site.theta)
+            .collect();
+        let mut levels: Vec<f64> = potential
+            .critical_points()
+            .iter()
+            .filter(|p| p.kind == CriticalKind::Maximum)
+            .map(|p| p.value)
+            .collect();
+        levels.sort_by(f64::total_cmp);
+        let Some(low) = bottom(&potential) else {
+            return Vec::new();
+        };
+        let mut energies: Vec<(f64, Option<usize>)> = (0..self.energies)
+            .map(|i| (grid_energy(low, grid_q(i, self.energies)), Some(i)))
+            .collect();
+        energies.extend(
+            HIGH_ENERGY_TAIL
+                .iter()
+                .map(|&t| (grid_energy(low, 1.0 - t), None)),
+        );
+        energies.extend(
+            potential
+                .critical_points()
+                .iter()
+                .filter(|p| p.kind == CriticalKind::Minimum && p.value > low)
+                .map(|p| (p.value, None)),
+        );
+        for &level in &levels {
+            for d in SEPARATRIX_PROBES {
+                let step = d * level.abs().max(1.0);
+                energies.push((level - step, None));
+                energies.push((level + step, None));
+            }
+        }
+        energies.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let shape = (minima.len(), levels.len());
+        let mut out = Vec::with_capacity(energies.len() * 2);
+        for (energy, grid) in energies {
+            let Ok(components) = potential.components(energy) else {
+                continue;
+            };
+            let gap = levels.iter().filter(|&&l| l < energy).count();
+            for c in &components {
+                if c.kind == MotionKind::Rotation {
+                    continue;
+                }
+                let Some(m) = c.minimum() else { continue };
+                let Ok(r) = solve_component(&potential, energy, c, &self.cell) else {
+                    continue;
+                };
+                if r.status == Status::Separatrix || !r.rotation_number.is_finite() {
+                    continue;
+                }
+                let well = minima.iter().position(|&t| t == m.site.theta).unwrap_or(0);
+                out.push(Sample {
+                    kappa,
+                    energy,
+                    grid,
+                    gap,
+                    well,
+                    shape,
+                    n: r.rotation_number,
+                    error: r.error_estimate,
+                });
+            }
+        }
+        out
+    }
+
+    /// N − k of the component around well `well` (rank by θ) at (κ, ε), if V there has the
+    /// family's `shape` and ε lies in gap `gap`.
+    fn offset(&self, kappa: f64, energy: f64, of: &Sample, k: f64) -> Option<f64> {
+        self.solve(kappa, energy, of, false)
+            .map(|r| r.rotation_number - k)
+    }
+
+    fn solve(
+        &self,
+        kappa: f64,
+        energy: f64,
+        of: &Sample,
+        drift: bool,
+    ) -> Option<crate::cell::ComponentResult> {
+        let potential = EffectivePotential::new(self.body, kappa);
+        let minima: Vec<f64> = potential
+            .critical_points()
+            .iter()
+            .filter(|p| p.kind == CriticalKind::Minimum)
+            .map(|p| p.site.theta)
+            .collect();
+        let levels = potential
+            .critical_points()
+            .iter()
+            .filter(|p| p.kind == CriticalKind::Maximum)
+            .count();
+        if (minima.len(), levels) != of.shape {
+            return None;
+        }
+        let gap = potential
+            .critical_points()
+            .iter()
+            .filter(|p| p.kind == CriticalKind::Maximum && p.value < energy)
+            .count();
+        if gap != of.gap {
+            return None;
+        }
+        let theta = *minima.get(of.well)?;
+        let components = potential.components(energy).ok()?;
+        let c = components.iter().find(|c| {
+            c.kind != MotionKind::Rotation && c.minimum().map(|m| m.site.theta) == Some(theta)
+        })?;
+        let options = CellOptions { drift, ..self.cell };
+        let r = solve_component(&potential, energy, c, &options).ok()?;
+        (r.status != Status::Separatrix && r.rotation_number.is_finite()).then_some(r)
+    }
+}
+
+/// A bracket of an integer between two samples of one family, or a sample on it.
+#[derive(Debug, Clone, Copy)]
+struct Candidate {
+    a: Sample,
+    b: Option<Sample>,
+    k: i64,
+}
+
+/// Below this, |N − k| is not a reliable sign whatever the error estimate says.
+const SIGN_FLOOR: f64 = 1e-13;
+/// On-integer samples are taken only from lines at κ ≥ this: closer to κ = 0, N → 0 as κ·f(ε)
+/// (a limit, not a resonance) and falls below the solver's tolerance.
+const ON_INTEGER_KAPPA: f64 = 1e-3;
+
+/// The error bar within which N − k has no reliable sign: the solver's estimate, and never
+/// less than its tolerance (a cell solved to `tol` does not promise the sign of a smaller
+/// difference).
+fn ambiguity(s: &Sample, tol: f64) -> f64 {
+    s.error.max(tol).max(SIGN_FLOOR)
+}
+
+/// Integers k strictly between the N of two samples whose N − k have reliable signs; with one
+/// sample, the integer it is on within its error bar (a body whose symmetry makes N an
+/// integer on a whole family, such as N ≡ 0 at α = 0). Only interior samples count alone: at
+/// the bottom and at ε → ∞ N reaches 0 as a limit.
+fn integers_between(
+    a: &Sample,
+    b: Option<&Sample>,
+    interior: bool,
+    tol: f64,
+    out: &mut Vec<Candidate>,
+) {
+    match b {
+        None => {
+            let k = a.n.round();
+            if interior && a.kappa >= ON_INTEGER_KAPPA && (a.n - k).abs() <= a.error {
+                out.push(Candidate {
+                    a: *a,
+                    b: None,
+                    k: k as i64,
+                });
+            }
+        }
+        Some(b) => {
+            let (lo, hi) = (a.n.min(b.n), a.n.max(b.n));
+            let first = lo.floor() as i64 + 1;
+            let last = hi.ceil() as i64 - 1;
+            // Near a separatrix N runs to ±∞: the integers nearest 0 are enough.
+            let (first, last) = if last.saturating_sub(first) > 8 {
+                let start = if first > 0 {
+                    first
+                } else if last < 0 {
+                    last - 8
+                } else {
+                    -4
+                };
+                (start.max(first), (start + 8).min(last))
+            } else {
+                (first, last)
+            };
+            for k in first..=last {
+                let kf = k as f64;
+                if (a.n - kf).abs() > ambiguity(a, tol) && (b.n - kf).abs() > ambiguity(b, tol) {
+                    out.push(Candidate {
+                        a: *a,
+                        b: Some(*b),
+                        k,
+                    });
+                }
+            }
+        }
+    }
+}
+
+/// The automatic window in which the N = 0 curve hugging σ_u is traced for its fold:
+/// κ up to twice the cusp's, ε from the bottom to well above the cusp.
+fn fold_window(body: &EllipsoidBody, set: &CriticalSet) -> Option<((f64, f64), (f64, f64))> {
+    let cusp = set.cusp?;
+    let low = bottom(&EffectivePotential::new(body, 0.01))?;
+    let top = cusp.energy + 2.0 * (cusp.energy - low).max(1.0);
+    Some(((0.01, 2.0 * cusp.kappa + 0.5), (low, top)))
+}
+
+/// κ_max of case 2: the fold of the N = 0 curve of largest κ near σ_u, with its error. The
+/// continuation of [`resonance::fold`] finds it; it is then solved from its definition
+/// (N = 0, ∂N/∂ε = 0): M(κ) = max over ε of ±N(κ, ε) near the fold, and κ_max the root of
+/// M, by Illinois regula falsi (the final bracket and the solver's tolerance through dM/dκ
+/// bound the error).
+fn kappa_max(body: &EllipsoidBody, set: &CriticalSet, tol: f64) -> Result<Option<(f64, f64)>> {
+    let Some((kappa, energy)) = fold_window(body, set) else {
+        return Ok(None);
+    };
+    let cell = CellOptions {
+        tol,
+        drift: false,
+        ..CellOptions::default()
+    };
+    let options = ResonanceOptions {
+        target: 0.0,
+        kappa,
+        energy,
+        grid: 48,
+        cell,
+        max_points: 20_000,
+        max_point_error: 1e-6,
+    };
+    let Some(fold) = resonance::fold(body, &options)? else {
+        return Ok(None);
+    };
+    Ok(Some(
+        polish_fold(body, &fold, &cell).unwrap_or((fold.kappa_max, fold.kappa_error)),
+    ))
+}
+
+/// N of the component around the minimum of V nearest `well` at (κ, ε).
+fn n_near_well(
+    body: &EllipsoidBody,
+    kappa: f64,
+    energy: f64,
+    well: f64,
+    cell: &CellOptions,
+) -> Option<f64> {
+    let potential = EffectivePotential::new(body, kappa);
+    let minimum = potential
+        .critical_points()
+        .iter()
+        .filter(|p| p.kind == CriticalKind::Minimum)
+        .map(|p| p.site.theta)
+        .min_by(|a, b| (a - well).abs().total_cmp(&(b - well).abs()))?;
+    let components = potential.components(energy).ok()?;
+    let c = components.iter().find(|c| {
+        c.kind == MotionKind::Libration && c.theta_min() <= minimum && minimum <= c.theta_max()
+    })?;
+    let r = solve_component(&potential, energy, c, cell).ok()?;
+    (r.status != Status::Separatrix && r.rotation_number.is_finite()).then_some(r.rotation_number)
+}
+
+fn polish_fold(
+    body: &EllipsoidBody,
+    fold: &resonance::Fold,
+    cell: &CellOptions,
+) -> Option<(f64, f64)> {
+    let width = 1e-3 * (1.0 + fold.energy.abs());
+    let (e0, e1) = (fold.energy - width, fold.energy + width);
+    // The sign of the extremum: N just above the fold stays on one side of 0.
+    let probe = fold.kappa_max * (1.0 + 1e-4);
+    let side: Vec<f64> = (0..=8)
+        .filter_map(|i| {
+            n_near_well(
+                body,
+                probe,
+                e0 + (e1 - e0) * i as f64 / 8.0,
+                fold.well,
+                cell,
+            )
+        })
+        .collect();
+    let sign = if side.iter().all(|&n| n < 0.0) {
+        1.0
+    } else if side.iter().all(|&n| n > 0.0) {
+        -1.0
+    } else {
+        return None;
+    };
+    let m = |kappa: f64| -> Result<f64> {
+        let (_, v) = golden_max(
+            |e| {
+                n_near_well(body, kappa, e, fold.well, cell).map_or(f64::NEG_INFINITY, |n| sign * n)
+            },
+            e0,
+            e1,
+            1e-10 * (1.0 + fold.energy.abs()),
+        );
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(AtlasError::NotPeriodic {
+                reason: "no torus of the fold's family near it",
+            })
+        }
+    };
+    // A bracket [a, b] around the root, M(a) > 0 > M(b).
+    let mut step = 1e-6 * fold.kappa_max;
+    let (mut a, mut b) = (fold.kappa_max, fold.kappa_max);
+    let (mut fa, mut fb) = (m(a).ok()?, m(b).ok()?);
+    for _ in 0..30 {
+        if fa > 0.0 && fb < 0.0 {
+            break;
+        }
+        if fa <= 0.0 {
+            a -= step;
+            fa = m(a).ok()?;
+        }
+        if fb >= 0.0 {
+            b += step;
+            fb = m(b).ok()?;
+        }
+        step *= 2.0;
+    }
+    if !(fa > 0.0 && fb < 0.0) {
+        return None;
+    }
+    let (root, width) = illinois(m, (a, fa), (b, fb), 1e-12).ok()?;
+    let slope = (fb - fa) / (b - a);
+    Some((root, width + cell.tol / slope.abs().max(f64::MIN_POSITIVE)))
+}
+
+/// The verdict for one body with α ≥ 0.
+pub fn verdict(body: &EllipsoidBody, options: &VerdictOptions) -> Result<Verdict> {
+    let (alpha, beta) = (body.shape.alpha, body.shape.beta);
+    if alpha < 0.0 {
+        return Err(AtlasError::InvalidParameter {
+            name: "alpha",
+            value: alpha,
+            reason: "the verdict is computed for alpha >= 0; alpha < 0 is its mirror image theta -> pi - theta",
+        });
+    }
+    check_range(
+        "tol",
+        options.tol,
+        Some((1e-13, true)),
+        Some((1e-4, true)),
+        "must satisfy 1e-13 <= tol <= 1e-4",
+    )?;
+    if !(8..=4096).contains(&options.resolution) {
+        return Err(AtlasError::InvalidParameter {
+            name: "resolution",
+            value: options.resolution as f64,
+            reason: "must be between 8 and 4096",
+        });
+    }
+    let case = Case::of(alpha, beta);
+    let high_energy = HighEnergyLimit::of(body, options.tol.min(1e-12))?;
+    let diagram_type = DiagramType::of(alpha, beta);
+    let mut verdict = Verdict {
+        alpha,
+        beta,
+        nu: body.nu,
+        eta: body.eta,
+        diagram_type,
+        case,
+        holds: None,
+        kappa_max: None,
+        kappa_max_error: None,
+        counterexamples: Vec::new(),
+        high_energy,
+        fail_margin: f64::NAN,
+        margins: None,
+        evidence: Evidence {
+            kappa_range: [f64::NAN; 2],
+            kappa_lines: 0,
+            energies_per_line: 0,
+            components_solved: 0,
+            rotation_number_range: [f64::NAN; 2],
+            integer_brackets: 0,
+            refinement_failures: 0,
+            limit_failure: None,
+            limits: Vec::new(),
+        },
+    };
+    if case == Case::NotCovered {
+        return Ok(verdict);
+    }
+    let cell = CellOptions {
+        tol: options.tol,
+        drift: false,
+        ..CellOptions::default()
+    };
+    // The critical set, untruncated (its cusp bounds the fold's window).
+    let set = CriticalSet::of(body, 400, 1e6)?;
+    let cusp_kappa = set.cusp.map(|c| c.kappa);
+    // The region of the hypothesis: κ > 0 (case 1) or κ > κ_max (case 2).
+    let lo = match case {
+        Case::Two => match kappa_max(body, &set, options.tol)? {
+            Some((k, err)) => {
+                verdict.kappa_max = Some(k);
+                verdict.kappa_max_error = Some(err);
+                // Just above the fold: its own error, and a relative step past it.
+                k + 4.0 * err + 1e-6 * k
+            }
+            // No fold in the window: the N = 0 curve is not bounded in κ there; the whole
+            // half-plane above the cusp is examined.
+            None => cusp_kappa.unwrap_or(KAPPA_FLOOR),
+        },
+        _ => KAPPA_FLOOR,
+    };
+    let linear_top = (3.0 * lo).max(4.0).max(3.0 * cusp_kappa.unwrap_or(0.0));
+    let kappas = kappa_lines(lo, linear_top, options.resolution);
+    let sampler = Sampler {
+        body,
+        cell,
+        energies: options.resolution,
+    };
+    let lines: Vec<Vec<Sample>> = kappas.par_iter().map(|&k| sampler.line(k)).collect();
+    let candidates = brackets(&lines, options.tol);
+    let all: Vec<&Sample> = lines.iter().flatten().collect();
+    let (n_lo, n_hi) = all
+        .iter()
+        .fold((high_energy.n_min, high_energy.n_max), |(lo, hi), s| {
+            (lo.min(s.n), hi.max(s.n))
+        });
+    let (mut found, mut refinement_failures) = counterexamples(&sampler, &candidates);
+    let mut integer_brackets = candidates.len();
+
+    // The limit κ → ∞ decides what lies beyond the last line.
+    let bottom_sign = lines
+        .last()
+        .and_then(|l| l.iter().find(|s| s.grid == Some(0)))
+        .filter(|s| s.n.abs() > ambiguity(s, options.tol))
+        .map_or(0.0, |s| s.n.signum());
+    let limit_failure = limit_failure(&high_energy, bottom_sign);
+    let mut kappa_top = *kappas.last().expect("lines");
+    if let Some((_, k)) = &limit_failure {
+        if !found.iter().any(|c| c.integer == *k) {
+            // The resonance it proves lies at larger κ: two more lines, as far as double
+            // precision resolves ε − V (κ² ≲ 1e12).
+            let extra: Vec<Vec<Sample>> = EXTRA_KAPPA_LINES
+                .par_iter()
+                .map(|&k| sampler.line(k))
+                .collect();
+            kappa_top = *EXTRA_KAPPA_LINES.last().expect("lines");
+            let mut joined = vec![lines.last().cloned().unwrap_or_default()];
+            joined.extend(extra);
+            let more = brackets(&joined, options.tol);
+            integer_brackets += more.len();
+            let (extra_found, extra_failures) = counterexamples(&sampler, &more);
+            refinement_failures += extra_failures;
+            for c in extra_found {
+                if !found
+                    .iter()
+                    .any(|f| f.integer == c.integer && f.kappa == c.kappa)
+                {
+                    found.push(c);
+                }
+            }
+        }
+    }
+    verdict.counterexamples = found;
+    verdict.holds = Some(verdict.counterexamples.is_empty() && limit_failure.is_none());
+    let margins = fail_margin(&sampler, &lines, &high_energy, n_lo, n_hi);
+    verdict.fail_margin = margins.value();
+    verdict.margins = Some(margins);
+    verdict.evidence = Evidence {
+        kappa_range: [kappas[0], kappa_top],
+        kappa_lines: kappas.len(),
+        energies_per_line: options.resolution,
+        components_solved: all.len(),
+        rotation_number_range: [n_lo, n_hi],
+        integer_brackets,
+        refinement_failures,
+        limit_failure: limit_failure.map(|(reason, _)| reason),
+        limits: [
+            "bottom: each line starts at the deepest minimum of V (the linearised N of the stable permanent rotation, limits::bottom_rotation_number)",
+            "high energy: each line runs to epsilon = 1e12 V_low, where N = slope kappa / sqrt(epsilon) + O(1/epsilon); beyond the last line, N = N_inf(lambda) + O(1/kappa^2) (limits::HighEnergyLimit)",
+            "kappa -> 0 (case 1): below kappa = 1e-6, N -> +1/2 or -1/2 near one pole and O(kappa) across both (limits::small_kappa_limit)",
+            "separatrices: levels 1e-1 ... 1e-13 (relative) on both sides of every maximum of V, where N -> +-infinity (limits::separatrix_limit_sign)",
+        ]
+        .into_iter()
+        .filter(|l| case == Case::One || !l.starts_with("kappa -> 0"))
+        .collect(),
+    };
+    Ok(verdict)
+}
+
+/// ñ = N √ε / κ: N's sign, finite where N → 0 at ε → ∞ (slope), κ → 0 (lim N/κ) and κ → ∞.
+fn normalized(s: &Sample) -> f64 {
+    s.n * s.energy.sqrt() / s.kappa
+}
+
+/// The fail margin of the verdict (see [`Verdict::fail_margin`]). The extreme ñ of the
+/// samples are refined by golden section, along ε between the neighbouring samples of the
+/// family, then along κ, then along ε again, so that the margin follows the lobe's true peak
+/// rather than the grid. The edge κ → ∞ contributes N∞(λ)/λ.
+fn fail_margin(
+    sampler: &Sampler<'_>,
+    lines: &[Vec<Sample>],
+    high_energy: &HighEnergyLimit,
+    n_lo: f64,
+    n_hi: f64,
+) -> Margins {
+    let tol = sampler.cell.tol;
+    // The edge κ → ∞: Ñ = N∞/(λ x₀²), N's sign there, with its exact extrema.
+    let edge = [high_energy.normalized_max, high_energy.normalized_min];
+    let reliable = |s: &&Sample| (s.n).abs() > ambiguity(s, tol);
+    // (sign · extreme, whether it is the edge's).
+    let extreme = |sign: f64| -> (f64, bool) {
+        let edge_best = edge
+            .iter()
+            .map(|v| sign * v)
+            .fold(f64::NEG_INFINITY, f64::max);
+        let best = lines
+            .iter()
+            .enumerate()
+            .flat_map(|(j, l)| l.iter().enumerate().map(move |(i, s)| (j, i, s)))
+            .filter(|(_, _, s)| reliable(s))
+            .max_by(|a, b| (sign * normalized(a.2)).total_cmp(&(sign * normalized(b.2))));
+        let Some((j, i, s)) = best else {
+            return (edge_best, true);
+        };
+        let mut value = sign * normalized(s);
+        let same = |t: &Sample| t.gap == s.gap && t.well == s.well;
+        let line = &lines[j];
+        let prev = line[..i]
+            .iter()
+            .rev()
+            .find(|t| same(t))
+            .map_or(s.energy, |t| t.energy);
+        let next = line[i + 1..]
+            .iter()
+            .find(|t| same(t))
+            .map_or(s.energy, |t| t.energy);
+        let at = |kappa: f64, energy: f64| -> f64 {
+            sampler
+                .solve(kappa, energy, s, false)
+                .filter(|r| (r.rotation_number).abs() > r.error_estimate.max(tol).max(SIGN_FLOOR))
+                .map_or(f64::NEG_INFINITY, |r| {
+                    sign * r.rotation_number * energy.sqrt() / kappa
+                })
+        };
+        // Along ε (in log ε), then κ (in log κ), then ε again.
+        let (mut kappa, mut energy) = (s.kappa, s.energy);
+        let log_golden = |f: &dyn Fn(f64) -> f64, a: f64, b: f64| -> (f64, f64) {
+            if a == b {
+                return (a, f(a));
+            }
+            let (x, v) = golden_max(|u| f(u.exp()), a.ln(), b.ln(), 1e-9);
+            (x.exp(), v)
+        };
+        let (e, v) = log_golden(&|e| at(kappa, e), prev, next);
+        if v > value {
+            (energy, value) = (e, v);
+        }
+        let kprev = if j > 0 {
+            lines[j - 1].first().map_or(kappa, |t| t.kappa)
+        } else {
+            kappa
+        };
+        let knext = lines
+            .get(j + 1)
+            .and_then(|l| l.first())
+            .map_or(kappa, |t| t.kappa);
+        let (k, v) = log_golden(&|k| at(k, energy), kprev, knext);
+        if v > value {
+            (kappa, value) = (k, v);
+        }
+        let (lo, hi) = (energy.min(prev).min(next), energy.max(prev).max(next));
+        let (_, v) = log_golden(&|e| at(kappa, e), lo, hi);
+        let sampled = value.max(v);
+        (sampled.max(edge_best), edge_best >= sampled)
+    };
+    let (sup, sup_edge) = extreme(1.0);
+    let (neg_inf, inf_edge) = extreme(-1.0);
+    let both_signs = sup.min(neg_inf);
+    let (n_lo_edge, n_hi_edge) = (n_lo == high_energy.n_min, n_hi == high_energy.n_max);
+    Margins {
+        both_signs,
+        to_plus_one: n_hi - 1.0,
+        to_minus_one: -1.0 - n_lo,
+        from_limit: [
+            if sup <= neg_inf { sup_edge } else { inf_edge },
+            n_hi_edge,
+            n_lo_edge,
+        ],
+    }
+}
+
+/// The terms of the fail margin: each positive exactly when its resonance exists.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Margins {
+    /// min(sup ñ, −inf ñ): N takes both signs (an N = 0 resonance).
+    pub both_signs: f64,
+    /// N_max − 1 (an N = 1 resonance).
+    pub to_plus_one: f64,
+    /// −1 − N_min (an N = −1 resonance).
+    pub to_minus_one: f64,
+    /// Whether each term (in the order above) is decided by the high-energy limit (the edge
+    /// κ → ∞) rather than by a sampled cell.
+    pub from_limit: [bool; 3],
+}
+
+impl Margins {
+    /// The terms in order.
+    pub fn terms(&self) -> [f64; 3] {
+        [self.both_signs, self.to_plus_one, self.to_minus_one]
+    }
+
+    /// The same terms from the high-energy limit alone.
+    pub fn of_limit(h: &HighEnergyLimit) -> [f64; 3] {
+        [
+            h.normalized_max.min(-h.normalized_min),
+            h.n_max - 1.0,
+            -1.0 - h.n_min,
+        ]
+    }
+}
+
+impl Margins {
+    /// F, the largest term.
+    pub fn value(&self) -> f64 {
+        self.both_signs.max(self.to_plus_one).max(self.to_minus_one)
+    }
+
+    /// The names of the terms.
+    pub const NAMES: [&'static str; 3] =
+        ["N takes both signs (N = 0)", "N reaches 1", "N reaches -1"];
+}
+
+/// The lines searched beyond [`KAPPA_CEIL`] when the high-energy limit proves a resonance
+/// that the regular lines did not reach.
+const EXTRA_KAPPA_LINES: [f64; 3] = [3e4, 1e5, 1e6];
+
+/// What the limit κ → ∞ proves, if anything: N → N∞(λ) uniformly on compact λ-sets, so an
+/// integer k ≠ 0 inside N∞'s range, both signs of N∞ (Ñ), or a sign of Ñ against the sign of
+/// N at the bottom of the largest line (which N_b keeps as κ → ∞) puts a resonance N = k on
+/// every κ-line beyond some κ. Returns the reason and k.
+fn limit_failure(h: &HighEnergyLimit, bottom_sign: f64) -> Option<(String, i64)> {
+    let e = h.extrema_error.max(h.slope_error);
+    if h.n_min < -1.0 - e {
+        return Some((
+            format!(
+                "high energy: min N_inf = {} < -1, so N = -1 at every large kappa",
+                h.n_min
+            ),
+            -1,
+        ));
+    }
+    if h.n_max > 1.0 + e {
+        return Some((
+            format!(
+                "high energy: max N_inf = {} > 1, so N = 1 at every large kappa",
+                h.n_max
+            ),
+            1,
+        ));
+    }
+    if h.normalized_min < -e && h.normalized_max > e {
+        return Some((
+            format!(
+                "high energy: N_inf takes both signs (N_inf/(lambda x0^2) from {} to {}), so N = 0 at every large kappa",
+                h.normalized_min, h.normalized_max
+            ),
+            0,
+        ));
+    }
+    let against =
+        (bottom_sign < 0.0 && h.normalized_max > e) || (bottom_sign > 0.0 && h.normalized_min < -e);
+    against.then(|| {
+        (
+            format!(
+                "high energy: N at the bottom has sign {bottom_sign} while N_inf/(lambda x0^2) reaches {}, so N = 0 at every large kappa",
+                if bottom_sign < 0.0 { h.normalized_max } else { h.normalized_min }
+            ),
+            0,
+        )
+    })
+}
+
+/// Integer brackets along each line (same family: gap and well) and across neighbouring
+/// lines at the same base energy index.
+fn brackets(lines: &[Vec<Sample>], tol: f64) -> Vec<Candidate> {
+    let mut candidates = Vec::new();
+    let interior = |s: &Sample| s.grid.is_some_and(|i| i > 0);
+    for line in lines {
+        for (i, a) in line.iter().enumerate() {
+            integers_between(a, None, interior(a), tol, &mut candidates);
+            if let Some(b) = line[i + 1..]
+                .iter()
+                .find(|b| b.gap == a.gap && b.well == a.well)
+            {
+                integers_between(a, Some(b), false, tol, &mut candidates);
+            }
+        }
+    }
+    for pair in lines.windows(2) {
+        for a in pair[0].iter().filter(|s| s.grid.is_some()) {
+            if let Some(b) = pair[1].iter().find(|b| {
+                b.grid == a.grid && b.gap == a.gap && b.well == a.well && b.shape == a.shape
+            }) {
+                integers_between(a, Some(b), false, tol, &mut candidates);
+            }
+        }
+    }
+    candidates
+}
+
+/// Refines the brackets into counterexamples, per integer (those nearest 0 first): first the
+/// bracket nearest κ = 1 (the most tractable to check with a trajectory), then the one of
+/// largest κ (how far the resonance reaches). Returns them and the number of failed
+/// refinements.
+fn counterexamples(
+    sampler: &Sampler<'_>,
+    candidates: &[Candidate],
+) -> (Vec<Counterexample>, usize) {
+    let mut integers: Vec<i64> = candidates.iter().map(|c| c.k).collect();
+    integers.sort_by_key(|&k| (k.abs(), k));
+    integers.dedup();
+    integers.truncate(INTEGERS_REPORTED);
+    let mut failures = 0;
+    let mut out = Vec::new();
+    for &k in &integers {
+        let mut of_k: Vec<&Candidate> = candidates.iter().filter(|c| c.k == k).collect();
+        of_k.sort_by(|x, y| x.a.kappa.ln().abs().total_cmp(&y.a.kappa.ln().abs()));
+        let largest = of_k
+            .iter()
+            .copied()
+            .max_by(|x, y| x.a.kappa.total_cmp(&y.a.kappa));
+        let mut order: Vec<&Candidate> = of_k.iter().copied().take(1).collect();
+        order.extend(largest);
+        order.extend(of_k.iter().copied().skip(1).take(2));
+        let mut found: Vec<Counterexample> = Vec::new();
+        for c in order {
+            if found.len() == PER_INTEGER {
+                break;
+            }
+            match refine(sampler, c) {
+                Some(x) if !found.iter().any(|f| f.kappa == x.kappa) => found.push(x),
+                Some(_) => {}
+                None => failures += 1,
+            }
+        }
+        out.extend(found);
+    }
+    (out, failures)
+}
+
+/// The bracket refined to N = k by regula falsi (along ε on one line, or along the segment
+/// between two lines at one base energy index), then solved with the drift: a counterexample
+/// if the drift over a period exceeds its error.
+fn refine(sampler: &Sampler<'_>, c: &Candidate) -> Option<Counterexample> {
+    let k = c.k as f64;
+    let tol = sampler.cell.tol;
+    let (kappa, energy) = match c.b {
+        None => (c.a.kappa, c.a.energy),
+        Some(b) if b.kappa == c.a.kappa => {
+            let f = |e: f64| sampler.offset(c.a.kappa, e, &c.a, k);
+            let e = bracketed_root(
+                f,
+                (c.a.energy, c.a.n - k),
+                (b.energy, b.n - k),
+                1e-15 * b.energy.abs(),
+                0.5 * tol,
+            )?;
+            (c.a.kappa, e)
+        }
+        Some(b) => {
+            // Along κ at the base energy index of both: ε = V_low(κ) / (1 − q)².
+            let q = grid_q(c.a.grid?, sampler.energies);
+            let at = |t: f64| -> Option<(f64, f64)> {
+                let kappa = c.a.kappa + t * (b.kappa - c.a.kappa);
+                let low = bottom(&EffectivePotential::new(sampler.body, kappa))?;
+                Some((kappa, grid_energy(low, q)))
+            };
+            let f = |t: f64| {
+                let (kappa, energy) = at(t)?;
+                sampler.offset(kappa, energy, &c.a, k)
+            };
+            let t = bracketed_root(f, (0.0, c.a.n - k), (1.0, b.n - k), 1e-15, 0.5 * tol)?;
+            at(t)?
+        }
+    };
+    let r = sampler.solve(kappa, energy, &c.a, true)?;
+    if (r.rotation_number - k).abs() > r.error_estimate.max(sampler.cell.resonance_tol) {
+        return None;
+    }
+    if r.bounded != Some(false) {
+        return None;
+    }
+    Some(Counterexample {
+        kappa,
+        energy,
+        rotation_number: r.rotation_number,
+        theta_min: r.theta_min,
+        theta_max: r.theta_max,
+        integer: c.k,
+        error_estimate: r.error_estimate,
+        drift: r.drift,
+        drift_error: r.errors.drift,
+    })
+}
+
+/// Where the verdict changes along β at one α, and the quantity that decides it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Boundary {
+    pub beta: f64,
+    /// Bound on the error of `beta`.
+    pub error: f64,
+    /// What changes sign there: `case` (β² = 1 + α), a quantity of the high-energy limit
+    /// (`high_energy.normalized_max`, `high_energy.n_min + 1`, …), or `verdict` (bisection
+    /// on the sampled verdict, when no limit explains the change).
+    pub quantity: String,
+    pub case_below: Case,
+    pub holds_below: Option<bool>,
+    pub case_above: Case,
+    pub holds_above: Option<bool>,
+}
+
+/// One β of the scan behind the boundaries.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ScanPoint {
+    pub beta: f64,
+    pub case: Case,
+    pub holds: Option<bool>,
+    pub kappa_max: Option<f64>,
+    pub counterexamples: usize,
+    pub high_energy: HighEnergyLimit,
+}
+
+/// The boundaries of the verdict along β at one α (SPEC §4 contract of `verdict
+/// --boundaries`), with the scan they were found from.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Boundaries {
+    pub alpha: f64,
+    pub nu: f64,
+    pub eta: f64,
+    pub beta_range: [f64; 2],
+    pub boundaries: Vec<Boundary>,
+    pub scan: Vec<ScanPoint>,
+}
+
+/// The β range and the scan density of [`boundaries`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BoundaryOptions {
+    pub beta_min: f64,
+    pub beta_max: f64,
+    /// Log-spaced β of the scan (the case line β² = 1 + α is added on both sides).
+    pub scan: usize,
+    pub verdict: VerdictOptions,
+}
+
+impl Default for BoundaryOptions {
+    fn default() -> Self {
+        Self {
+            beta_min: 0.05,
+            beta_max: 50.0,
+            scan: 48,
+            verdict: VerdictOptions::default(),
+        }
+    }
+}
+
+/// Relative width to which a boundary is located on the sampled plane.
+const BOUNDARY_XTOL: f64 = 1e-6;
+
+/// Illinois regula falsi on a bracket, to a relative width `xtol`: the root and the final
+/// bracket's width (a bound on its error).
+fn illinois(
+    f: impl Fn(f64) -> Result<f64>,
+    (mut a, mut fa): (f64, f64),
+    (mut b, mut fb): (f64, f64),
+    xtol: f64,
+) -> Result<(f64, f64)> {
+    let mut side = 0;
+    for _ in 0..100 {
+        if (b - a).abs() <= xtol * a.abs().max(b.abs()) {
+            break;
+        }
+        let c = (a * fb - b * fa) / (fb - fa);
+        let c = if c > a.min(b) && c < a.max(b) {
+            c
+        } else {
+            0.5 * (a + b)
+        };
+        let fc = f(c)?;
+        if fc == 0.0 || !fc.is_finite() {
+            return Ok((c, if fc == 0.0 { 0.0 } else { (b - a).abs() }));
+        }
+        if (fc > 0.0) == (fb > 0.0) {
+            (b, fb) = (c, fc);
+            if side == -1 {
+                fa *= 0.5;
+            }
+            side = -1;
+        } else {
+            (a, fa) = (c, fc);
+            if side == 1 {
+                fb *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    Ok((0.5 * (a + b), 0.5 * (b - a).abs()))
+}
+
+fn key(v: &Verdict) -> (Case, Option<bool>) {
+    (v.case, v.holds)
+}
+
+/// The β in (β_min, β_max) at which the verdict (case and holds) changes at this α. The
+/// scan solves the full verdict at log-spaced β; each change is then located by root-finding
+/// (Illinois regula falsi) on the high-energy quantity that changes sign across it, and
+/// checked by the verdict on both sides of the root; a change no limit explains is located
+/// by bisection on the verdict itself.
+pub fn boundaries(alpha: f64, nu: f64, eta: f64, options: &BoundaryOptions) -> Result<Boundaries> {
+    let (b0, b1) = (options.beta_min, options.beta_max);
+    if !(b0.is_finite() && b0 > 0.0) {
+        return Err(AtlasError::InvalidParameter {
+            name: "beta-min",
+            value: b0,
+            reason: "must be a finite number > 0",
+        });
+    }
+    if !(b1.is_finite() && b1 > b0) {
+        return Err(AtlasError::InvalidParameter {
+            name: "beta-max",
+            value: b1,
+            reason: "must be finite and above beta-min",
+        });
+    }
+    if !(4..=10_000).contains(&options.scan) {
+        return Err(AtlasError::InvalidParameter {
+            name: "scan",
+            value: options.scan as f64,
+            reason: "must be between 4 and 10000",
+        });
+    }
+    // Validates α, ν, η once.
+    EllipsoidBody::ellipsoid(alpha, 1.0, nu, eta)?;
+    let body = |beta: f64| EllipsoidBody::ellipsoid(alpha, beta, nu, eta);
+    let run = |beta: f64| -> Result<Verdict> { verdict(&body(beta)?, &options.verdict) };
+    let mut betas: Vec<f64> = (0..options.scan)
+        .map(|i| (b0.ln() + (b1.ln() - b0.ln()) * i as f64 / (options.scan - 1) as f64).exp())
+        .collect();
+    let case_line = (1.0 + alpha).sqrt();
+    if case_line > b0 && case_line < b1 {
+        betas.push(case_line * (1.0 - 1e-9));
+        betas.push(case_line * (1.0 + 1e-9));
+    }
+    betas.sort_by(f64::total_cmp);
+    let verdicts: Vec<Verdict> = betas.par_iter().map(|&b| run(b)).collect::<Result<_>>()?;
+    let mut found = Vec::new();
+    for pair in verdicts.windows(2) {
+        let (lo, hi) = (&pair[0], &pair[1]);
+        if key(lo) == key(hi) {
+            continue;
+        }
+        let boundary = |beta: f64, error: f64, quantity: String| Boundary {
+            beta,
+            error,
+            quantity,
+            case_below: lo.case,
+            holds_below: lo.holds,
+            case_above: hi.case,
+            holds_above: hi.holds,
+        };
+        if lo.case != hi.case {
+            found.push(boundary(
+                case_line,
+                4.0 * f64::EPSILON * case_line,
+                "case: beta^2 = 1 + alpha".into(),
+            ));
+            continue;
+        }
+        let mut located = None;
+        if let (Some(ml), Some(mh)) = (lo.margins, hi.margins) {
+            let (tl, th) = (ml.terms(), mh.terms());
+            // The term that changes sign across the pair decides; where the high-energy limit
+            // gives it at both ends, it is root-found on the limit alone (cheap and exact).
+            if let Some(t) = (0..3).find(|&t| (tl[t] > 0.0) != (th[t] > 0.0)) {
+                let limit_only = ml.from_limit[t] && mh.from_limit[t];
+                let tol = options.verdict.tol.min(1e-12);
+                let f = |beta: f64| -> Result<f64> {
+                    if limit_only {
+                        Ok(Margins::of_limit(&HighEnergyLimit::of(&body(beta)?, tol)?)[t])
+                    } else {
+                        Ok(run(beta)?.margins.map_or(f64::NAN, |m| m.terms()[t]))
+                    }
+                };
+                let (fa, fb) = if limit_only {
+                    (f(lo.beta)?, f(hi.beta)?)
+                } else {
+                    (tl[t], th[t])
+                };
+                if (fa > 0.0) != (fb > 0.0) && fa.is_finite() && fb.is_finite() {
+                    let xtol = if limit_only { 1e-10 } else { BOUNDARY_XTOL };
+                    let (root, width) = illinois(f, (lo.beta, fa), (hi.beta, fb), xtol)?;
+                    let source = if limit_only {
+                        "high-energy limit"
+                    } else {
+                        "sampled plane"
+                    };
+                    located = Some(boundary(
+                        root,
+                        width,
+                        format!("fail_margin: {} ({source})", Margins::NAMES[t]),
+                    ));
+                }
+            }
+        }
+        if located.is_none() {
+            // Bisection on the verdict itself, to a relative width of 1e-6.
+            let (mut a, mut b) = (lo.beta, hi.beta);
+            while b - a > 1e-6 * b {
+                let m = (a * b).sqrt();
+                if key(&run(m)?) == key(lo) {
+                    a = m;
+                } else {
+                    b = m;
+                }
+            }
+            located = Some(boundary((a * b).sqrt(), 0.5 * (b - a), "verdict".into()));
+        }
+        found.extend(located);
+    }
+    Ok(Boundaries {
+        alpha,
+        nu,
+        eta,
+        beta_range: [b0, b1],
+        boundaries: found,
+        scan: verdicts
+            .iter()
+            .map(|v| ScanPoint {
+                beta: v.beta,
+                case: v.case,
+                holds: v.holds,
+                kappa_max: v.kappa_max,
+                counterexamples: v.counterexamples.len(),
+                high_energy: v.high_energy,
+            })
+            .collect(),
+    })
+}

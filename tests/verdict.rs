@@ -1,0 +1,174 @@
+//! The verdict on the boundedness hypothesis over the whole (κ, ε) plane (src/verdict.rs),
+//! tested on the bodies of issue 11 against independent computations: every counterexample
+//! is solved again by the ODE method (one period of the reduced system with DOP853) and
+//! followed with the full six-dimensional model, whose centre of mass must run away by n·|Δζ|
+//! after n periods; the boundaries must stay put when the sampling resolution doubles.
+
+use rubber_atlas::cell::{solve_cell, CellOptions, Method};
+use rubber_atlas::trajectory::{integrate, Model, Start};
+use rubber_atlas::verdict::{boundaries, verdict, BoundaryOptions, Case, Verdict, VerdictOptions};
+use rubber_atlas::EllipsoidBody;
+
+fn judge(alpha: f64, beta: f64) -> (EllipsoidBody, Verdict) {
+    let body = EllipsoidBody::ellipsoid(alpha, beta, 0.5, 0.5).unwrap();
+    let v = verdict(&body, &VerdictOptions::default()).unwrap();
+    (body, v)
+}
+
+/// Every counterexample: on its integer to the tolerance, confirmed by the ODE method, and a
+/// full-model path whose centre of mass is n·|Δζ| from its start after n = 5 and 10 periods.
+fn check_counterexamples(body: &EllipsoidBody, v: &Verdict) {
+    assert!(!v.counterexamples.is_empty(), "{v:#?}");
+    for c in &v.counterexamples {
+        let ctx = format!("α = {}, β = {}: {c:?}", v.alpha, v.beta);
+        assert!(
+            (c.rotation_number - c.integer as f64).abs() <= 1e-10,
+            "{ctx}"
+        );
+        assert!(c.drift > 1e3 * c.drift_error, "{ctx}");
+        if v.case == Case::Two {
+            assert!(c.kappa > v.kappa_max.unwrap(), "{ctx}");
+        } else {
+            assert!(c.kappa > 0.0, "{ctx}");
+        }
+        if c.kappa > 100.0 {
+            continue; // far out: the ODE check of the nearer one covers the method
+        }
+        let ode = CellOptions {
+            tol: 1e-10,
+            method: Method::Ode,
+            ..CellOptions::default()
+        };
+        let r = solve_cell(body, c.kappa, c.energy, &ode).unwrap();
+        let comp = r
+            .components
+            .iter()
+            .find(|x| (x.theta_min - c.theta_min).abs() < 1e-6)
+            .unwrap_or_else(|| panic!("{ctx}: ODE components {:?}", r.components));
+        assert!(
+            (comp.rotation_number - c.integer as f64).abs() <= 1e-8 + comp.error_estimate,
+            "{ctx}: ODE N = {} ± {}",
+            comp.rotation_number,
+            comp.error_estimate
+        );
+        assert!(
+            (comp.drift - c.drift).abs() <= 1e-6 * c.drift,
+            "{ctx}: ODE drift {}",
+            comp.drift
+        );
+        let start = Start {
+            kappa: c.kappa,
+            theta0: c.theta_min,
+            theta_dot0: 0.0,
+        };
+        let away = |periods: f64| {
+            let t = integrate(body, &start, Model::Full, periods * comp.period, 4, 1e-12).unwrap();
+            let n = t.t.len() - 1;
+            (t.x_c[n] - t.x_c[0]).hypot(t.y_c[n] - t.y_c[0])
+        };
+        for periods in [5.0, 10.0] {
+            let d = away(periods);
+            assert!(
+                (d - periods * c.drift).abs() <= 1e-5 * periods * c.drift,
+                "{ctx}: after {periods} periods the full model is {d} away, expected {}",
+                periods * c.drift
+            );
+        }
+    }
+}
+
+#[test]
+fn prolate_case_one_body_fails_with_an_n_zero_resonance() {
+    // Issue 11: α = 0.5, β = 0.5, κ = 0.5 has N < 0 at ε = 8 and N > 0 at ε = 10.
+    let (body, v) = judge(0.5, 0.5);
+    assert_eq!((v.case, v.holds), (Case::One, Some(false)));
+    assert!(v.counterexamples.iter().any(|c| c.integer == 0
+        && c.kappa > 0.5
+        && c.kappa < 2.0
+        && c.energy > 8.0
+        && c.energy < 10.0));
+    // The limit says the same at every large κ: N at the bottom < 0 < N∞.
+    assert!(v.high_energy.normalized_max > 0.0 && v.high_energy.slope > 0.0);
+    assert!(v.evidence.limit_failure.is_some());
+    check_counterexamples(&body, &v);
+}
+
+#[test]
+fn strongly_oblate_body_fails_beyond_kappa_max() {
+    // Issue 11: α = 0.9, β = 20: κ_max = 3.919 and N falls below −1 at high energy.
+    let (body, v) = judge(0.9, 20.0);
+    assert_eq!((v.case, v.holds), (Case::Two, Some(false)));
+    let k = v.kappa_max.unwrap();
+    assert!((k - 3.91899).abs() < 1e-4, "{k}");
+    assert!(v.high_energy.n_min < -1.76 && v.high_energy.n_min > -1.7612);
+    assert!(v.counterexamples.iter().any(|c| c.integer == -1));
+    check_counterexamples(&body, &v);
+}
+
+#[test]
+fn symmetric_prolate_body_fails_everywhere() {
+    // α = 0, β < 1 (type (d)): V is symmetric about the equator, N = 0 on every torus.
+    let (body, v) = judge(0.0, 0.5);
+    assert_eq!((v.case, v.holds), (Case::One, Some(false)));
+    assert_eq!((v.high_energy.n_min, v.high_energy.n_max), (0.0, 0.0));
+    assert!(v.counterexamples.iter().all(|c| c.integer == 0));
+    check_counterexamples(&body, &v);
+}
+
+#[test]
+fn the_papers_body_holds_and_uncovered_bodies_are_said_so() {
+    let (_, v) = judge(0.5, 3.0);
+    assert_eq!((v.case, v.holds), (Case::Two, Some(true)));
+    assert!((v.kappa_max.unwrap() - 1.1078360352).abs() < 1e-6);
+    assert!(v.counterexamples.is_empty() && v.fail_margin < 0.0);
+    let (_, v) = judge(0.0, 2.0);
+    assert_eq!((v.case, v.holds), (Case::NotCovered, None));
+    // A type (b) body holds: N < 0 everywhere, from the bottom to N∞.
+    let (_, v) = judge(0.5, 1.1);
+    assert_eq!((v.case, v.holds), (Case::One, Some(true)));
+    assert!(v.evidence.rotation_number_range[1] <= 0.0);
+}
+
+#[test]
+fn boundaries_stay_put_when_the_resolution_doubles() {
+    let at = |resolution: usize| {
+        let options = BoundaryOptions {
+            beta_min: 0.6,
+            beta_max: 0.9,
+            scan: 4,
+            verdict: VerdictOptions {
+                resolution,
+                ..VerdictOptions::default()
+            },
+        };
+        let b = boundaries(0.5, 0.5, 0.5, &options).unwrap();
+        assert_eq!(b.boundaries.len(), 1, "{b:#?}");
+        b.boundaries[0].clone()
+    };
+    let (coarse, fine) = (at(64), at(128));
+    assert!(
+        (coarse.beta - fine.beta).abs() <= 1e-5 + coarse.error + fine.error,
+        "{coarse:?} vs {fine:?}"
+    );
+    assert!((fine.beta - 0.744478).abs() < 1e-5, "{fine:?}");
+    assert_eq!(
+        (fine.holds_below, fine.holds_above),
+        (Some(false), Some(true))
+    );
+}
+
+#[test]
+fn bad_options_are_refused() {
+    let body = EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 0.5).unwrap();
+    for (tol, resolution) in [(0.0, 64), (f64::NAN, 64), (1e-10, 2), (1e-10, 1 << 20)] {
+        assert!(verdict(&body, &VerdictOptions { tol, resolution }).is_err());
+    }
+    let mirror = EllipsoidBody::ellipsoid(-0.5, 3.0, 0.5, 0.5).unwrap();
+    assert!(verdict(&mirror, &VerdictOptions::default()).is_err());
+    let bad = BoundaryOptions {
+        beta_min: 2.0,
+        beta_max: 1.0,
+        ..BoundaryOptions::default()
+    };
+    assert!(boundaries(0.5, 0.5, 0.5, &bad).is_err());
+}
