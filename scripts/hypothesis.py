@@ -1,274 +1,293 @@
-"""The paper's boundedness hypothesis (SPEC §4) tested over an (α, β) atlas.
+"""The paper's boundedness hypothesis (SPEC §4) over the (α, β) plane, from `rubber-atlas verdict`.
 
-The hypothesis: trajectories are bounded (1) for β² < 1 + α, except κ = 0 with ε > ε_min;
-(2) for β² > 1 + α, α > 0, when κ > κ_max, where κ_max is the fold of the N = 0 curve
-(N = 0, ∂N/∂ε = 0). A path is unbounded exactly where a component's rotation number N is an
-integer (the drift radius R = |Δζ|/(2|sin πN|) is infinite there), so for every body of the
-atlas this script:
-- finds the integer resonances at κ > 0: sign changes of N − k between neighbouring cells of
-  one continuous component field (not across a separatrix, where N jumps);
-- computes κ_max with `rubber-atlas resonance --rotation-number 0 --fold` (case 2);
-- gives the verdict: `holds`, `fails` (an integer resonance where the hypothesis says
-  bounded), or `not covered` (α = 0, β > 1: diagram type (e));
-- for a failure, the evidence: the cell, its N and drift radius, the point of the resonance
-  traced exactly, and a `rubber-atlas trajectory` there whose centre of mass drifts away.
+The hypothesis: paths are bounded (1) for β² < 1 + α at every κ ≠ 0; (2) for β² > 1 + α, α > 0,
+when κ > κ_max (the fold of the N = 0 curve beside σ_u). `rubber-atlas verdict` decides it for
+one body over the whole (κ, ε) plane, the limits ε → ∞, κ → 0 and the bottom of each well
+included; `verdict --boundaries` gives, for one α, the β at which the verdict changes, each by
+root-finding on the fail margin (the quantity that decides it).
 
-    .venv/bin/python scripts/hypothesis.py atlas/hypothesis.h5 --out atlas/out/hypothesis
-writes hypothesis.csv, hypothesis.h5 (verdict per (α, β)) and hypothesis.png (the map).
+This script, for given (ν, η):
+- runs `verdict --boundaries` at every α of a grid, whose scan gives the verdict of every
+  body of an α × β grid (log-spaced β) and the boundary curves β(α);
+- repeats the boundaries (on a coarser grid) for other (ν, η), to show how the curves move;
+- confirms each failure region with one full-model trajectory (`trajectory --model full`)
+  started on a counterexample: its centre of mass must run away linearly, n·|Δζ| after n
+  periods;
+- writes <out>.csv (the map), <out>-boundaries.csv, <out>-evidence.csv, <out>.h5 (all three)
+  and <out>.png (the map with the curves).
+
+    .venv/bin/python scripts/hypothesis.py --out docs/hypothesis
 """
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import os
 import subprocess
+import sys
 import tempfile
-from dataclasses import asdict, dataclass
+import time
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
+import h5py
 import numpy as np
-
-from atlas_io import open_atlas
 
 ROOT = Path(__file__).resolve().parents[1]
 BIN = os.environ.get("RUBBER_ATLAS_BIN", str(ROOT / "target" / "release" / "rubber-atlas"))
-JUMP = 0.5  # a larger change of N between neighbouring cells is a separatrix, not a crossing
-VERDICTS = ["holds", "fails", "not covered"]
-
-
-@dataclass
-class Verdict:
-    alpha: float
-    beta: float
-    diagram_type: str
-    case: int  # 1: β² < 1 + α; 2: β² > 1 + α, α > 0; 0: not covered
-    integer_resonance: bool
-    resonance_kappa: float  # the largest κ of an integer crossing found (NaN if none)
-    kappa_max: float  # the fold of the N = 0 curve (NaN if none or not computed)
-    verdict: str
-    evidence_kappa: float = float("nan")
-    evidence_energy: float = float("nan")
-    evidence_n: float = float("nan")
-    evidence_drift_radius: float = float("nan")
-    evidence_integer: float = float("nan")
-    evidence_component: int = -1
+CATEGORIES = {"holds": 0, "fails": 1, "not covered": 2}
 
 
 def run(*args: str) -> str:
-    return subprocess.run([BIN, *args], check=True, capture_output=True, text=True).stdout
+    """The program's standard output; its one-line error message if it fails."""
+    p = subprocess.run([BIN, *args], capture_output=True, text=True)
+    if p.returncode != 0:
+        raise RuntimeError(f"rubber-atlas {' '.join(args)}: {p.stderr.strip()}")
+    return p.stdout
 
 
-def diagram_type(alpha: float, beta: float, nu: float, eta: float) -> str:
-    out = json.loads(run("diagram", "--alpha", repr(alpha), "--beta", repr(beta), "--nu", repr(nu), "--eta", repr(eta),
-                         "--json"))
-    return out["diagram_type"]
+def boundaries(alpha: float, nu: float, eta: float, scan: int, beta_min: float, beta_max: float) -> dict:
+    """`verdict --boundaries` at one α: {alpha, boundaries: [...], scan: [...]}."""
+    return json.loads(run("verdict", f"--alpha={alpha!r}", f"--nu={nu!r}", f"--eta={eta!r}", "--boundaries",
+                          f"--scan={scan}", f"--beta-min={beta_min!r}", f"--beta-max={beta_max!r}", "--json"))
 
 
-def integer_crossings(kappa: np.ndarray, energy: np.ndarray, n: np.ndarray, drift_radius: np.ndarray,
-                      bounded: np.ndarray | None = None):
-    """(κ, ε, N, R, k, slot) of the cells next to a crossing of an integer k by N (κ > 0), over
-    every component slot, neighbours along κ and along ε; and of the cells the solver marked
-    unbounded (N an integer within its error estimate), if `bounded` is given."""
-    found = []
-    for slot in range(n.shape[-1]):
-        z, r = n[..., slot], drift_radius[..., slot]
-        for axis in (0, 1):
-            lo, hi = (z[:-1, :], z[1:, :]) if axis == 0 else (z[:, :-1], z[:, 1:])
-            ok = np.isfinite(lo) & np.isfinite(hi) & (np.abs(hi - lo) < JUMP)
-            with np.errstate(invalid="ignore"):
-                cross = ok & (np.floor(lo) != np.floor(hi))
-            for i, j in np.argwhere(cross):
-                ii, jj = (i + 1, j) if axis == 0 else (i, j + 1)
-                if kappa[i] <= 0 or kappa[ii] <= 0:
-                    continue
-                k = float(max(np.floor(lo[i, j]), np.floor(hi[i, j])))
-                # The cell of the pair nearer the integer.
-                pick = (i, j) if abs(z[i, j] - k) < abs(z[ii, jj] - k) else (ii, jj)
-                found.append((float(kappa[pick[0]]), float(energy[pick[1]]), float(z[pick]), float(r[pick]), k, slot))
-        if bounded is not None:
-            for i, j in np.argwhere(bounded[..., slot] == 0):
-                if kappa[i] > 0:
-                    found.append((float(kappa[i]), float(energy[j]), float(z[i, j]), float(r[i, j]),
-                                  float(np.round(z[i, j])), slot))
-    return found
+def verdict(alpha: float, beta: float, nu: float, eta: float) -> dict:
+    return json.loads(run("verdict", f"--alpha={alpha!r}", f"--beta={beta!r}", f"--nu={nu!r}", f"--eta={eta!r}",
+                          "--json"))
 
 
-def fold(alpha, beta, nu, eta, window) -> float:
-    out = json.loads(run("resonance", "--alpha", repr(alpha), "--beta", repr(beta), "--nu", repr(nu), "--eta", repr(eta),
-                         "--rotation-number", "0", "--fold", "--kappa-min", repr(window[0]), "--kappa-max",
-                         repr(window[1]), "--energy-min", repr(window[2]), "--energy-max", repr(window[3]),
-                         "--grid", "32"))
-    return float("nan") if out["kappa_max"] is None else float(out["kappa_max"])
+def label(holds) -> str:
+    return "not covered" if holds is None else ("holds" if holds else "fails")
 
 
-def judge(path: str | Path) -> list[Verdict]:
-    ds = open_atlas(path)
-    nu, eta = float(ds.attrs["nu"]), float(ds.attrs["eta"])
-    kappa, energy = ds.kappa.values, ds.energy.values
-    positive = kappa[kappa > 0]
-    window = (float(positive.min()), float(kappa.max()), float(energy.min()), float(energy.max()))
-    dk = float(np.diff(kappa).max()) if len(kappa) > 1 else 0.0
-    verdicts = []
-    for ia, alpha in enumerate(ds.alpha.values):
-        for ib, beta in enumerate(ds.beta.values):
-            alpha, beta = float(alpha), float(beta)
-            n = ds.rotation_number.isel(alpha=ia, beta=ib).values
-            r = ds.drift_radius.isel(alpha=ia, beta=ib).values if "drift_radius" in ds else np.full_like(n, np.nan)
-            b = ds.bounded.isel(alpha=ia, beta=ib).values if "bounded" in ds else None
-            crossings = integer_crossings(kappa, energy, n, r, b)
-            kind = diagram_type(alpha, beta, nu, eta)
-            if beta**2 < 1 + alpha:
-                case = 1
-            elif alpha > 0:
-                case = 2
-            else:
-                case = 0
-            k_max = fold(alpha, beta, nu, eta, window) if case == 2 else float("nan")
-            top = max(crossings, key=lambda c: c[0]) if crossings else None
-            v = Verdict(alpha, beta, kind, case, bool(crossings), top[0] if top else float("nan"), k_max, "holds")
-            if case == 0:
-                v.verdict = "not covered"
-            elif case == 1:
-                bad = crossings
-            else:
-                # Beyond the fold, with a grid cell's margin (the crossing is between cells).
-                limit = k_max if np.isfinite(k_max) else 0.0
-                bad = [c for c in crossings if c[0] > limit + dk]
-            if case and bad:
-                worst = max(bad, key=lambda c: c[0])
-                v.verdict = "fails"
-                (v.evidence_kappa, v.evidence_energy, v.evidence_n, v.evidence_drift_radius, v.evidence_integer,
-                 v.evidence_component) = worst
-            verdicts.append(v)
-    ds.close()
-    return verdicts
+def sweep(alphas, nu, eta, scan, beta_min, beta_max, jobs):
+    """`verdict --boundaries` at every α, `jobs` processes at a time, in α order."""
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
+        return list(pool.map(lambda a: boundaries(a, nu, eta, scan, beta_min, beta_max), alphas))
 
 
-def confirm(v: Verdict, nu: float, eta: float, periods=(10, 40)) -> dict:
-    """A failure checked with the program: the resonance traced exactly near the evidence cell
-    (`resonance`), then the centre of mass over `periods` θ-periods there (`trajectory`): on
-    an integer resonance its distance from the start grows in proportion to the periods."""
-    if abs(v.evidence_n - v.evidence_integer) < 1e-9:
-        # The cell itself is on the resonance (N = k to the solver's tolerance).
-        p = {"kappa": v.evidence_kappa, "energy": v.evidence_energy, "component": v.evidence_component,
-             "rotation_number": v.evidence_n}
-    else:
-        pad_k, pad_e = 0.05, 0.05
-        traced = json.loads(run("resonance", "--alpha", repr(v.alpha), "--beta", repr(v.beta), "--nu", repr(nu),
-                                "--eta", repr(eta), "--rotation-number", repr(v.evidence_integer), "--kappa-min",
-                                repr(max(v.evidence_kappa - pad_k, 1e-3)), "--kappa-max",
-                                repr(v.evidence_kappa + pad_k), "--energy-min", repr(v.evidence_energy - pad_e),
-                                "--energy-max", repr(v.evidence_energy + pad_e), "--grid", "16", "--json"))
-        points = [p for c in traced["curves"] for p in c["points"]]
-        if not points:
-            return {"confirmed": False, "reason": "no resonance point traced near the cell"}
-        p = min(points, key=lambda p: (p["kappa"] - v.evidence_kappa) ** 2 + (p["energy"] - v.evidence_energy) ** 2)
-    import h5py
+def map_rows(results) -> list[dict]:
+    """One row per body of the scans: the map."""
+    rows = []
+    for r in results:
+        for p in r["scan"]:
+            h = p["high_energy"]
+            rows.append(dict(alpha=r["alpha"], beta=p["beta"], case=p["case"], verdict=label(p["holds"]),
+                             kappa_max=np.nan if p["kappa_max"] is None else p["kappa_max"],
+                             counterexamples=p["counterexamples"], slope=h["slope"], n_min=h["n_min"],
+                             n_max=h["n_max"]))
+    return rows
 
+
+def boundary_rows(results, nu, eta) -> list[dict]:
+    rows = []
+    for r in results:
+        for b in r["boundaries"]:
+            rows.append(dict(nu=nu, eta=eta, alpha=r["alpha"], beta=b["beta"], error=b["error"],
+                             quantity=b["quantity"], below=f"case {b['case_below']} {label(b['holds_below'])}",
+                             above=f"case {b['case_above']} {label(b['holds_above'])}"))
+    return rows
+
+
+def curve_kind(row: dict) -> str:
+    """Boundaries of one kind join into one curve β(α)."""
+    if row["quantity"].startswith("case"):
+        return "case line beta^2 = 1 + alpha"
+    return f"{row['below']} | {row['above']}: {row['quantity']}"
+
+
+def regions(rows: list[dict]) -> list[list[dict]]:
+    """Connected sets of failing bodies on the α × β grid (4-neighbours, one case each)."""
+    alphas = sorted({r["alpha"] for r in rows})
+    betas = {a: sorted(r["beta"] for r in rows if r["alpha"] == a) for a in alphas}
+    at = {(r["alpha"], r["beta"]): r for r in rows}
+    index = {(a, b): (i, j) for i, a in enumerate(alphas) for j, b in enumerate(betas[a])}
+    cell = {v: k for k, v in index.items()}
+    seen, out = set(), []
+    for key, r in at.items():
+        if r["verdict"] != "fails" or key in seen:
+            continue
+        stack, region = [key], []
+        seen.add(key)
+        while stack:
+            k = stack.pop()
+            region.append(at[k])
+            i, j = index[k]
+            for n in [(i + 1, j), (i - 1, j), (i, j + 1), (i, j - 1)]:
+                nk = cell.get(n)
+                if nk and nk not in seen and at[nk]["verdict"] == "fails" and at[nk]["case"] == r["case"]:
+                    seen.add(nk)
+                    stack.append(nk)
+        out.append(region)
+    return out
+
+
+def confirm(alpha: float, beta: float, nu: float, eta: float, periods=(10, 20)) -> dict:
+    """The first counterexample of one body, followed with the full model: the centre of mass
+    is n·|Δζ| from its start after n periods on an integer resonance."""
+    v = verdict(alpha, beta, nu, eta)
+    if not v["counterexamples"]:
+        return dict(alpha=alpha, beta=beta, confirmed=False, reason=v["evidence"].get("limit_failure") or "none")
+    c = min(v["counterexamples"], key=lambda c: abs(np.log(c["kappa"])))
+    cell = json.loads(run("cell", f"--alpha={alpha!r}", f"--beta={beta!r}", f"--nu={nu!r}", f"--eta={eta!r}",
+                          f"--kappa={c['kappa']!r}", f"--energy={c['energy']!r}", "--method", "ode", "--json"))
+    comp = min(cell["components"], key=lambda x: abs(x["theta_min"] - c["theta_min"]))
     distances = []
-    with tempfile.TemporaryDirectory() as d:
-        for k in periods:
-            out = Path(d) / f"t{k}.h5"
-            run("trajectory", "--alpha", repr(v.alpha), "--beta", repr(v.beta), "--nu", repr(nu), "--eta", repr(eta),
-                "--kappa", repr(p["kappa"]), "--energy", repr(p["energy"]), "--component", str(p["component"]),
-                "--periods", str(k), "--samples", str(20 * k), "--out", str(out))
+    with tempfile.TemporaryDirectory() as tmp:
+        for n in periods:
+            out = Path(tmp) / f"t{n}.h5"
+            run("trajectory", f"--alpha={alpha!r}", f"--beta={beta!r}", f"--nu={nu!r}", f"--eta={eta!r}",
+                f"--kappa={c['kappa']!r}", f"--theta0={c['theta_min']!r}", f"--periods={n}", "--samples=4",
+                "--model", "full", "--out", str(out))
             with h5py.File(out) as f:
                 x, y = f["x_c"][()], f["y_c"][()]
             distances.append(float(np.hypot(x[-1] - x[0], y[-1] - y[0])))
-    ratio = distances[1] / distances[0] if distances[0] > 0 else float("nan")
-    return {"confirmed": bool(abs(ratio - periods[1] / periods[0]) < 0.5), "kappa": p["kappa"], "energy": p["energy"],
-            "rotation_number": p["rotation_number"], "periods": list(periods), "distances": distances}
+    expected = [n * c["drift"] for n in periods]
+    linear = all(abs(d - e) <= 1e-5 * e for d, e in zip(distances, expected))
+    return dict(alpha=alpha, beta=beta, case=v["case"], integer=c["integer"], kappa=c["kappa"], energy=c["energy"],
+                rotation_number=c["rotation_number"], ode_rotation_number=comp["rotation_number"],
+                drift_per_period=c["drift"], periods=list(periods), distance=distances, confirmed=linear)
 
 
-def save(verdicts: list[Verdict], out: Path, nu: float, eta: float) -> None:
-    out.parent.mkdir(parents=True, exist_ok=True)
-    rows = [asdict(v) for v in verdicts]
-    with open(out.with_suffix(".csv"), "w", newline="") as f:
+def write_csv(path: Path, rows: list[dict]) -> None:
+    import csv
+
+    with open(path, "w", newline="") as f:
+        if not rows:
+            return
         w = csv.DictWriter(f, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
-    import h5py
-
-    alphas = sorted({v.alpha for v in verdicts})
-    betas = sorted({v.beta for v in verdicts})
-    shape = (len(alphas), len(betas))
-    with h5py.File(out.with_suffix(".h5"), "w") as f:
-        f.attrs["nu"], f.attrs["eta"] = nu, eta
-        f.attrs["verdict_meanings"] = " ".join(v.replace(" ", "_") for v in VERDICTS)
-        f.create_dataset("alpha", data=alphas)
-        f.create_dataset("beta", data=betas)
-        grids = {name: np.full(shape, np.nan) for name in ("kappa_max", "resonance_kappa", "case", "verdict")}
-        for v in verdicts:
-            i, j = alphas.index(v.alpha), betas.index(v.beta)
-            grids["kappa_max"][i, j] = v.kappa_max
-            grids["resonance_kappa"][i, j] = v.resonance_kappa
-            grids["case"][i, j] = v.case
-            grids["verdict"][i, j] = VERDICTS.index(v.verdict)
-        for name, data in grids.items():
-            f.create_dataset(name, data=data)
-    plot(verdicts, out.with_suffix(".png"))
 
 
-def plot(verdicts: list[Verdict], png: Path) -> None:
+def write_h5(path: Path, tables: dict[str, list[dict]], attrs: dict) -> None:
+    with h5py.File(path, "w") as f:
+        f.attrs.update(attrs)
+        for name, rows in tables.items():
+            g = f.create_group(name)
+            for key in rows[0] if rows else []:
+                values = [r[key] for r in rows]
+                if isinstance(values[0], str) or isinstance(values[0], list):
+                    g.create_dataset(key, data=np.array([str(v) for v in values], dtype=h5py.string_dtype()))
+                else:
+                    g.create_dataset(key, data=np.array(values, dtype=float))
+
+
+def plot(rows, curves, others, evidence, png: Path, nu: float, eta: float) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.colors import ListedColormap
 
-    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.4))
-    colours = {"holds": "tab:green", "fails": "tab:red", "not covered": "tab:gray"}
-    for name, c in colours.items():
-        pts = [(v.alpha, v.beta**2) for v in verdicts if v.verdict == name]
-        if pts:
-            a, b = zip(*pts)
-            ax.scatter(a, b, c=c, s=18, label=f"{name} ({len(pts)})")
-    alpha = np.linspace(0, 1, 100)
-    for sign, style in ((1, "-"), (-1, "--")):
-        ax.plot(alpha, 1 + sign * alpha, "k" + style, lw=0.8, label=f"β² = 1 {'+' if sign > 0 else '−'} α")
-    ax.set_xlabel("α")
-    ax.set_ylabel("β²")
-    ax.set_title("boundedness hypothesis: verdict per body")
-    ax.legend(fontsize=8)
-    pts = [(v.alpha, v.beta**2, v.kappa_max) for v in verdicts if np.isfinite(v.kappa_max)]
-    if pts:
-        a, b, k = zip(*pts)
-        sc = bx.scatter(a, b, c=k, s=18, cmap="viridis")
-        fig.colorbar(sc, ax=bx, label="κ_max (fold of N = 0)")
-    bx.plot(alpha, 1 + alpha, "k-", lw=0.8)
-    bx.set_xlabel("α")
-    bx.set_ylabel("β²")
-    bx.set_title("κ_max(α, β) where β² > 1 + α")
+    alphas = np.array(sorted({r["alpha"] for r in rows}))
+    betas = np.array(sorted({r["beta"] for r in rows if r["alpha"] == alphas[0]}))
+    grid = np.full((len(betas), len(alphas)), np.nan)
+    for r in rows:
+        i = int(np.argmin(np.abs(betas - r["beta"])))
+        grid[i, int(np.searchsorted(alphas, r["alpha"]))] = CATEGORIES[r["verdict"]]
+    fig, ax = plt.subplots(figsize=(9, 6.5))
+    cmap = ListedColormap(["#bfe3bf", "#f2b8b5", "#dddddd"])
+    ax.pcolormesh(alphas, betas, grid, cmap=cmap, vmin=-0.5, vmax=2.5, shading="nearest")
+    styles = ["-", "-", "-", "-"]
+    for n, (kind, pts) in enumerate(sorted(curves.items())):
+        pts = sorted(pts, key=lambda p: p[0])
+        a, b = np.array(pts).T
+        if kind.startswith("case line"):
+            ax.plot(a, b, "k--", lw=1, label=r"$\beta^2 = 1 + \alpha$ (cases 1 | 2)")
+        else:
+            ax.plot(a, b, styles[n % 4], marker=".", ms=3, lw=1.6, label=kind.split(": fail_margin: ")[-1])
+    for (o_nu, o_eta), o_curves in others.items():
+        for kind, pts in o_curves.items():
+            if kind.startswith("case line"):
+                continue
+            pts = sorted(pts, key=lambda p: p[0])
+            a, b = np.array(pts).T
+            ax.plot(a, b, ":", lw=1.2, label=f"nu = {o_nu}, eta = {o_eta}")
+    for e in evidence:
+        if e.get("confirmed"):
+            ax.plot(e["alpha"], e["beta"], "k*", ms=9)
+    ax.set_yscale("log")
+    ax.set_xlabel(r"$\alpha$")
+    ax.set_ylabel(r"$\beta$")
+    ax.set_title(f"Boundedness hypothesis over the whole ($\\kappa$, $\\varepsilon$) plane ($\\nu$ = {nu}, "
+                 f"$\\eta$ = {eta})\ngreen holds, red fails, grey not covered; * trajectory evidence", fontsize=10)
+    ax.legend(fontsize=7, loc="lower right")
     fig.tight_layout()
-    fig.savefig(png, dpi=110)
+    fig.savefig(png, dpi=130)
     plt.close(fig)
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("atlas", help="an atlas over (alpha, beta) with rotation_number (e.g. atlas/hypothesis.toml)")
-    parser.add_argument("--out", required=True, help="output path without extension (.csv, .h5, .png are written)")
-    parser.add_argument("--no-confirm", action="store_true", help="skip the trajectory check of failures")
+    parser = argparse.ArgumentParser(
+        description="The boundedness hypothesis over the (alpha, beta) plane from `rubber-atlas verdict`: the map, "
+                    "the boundary curves for several (nu, eta), and trajectory evidence for each failure region.")
+    parser.add_argument("--out", required=True, help="output path without extension (.csv, -boundaries.csv, "
+                                                     "-evidence.csv, .h5 and .png are written)")
+    parser.add_argument("--nu", type=float, default=0.5, help="nu of the map (default 0.5)")
+    parser.add_argument("--eta", type=float, default=0.5, help="eta of the map (default 0.5)")
+    parser.add_argument("--alphas", type=int, default=40, help="alpha values from 0 to 0.975 (default 40)")
+    parser.add_argument("--betas", type=int, default=60, help="log-spaced beta values (default 60)")
+    parser.add_argument("--beta-min", type=float, default=0.05, help="smallest beta (default 0.05)")
+    parser.add_argument("--beta-max", type=float, default=50.0, help="largest beta (default 50)")
+    parser.add_argument("--others", default="0.1,1;1,0.1;1.5,5",
+                        help="other (nu, eta) pairs whose boundary curves are drawn, as 'nu,eta;nu,eta' "
+                             "(default '0.1,1;1,0.1;1.5,5'; '' for none)")
+    parser.add_argument("--other-alphas", type=int, default=10, help="alpha values for the other pairs (default 10)")
+    parser.add_argument("--other-betas", type=int, default=24, help="beta scan for the other pairs (default 24)")
+    parser.add_argument("--jobs", type=int, default=2, help="verdict processes at a time (default 2)")
+    parser.add_argument("--no-confirm", action="store_true", help="skip the trajectory evidence")
     args = parser.parse_args()
-    ds = open_atlas(args.atlas)
-    nu, eta = float(ds.attrs["nu"]), float(ds.attrs["eta"])
-    ds.close()
-    verdicts = judge(args.atlas)
+
+    start = time.time()
+    alphas = [float(a) for a in np.linspace(0.0, 0.975, args.alphas)] if args.alphas > 1 else [0.5]
+    results = sweep(alphas, args.nu, args.eta, args.betas, args.beta_min, args.beta_max, args.jobs)
+    rows = map_rows(results)
+    brows = boundary_rows(results, args.nu, args.eta)
+    curves: dict[str, list] = {}
+    for b in brows:
+        curves.setdefault(curve_kind(b), []).append((b["alpha"], b["beta"]))
+    main_seconds = time.time() - start
+    others = {}
+    for pair in filter(None, args.others.split(";")):
+        o_nu, o_eta = (float(x) for x in pair.split(","))
+        o_alphas = [float(a) for a in np.linspace(0.0, 0.975, args.other_alphas)]
+        o_results = sweep(o_alphas, o_nu, o_eta, args.other_betas, args.beta_min, args.beta_max, args.jobs)
+        o_rows = boundary_rows(o_results, o_nu, o_eta)
+        brows += o_rows
+        o_curves: dict[str, list] = {}
+        for b in o_rows:
+            o_curves.setdefault(curve_kind(b), []).append((b["alpha"], b["beta"]))
+        others[(o_nu, o_eta)] = o_curves
+    evidence = []
+    if not args.no_confirm:
+        for region in regions(rows):
+            # The body nearest the region's middle (in α, then log β).
+            mid_a = np.median([r["alpha"] for r in region])
+            mid_b = np.exp(np.median([np.log(r["beta"]) for r in region]))
+            body = min(region, key=lambda r: (abs(r["alpha"] - mid_a), abs(np.log(r["beta"] / mid_b))))
+            e = confirm(body["alpha"], body["beta"], args.nu, args.eta)
+            e["region_bodies"] = len(region)
+            evidence.append(e)
     out = Path(args.out)
-    save(verdicts, out, nu, eta)
-    counts = {name: sum(v.verdict == name for v in verdicts) for name in VERDICTS}
-    print(f"{len(verdicts)} bodies: " + ", ".join(f"{n} {name}" for name, n in counts.items()))
-    for v in verdicts:
-        if v.verdict != "fails":
-            continue
-        line = (f"FAILS at alpha={v.alpha:g} beta={v.beta:g} (type {v.diagram_type}, case {v.case}): N crosses "
-                f"{v.evidence_integer:g} at kappa={v.evidence_kappa:.4g}, energy={v.evidence_energy:.4g} "
-                f"(cell N={v.evidence_n:.4g}, drift radius {v.evidence_drift_radius:.3g}); kappa_max={v.kappa_max:.6g}")
-        if not args.no_confirm:
-            c = confirm(v, nu, eta)
-            line += f"; trajectory: {json.dumps(c)}"
-        print(line)
-    print(f"wrote {out.with_suffix('.csv')}, {out.with_suffix('.h5')}, {out.with_suffix('.png')}")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    write_csv(out.with_suffix(".csv"), rows)
+    write_csv(out.parent / f"{out.name}-boundaries.csv", brows)
+    write_csv(out.parent / f"{out.name}-evidence.csv", evidence)
+    attrs = dict(nu=args.nu, eta=args.eta, program=run("--version").strip(),
+                 command_line=" ".join(sys.argv), seconds_map=main_seconds)
+    write_h5(out.with_suffix(".h5"), dict(map=rows, boundaries=brows, evidence=evidence), attrs)
+    plot(rows, curves, others, evidence, out.with_suffix(".png"), args.nu, args.eta)
+    counts = {k: sum(r["verdict"] == k for r in rows) for k in CATEGORIES}
+    print(f"hypothesis: {len(rows)} bodies ({counts}), {len(brows)} boundaries, "
+          f"{sum(e.get('confirmed', False) for e in evidence)}/{len(evidence)} failure regions confirmed by the "
+          f"full model; map and curves in {main_seconds:.0f} s, everything in {time.time() - start:.0f} s")
+    for e in evidence:
+        print("  evidence:", {k: e[k] for k in e if k in ("alpha", "beta", "integer", "kappa", "energy", "distance",
+                                                          "confirmed", "region_bodies", "reason")})
+    if not all(e.get("confirmed") for e in evidence):
+        sys.exit("hypothesis: a failure region was not confirmed by a trajectory")
 
 
 if __name__ == "__main__":

@@ -368,6 +368,7 @@ fn verdict(args: VerdictArgs) -> Result<()> {
     let options = VerdictOptions {
         tol: args.tol,
         resolution: args.resolution,
+        counterexamples: true,
     };
     if args.boundaries {
         let found = verdict::boundaries(

@@ -80,6 +80,9 @@ pub struct VerdictOptions {
     pub tol: f64,
     /// κ-lines of each kind (log-spaced and evenly spaced) and base energies per line.
     pub resolution: usize,
+    /// Refine the integer brackets into counterexamples (off: only the fail margin and the
+    /// count of brackets, as the root-finding of [`boundaries`] needs).
+    pub counterexamples: bool,
 }
 
 impl Default for VerdictOptions {
@@ -87,6 +90,7 @@ impl Default for VerdictOptions {
         Self {
             tol: 1e-10,
             resolution: 64,
+            counterexamples: true,
         }
     }
 }
@@ -421,13 +425,27 @@ fn integers_between(
     }
 }
 
-/// The automatic window in which the N = 0 curve hugging σ_u is traced for its fold:
-/// κ up to twice the cusp's, ε from the bottom to well above the cusp.
-fn fold_window(body: &EllipsoidBody, set: &CriticalSet) -> Option<((f64, f64), (f64, f64))> {
-    let cusp = set.cusp?;
-    let low = bottom(&EffectivePotential::new(body, 0.01))?;
-    let top = cusp.energy + 2.0 * (cusp.energy - low).max(1.0);
-    Some(((0.01, 2.0 * cusp.kappa + 0.5), (low, top)))
+/// The windows in which the N = 0 curve hugging σ_u is traced for its fold, with their seed
+/// grids: first a narrow one around the cusp (the fold lies a few per cent above κ_c for the
+/// bodies tried), then a wide one (κ up to 2κ_c + 0.5, ε well above the cusp).
+fn fold_windows(body: &EllipsoidBody, set: &CriticalSet) -> Vec<((f64, f64), (f64, f64), usize)> {
+    let Some(cusp) = set.cusp else {
+        return Vec::new();
+    };
+    let top_of_u = set
+        .theta_star
+        .map_or(cusp.energy, |t| body.shape.potential(t));
+    let mut out = Vec::new();
+    let k0 = 0.5 * cusp.kappa;
+    if let Some(low) = bottom(&EffectivePotential::new(body, k0)) {
+        let top = cusp.energy + (cusp.energy - top_of_u).max(0.05 * cusp.energy);
+        out.push(((k0, 1.5 * cusp.kappa + 0.05), (low, top), 24));
+    }
+    if let Some(low) = bottom(&EffectivePotential::new(body, 0.01)) {
+        let top = cusp.energy + 2.0 * (cusp.energy - low).max(1.0);
+        out.push(((0.01, 2.0 * cusp.kappa + 0.5), (low, top), 48));
+    }
+    out
 }
 
 /// κ_max of case 2: the fold of the N = 0 curve of largest κ near σ_u, with its error. The
@@ -436,29 +454,28 @@ fn fold_window(body: &EllipsoidBody, set: &CriticalSet) -> Option<((f64, f64), (
 /// M, by Illinois regula falsi (the final bracket and the solver's tolerance through dM/dκ
 /// bound the error).
 fn kappa_max(body: &EllipsoidBody, set: &CriticalSet, tol: f64) -> Result<Option<(f64, f64)>> {
-    let Some((kappa, energy)) = fold_window(body, set) else {
-        return Ok(None);
-    };
     let cell = CellOptions {
         tol,
         drift: false,
         ..CellOptions::default()
     };
-    let options = ResonanceOptions {
-        target: 0.0,
-        kappa,
-        energy,
-        grid: 48,
-        cell,
-        max_points: 20_000,
-        max_point_error: 1e-6,
-    };
-    let Some(fold) = resonance::fold(body, &options)? else {
-        return Ok(None);
-    };
-    Ok(Some(
-        polish_fold(body, &fold, &cell).unwrap_or((fold.kappa_max, fold.kappa_error)),
-    ))
+    for (kappa, energy, grid) in fold_windows(body, set) {
+        let options = ResonanceOptions {
+            target: 0.0,
+            kappa,
+            energy,
+            grid,
+            cell,
+            max_points: 20_000,
+            max_point_error: 1e-6,
+        };
+        if let Some(fold) = resonance::fold(body, &options)? {
+            return Ok(Some(
+                polish_fold(body, &fold, &cell).unwrap_or((fold.kappa_max, fold.kappa_error)),
+            ));
+        }
+    }
+    Ok(None)
 }
 
 /// N of the component around the minimum of V nearest `well` at (κ, ε).
@@ -648,7 +665,11 @@ pub fn verdict(body: &EllipsoidBody, options: &VerdictOptions) -> Result<Verdict
         .fold((high_energy.n_min, high_energy.n_max), |(lo, hi), s| {
             (lo.min(s.n), hi.max(s.n))
         });
-    let (mut found, mut refinement_failures) = counterexamples(&sampler, &candidates);
+    let (mut found, mut refinement_failures) = if options.counterexamples {
+        counterexamples(&sampler, &candidates)
+    } else {
+        (Vec::new(), 0)
+    };
     let mut integer_brackets = candidates.len();
 
     // The limit κ → ∞ decides what lies beyond the last line.
@@ -660,7 +681,7 @@ pub fn verdict(body: &EllipsoidBody, options: &VerdictOptions) -> Result<Verdict
     let limit_failure = limit_failure(&high_energy, bottom_sign);
     let mut kappa_top = *kappas.last().expect("lines");
     if let Some((_, k)) = &limit_failure {
-        if !found.iter().any(|c| c.integer == *k) {
+        if options.counterexamples && !found.iter().any(|c| c.integer == *k) {
             // The resonance it proves lies at larger κ: two more lines, as far as double
             // precision resolves ε − V (κ² ≲ 1e12).
             let extra: Vec<Vec<Sample>> = EXTRA_KAPPA_LINES
@@ -685,7 +706,12 @@ pub fn verdict(body: &EllipsoidBody, options: &VerdictOptions) -> Result<Verdict
         }
     }
     verdict.counterexamples = found;
-    verdict.holds = Some(verdict.counterexamples.is_empty() && limit_failure.is_none());
+    let resonant = if options.counterexamples {
+        !verdict.counterexamples.is_empty()
+    } else {
+        !candidates.is_empty()
+    };
+    verdict.holds = Some(!resonant && limit_failure.is_none());
     let margins = fail_margin(&sampler, &lines, &high_energy, n_lo, n_hi);
     verdict.fail_margin = margins.value();
     verdict.margins = Some(margins);
@@ -1088,7 +1114,7 @@ impl Default for BoundaryOptions {
 }
 
 /// Relative width to which a boundary is located on the sampled plane.
-const BOUNDARY_XTOL: f64 = 1e-6;
+const BOUNDARY_XTOL: f64 = 1e-5;
 
 /// Illinois regula falsi on a bracket, to a relative width `xtol`: the root and the final
 /// bracket's width (a bound on its error).
@@ -1166,6 +1192,12 @@ pub fn boundaries(alpha: f64, nu: f64, eta: f64, options: &BoundaryOptions) -> R
     EllipsoidBody::ellipsoid(alpha, 1.0, nu, eta)?;
     let body = |beta: f64| EllipsoidBody::ellipsoid(alpha, beta, nu, eta);
     let run = |beta: f64| -> Result<Verdict> { verdict(&body(beta)?, &options.verdict) };
+    // Inside the root-finding only the margin is needed.
+    let margin_only = VerdictOptions {
+        counterexamples: false,
+        ..options.verdict
+    };
+    let margin = |beta: f64| -> Result<Verdict> { verdict(&body(beta)?, &margin_only) };
     let mut betas: Vec<f64> = (0..options.scan)
         .map(|i| (b0.ln() + (b1.ln() - b0.ln()) * i as f64 / (options.scan - 1) as f64).exp())
         .collect();
@@ -1211,7 +1243,7 @@ pub fn boundaries(alpha: f64, nu: f64, eta: f64, options: &BoundaryOptions) -> R
                     if limit_only {
                         Ok(Margins::of_limit(&HighEnergyLimit::of(&body(beta)?, tol)?)[t])
                     } else {
-                        Ok(run(beta)?.margins.map_or(f64::NAN, |m| m.terms()[t]))
+                        Ok(margin(beta)?.margins.map_or(f64::NAN, |m| m.terms()[t]))
                     }
                 };
                 let (fa, fb) = if limit_only {
@@ -1236,11 +1268,11 @@ pub fn boundaries(alpha: f64, nu: f64, eta: f64, options: &BoundaryOptions) -> R
             }
         }
         if located.is_none() {
-            // Bisection on the verdict itself, to a relative width of 1e-6.
+            // Bisection on the verdict itself, to the same relative width.
             let (mut a, mut b) = (lo.beta, hi.beta);
-            while b - a > 1e-6 * b {
+            while b - a > BOUNDARY_XTOL * b {
                 let m = (a * b).sqrt();
-                if key(&run(m)?) == key(lo) {
+                if key(&margin(m)?) == key(lo) {
                     a = m;
                 } else {
                     b = m;

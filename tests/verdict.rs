@@ -161,7 +161,12 @@ fn boundaries_stay_put_when_the_resolution_doubles() {
 fn bad_options_are_refused() {
     let body = EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 0.5).unwrap();
     for (tol, resolution) in [(0.0, 64), (f64::NAN, 64), (1e-10, 2), (1e-10, 1 << 20)] {
-        assert!(verdict(&body, &VerdictOptions { tol, resolution }).is_err());
+        let options = VerdictOptions {
+            tol,
+            resolution,
+            ..VerdictOptions::default()
+        };
+        assert!(verdict(&body, &options).is_err());
     }
     let mirror = EllipsoidBody::ellipsoid(-0.5, 3.0, 0.5, 0.5).unwrap();
     assert!(verdict(&mirror, &VerdictOptions::default()).is_err());
