@@ -73,25 +73,16 @@ pub struct VerdictArgs {
     /// The β at which the verdict changes along β at this α, each by root-finding.
     #[arg(long)]
     pub boundaries: bool,
-    /// Smallest β searched by --boundaries.
-    #[arg(
-        long,
-        default_value_t = 0.05,
-        allow_negative_numbers = true,
-        requires = "boundaries"
-    )]
-    pub beta_min: f64,
-    /// Largest β searched by --boundaries.
-    #[arg(
-        long,
-        default_value_t = 50.0,
-        allow_negative_numbers = true,
-        requires = "boundaries"
-    )]
-    pub beta_max: f64,
-    /// Log-spaced β of the scan behind --boundaries (the line β² = 1 + α is added).
-    #[arg(long, default_value_t = 48, requires = "boundaries")]
-    pub scan: usize,
+    /// Smallest β searched by --boundaries [default: 0.05].
+    #[arg(long, allow_negative_numbers = true)]
+    pub beta_min: Option<f64>,
+    /// Largest β searched by --boundaries [default: 50].
+    #[arg(long, allow_negative_numbers = true)]
+    pub beta_max: Option<f64>,
+    /// Log-spaced β of the scan behind --boundaries (the line β² = 1 + α is added)
+    /// [default: 48].
+    #[arg(long)]
+    pub scan: Option<usize>,
     /// Tolerance of the cell solver (N at a counterexample equals the integer to this).
     #[arg(long, default_value_t = 1e-10, allow_negative_numbers = true)]
     pub tol: f64,
@@ -370,15 +361,25 @@ fn verdict(args: VerdictArgs) -> Result<()> {
         resolution: args.resolution,
         counterexamples: true,
     };
+    if !args.boundaries
+        && (args.beta_min.is_some() || args.beta_max.is_some() || args.scan.is_some())
+    {
+        return Err(AtlasError::Atlas {
+            path: "verdict".into(),
+            reason: "--beta-min, --beta-max and --scan go with --boundaries".into(),
+        }
+        .into());
+    }
     if args.boundaries {
+        let defaults = verdict::BoundaryOptions::default();
         let found = verdict::boundaries(
             args.alpha,
             args.nu,
             args.eta,
             &verdict::BoundaryOptions {
-                beta_min: args.beta_min,
-                beta_max: args.beta_max,
-                scan: args.scan,
+                beta_min: args.beta_min.unwrap_or(defaults.beta_min),
+                beta_max: args.beta_max.unwrap_or(defaults.beta_max),
+                scan: args.scan.unwrap_or(defaults.scan),
                 verdict: options,
             },
         )?;
@@ -446,17 +447,19 @@ fn print_verdict(v: &verdict::Verdict) {
         println!("  kappa_max = {k:.10} (+- {e:.1e}), the fold of the N = 0 curve beside sigma_u");
     }
     let h = &v.high_energy;
-    let at = |l: Option<f64>| l.map_or("-".to_string(), |l| format!("{l:.6}"));
     println!(
-        "  high energy: N_inf(lambda) ~ {:.6e} lambda at lambda -> 0; min {:.10} at lambda = {}; max {:.10} at lambda = {}",
+        "  high energy: N_inf(lambda) ~ {:.6e} lambda at lambda -> 0; min {:.10} at lambda = {:.6}; max {:.10} at lambda = {:.6}",
         h.slope,
         h.n_min,
-        at(h.lambda_at_min),
+        h.lambda_at_min,
         h.n_max,
-        at(h.lambda_at_max)
+        h.lambda_at_max
     );
     match v.holds {
-        None => println!("  verdict: not covered"),
+        None => match &v.evidence.undecided {
+            Some(why) => println!("  verdict: UNDECIDED ({why})"),
+            None => println!("  verdict: not covered"),
+        },
         Some(true) => println!("  verdict: HOLDS (fail margin {:.3e})", v.fail_margin),
         Some(false) => println!("  verdict: FAILS (fail margin {:.3e})", v.fail_margin),
     }

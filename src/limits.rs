@@ -19,6 +19,7 @@
 use crate::body::{Angle, Body, Shape};
 use crate::error::{check_range, Result};
 use crate::torus::{CriticalKind, CriticalPoint, EffectivePotential};
+use rayon::prelude::*;
 use serde::Serialize;
 use std::f64::consts::{FRAC_PI_2, PI, SQRT_2};
 
@@ -129,7 +130,7 @@ fn excess_ratio<S: Shape>(body: &Body<S>, x: f64) -> (f64, f64) {
 /// of an oblate one), and a coarser rule could agree with itself without seeing it.
 fn first_intervals<S: Shape>(body: &Body<S>) -> usize {
     let scale = body.shape.angular_feature_scale().clamp(1e-6, 1.0);
-    (32.0 / scale).ceil() as usize
+    (8.0 / scale).ceil().max(32.0) as usize
 }
 
 /// ∫_0^{π/2} sin u [H(x₀ sin u) − H(−x₀ sin u)] du by the trapezoid rule, doubled from at
@@ -154,6 +155,7 @@ fn odd_part_integral<S: Shape>(body: &Body<S>, x0: f64, abs_tol: f64) -> Estimat
         abs += a;
     }
     let mut value = sum * h0;
+    let mut last_diff = f64::INFINITY;
     loop {
         let h = FRAC_PI_2 / m as f64;
         let (mut add, mut add_abs) = (0.0, 0.0);
@@ -169,12 +171,17 @@ fn odd_part_integral<S: Shape>(body: &Body<S>, x0: f64, abs_tol: f64) -> Estimat
         let diff = (next - value).abs();
         let rounding = 8.0 * f64::EPSILON * abs * FRAC_PI_2 / m as f64;
         value = next;
-        if diff <= abs_tol || m >= MAX_INTERVALS {
+        // Converged; or at the rounding level, where a doubling no longer halves the
+        // difference (a geometric rule squares it): stop, and keep that difference as the
+        // error bar — it is the noise the sum carries.
+        let stalled = diff > 0.5 * last_diff && m >= 8 * first_intervals(body);
+        if diff <= abs_tol.max(4.0 * rounding) || stalled || m >= MAX_INTERVALS {
             return Estimate {
                 value,
-                error: diff + rounding,
+                error: diff.max(if stalled { last_diff } else { 0.0 }) + rounding,
             };
         }
+        last_diff = diff;
     }
 }
 
@@ -209,6 +216,10 @@ pub fn high_energy_rotation_number<S: Shape>(
     })
 }
 
+/// Ñ at λ = √2 is taken at x₀ = this: Ñ(x₀) = Ñ(0) + O(x₀²) = 1e-10 relative, while the
+/// odd part H(x₀ s) − H(−x₀ s) keeps 1e-11 of its relative accuracy.
+const NORMALIZED_END: f64 = 1e-5;
+
 /// Ñ(λ) = N∞(λ) / (λ x₀²) = ∫ … du / (√2 π x₀), x₀² = 1 − λ²/2: N∞ with its two zeros
 /// at the ends divided out. It has the sign of N∞ on (0, √2) and finite, generically
 /// non-zero, values at both ends (the slope at λ = 0), so a lobe of N∞ of the other sign
@@ -225,11 +236,11 @@ pub fn normalized_high_energy_rotation_number<S: Shape>(
         Some((SQRT_2, true)),
         "must satisfy 0 <= lambda <= sqrt(2)",
     )?;
-    // At λ = √2 the limit x₀ → 0, approached to O(x₀²) = 1e-16.
+    // At λ = √2 the limit x₀ → 0, approached as NORMALIZED_END says.
     let x0 = ((1.0 - lambda / SQRT_2) * (1.0 + lambda / SQRT_2))
         .max(0.0)
         .sqrt()
-        .max(1e-8);
+        .max(NORMALIZED_END);
     let factor = 1.0 / (SQRT_2 * PI * x0);
     let integral = odd_part_integral(body, x0, 0.25 * tol / factor);
     Ok(Estimate {
@@ -256,12 +267,12 @@ pub struct HighEnergyLimit {
     pub slope: f64,
     /// min N∞ (0 when N∞ ≥ 0: reached at λ → 0 and λ = √2).
     pub n_min: f64,
-    /// Where N∞ is smallest (None when N∞ ≡ 0).
-    pub lambda_at_min: Option<f64>,
+    /// Where N∞ is smallest (0 when N∞ ≥ 0, and when N∞ ≡ 0).
+    pub lambda_at_min: f64,
     /// max N∞ (0 when N∞ ≤ 0).
     pub n_max: f64,
-    /// Where N∞ is largest (None when N∞ ≡ 0).
-    pub lambda_at_max: Option<f64>,
+    /// Where N∞ is largest (0 when N∞ ≤ 0, and when N∞ ≡ 0).
+    pub lambda_at_max: f64,
     /// min and max of Ñ = N∞/(λ x₀²) over [0, √2]: N∞ takes both signs (an N = 0
     /// resonance at every large κ) exactly when normalized_min < 0 < normalized_max.
     pub normalized_min: f64,
@@ -280,7 +291,7 @@ pub fn high_energy_pair<S: Shape>(body: &Body<S>, lambda: f64, tol: f64) -> (Est
     let x0 = ((1.0 - lambda / SQRT_2) * (1.0 + lambda / SQRT_2))
         .max(0.0)
         .sqrt()
-        .max(1e-8);
+        .max(NORMALIZED_END);
     let c = SQRT_2 * PI;
     // Ñ = I/(c x₀) and N∞ = λ x₀ I / c = λ x₀² Ñ: I to c x₀ tol/4 serves both.
     let i = odd_part_integral(body, x0, 0.25 * c * x0 * tol);
@@ -301,8 +312,8 @@ pub fn high_energy_pair<S: Shape>(body: &Body<S>, lambda: f64, tol: f64) -> (Est
 }
 
 impl HighEnergyLimit {
-    /// Slope and extrema of N∞ and Ñ to the accuracy `tol` (values; λ to 1e-8, which moves
-    /// an extremum's value by O(1e-16)).
+    /// Slope and extrema of N∞ and Ñ to the accuracy `tol` (values; λ to 1e-7, which moves
+    /// an extremum's value by N″·1e-14).
     pub fn of<S: Shape>(body: &Body<S>, tol: f64) -> Result<Self> {
         check_range(
             "tol",
@@ -315,7 +326,7 @@ impl HighEnergyLimit {
             .map(|i| SQRT_2 * i as f64 / EXTREMA_SCAN as f64)
             .collect();
         let values: Vec<(Estimate, Estimate)> = lambdas
-            .iter()
+            .par_iter()
             .map(|&l| high_energy_pair(body, l, tol))
             .collect();
         let slope = values[0].1;
@@ -326,7 +337,7 @@ impl HighEnergyLimit {
         let flat = values.iter().all(|(n, _)| n.value.abs() <= n.error);
         // The extremum of sign·f over the scan, refined by golden section where interior;
         // `pick` selects N∞ (0) or Ñ (1).
-        let mut extremum = |sign: f64, pick: usize| -> (f64, Option<f64>) {
+        let mut extremum = |sign: f64, pick: usize| -> (f64, f64) {
             let get = |e: &(Estimate, Estimate)| if pick == 0 { e.0 } else { e.1 };
             let i = (0..=EXTREMA_SCAN)
                 .max_by(|&a, &b| {
@@ -334,31 +345,31 @@ impl HighEnergyLimit {
                 })
                 .expect("the scan has points");
             if i == 0 || i == EXTREMA_SCAN {
-                return (get(&values[i]).value, Some(lambdas[i]));
+                return (get(&values[i]).value, lambdas[i]);
             }
             let (l, v) = golden_max(
                 |l| sign * get(&high_energy_pair(body, l, tol)).value,
                 lambdas[i - 1],
                 lambdas[i + 1],
-                1e-8,
+                1e-7,
             );
             extrema_error = extrema_error.max(get(&high_energy_pair(body, l, tol)).error);
-            (sign * v, Some(l))
+            (sign * v, l)
         };
         let (mut n_max, mut lambda_at_max) = extremum(1.0, 0);
         let (mut n_min, mut lambda_at_min) = extremum(-1.0, 0);
         let (normalized_max, _) = extremum(1.0, 1);
         let (normalized_min, _) = extremum(-1.0, 1);
         if flat {
-            (n_max, n_min, lambda_at_max, lambda_at_min) = (0.0, 0.0, None, None);
+            (n_max, n_min, lambda_at_max, lambda_at_min) = (0.0, 0.0, 0.0, 0.0);
         }
         // N∞ = 0 at both ends: without an interior value of a sign, that extremum is the
         // limit 0 at λ → 0.
         if n_max <= 0.0 && !flat {
-            (n_max, lambda_at_max) = (0.0, Some(0.0));
+            (n_max, lambda_at_max) = (0.0, 0.0);
         }
         if n_min >= 0.0 && !flat {
-            (n_min, lambda_at_min) = (0.0, Some(0.0));
+            (n_min, lambda_at_min) = (0.0, 0.0);
         }
         Ok(Self {
             slope: slope.value,
@@ -412,7 +423,7 @@ mod tests {
         let body = EllipsoidBody::ellipsoid(0.0, 0.5, 0.5, 0.5).unwrap();
         let lim = HighEnergyLimit::of(&body, 1e-12).unwrap();
         assert_eq!((lim.n_min, lim.n_max, lim.slope), (0.0, 0.0, 0.0));
-        assert!(lim.lambda_at_min.is_none());
+        assert_eq!(lim.lambda_at_min, 0.0);
     }
 
     #[test]

@@ -135,6 +135,8 @@ pub struct Evidence {
     /// lines themselves may not show it: close to a boundary the resonance moves off to
     /// κ → ∞.
     pub limit_failure: Option<String>,
+    /// Why a covered body has no verdict (`holds` null), if so.
+    pub undecided: Option<String>,
     /// The limits that close the plane beyond the samples.
     pub limits: Vec<&'static str>,
 }
@@ -148,7 +150,8 @@ pub struct Verdict {
     pub eta: f64,
     pub diagram_type: DiagramType,
     pub case: Case,
-    /// true / false; None when the hypothesis does not cover the body.
+    /// true / false; None when the hypothesis does not cover the body, or (case 2) when
+    /// κ_max could not be found and nothing beyond it fails (`evidence.undecided` says so).
     pub holds: Option<bool>,
     /// The fold of the N = 0 curve that hugs σ_u (case 2).
     pub kappa_max: Option<f64>,
@@ -386,7 +389,11 @@ fn integers_between(
     match b {
         None => {
             let k = a.n.round();
-            if interior && a.kappa >= ON_INTEGER_KAPPA && (a.n - k).abs() <= a.error {
+            if interior
+                && a.kappa >= ON_INTEGER_KAPPA
+                && a.error <= tol
+                && (a.n - k).abs() <= a.error
+            {
                 out.push(Candidate {
                     a: *a,
                     b: None,
@@ -425,10 +432,13 @@ fn integers_between(
     }
 }
 
+/// A window of the (κ, ε) plane and the seed grid to trace in it.
+type FoldWindow = ((f64, f64), (f64, f64), usize);
+
 /// The windows in which the N = 0 curve hugging σ_u is traced for its fold, with their seed
 /// grids: first a narrow one around the cusp (the fold lies a few per cent above κ_c for the
 /// bodies tried), then a wide one (κ up to 2κ_c + 0.5, ε well above the cusp).
-fn fold_windows(body: &EllipsoidBody, set: &CriticalSet) -> Vec<((f64, f64), (f64, f64), usize)> {
+fn fold_windows(body: &EllipsoidBody, set: &CriticalSet) -> Vec<FoldWindow> {
     let Some(cusp) = set.cusp else {
         return Vec::new();
     };
@@ -470,9 +480,13 @@ fn kappa_max(body: &EllipsoidBody, set: &CriticalSet, tol: f64) -> Result<Option
             max_point_error: 1e-6,
         };
         if let Some(fold) = resonance::fold(body, &options)? {
-            return Ok(Some(
-                polish_fold(body, &fold, &cell).unwrap_or((fold.kappa_max, fold.kappa_error)),
-            ));
+            // Where the top is not a smooth fold (∂N/∂ε ≠ 0 there: the curve meets a
+            // separatrix or turns at a corner) the traced top stands, with the relative
+            // error CORNER_ERROR.
+            return Ok(Some(polish_fold(body, &fold, &cell).unwrap_or((
+                fold.kappa_max,
+                fold.kappa_error.max(CORNER_ERROR * fold.kappa_max),
+            ))));
         }
     }
     Ok(None)
@@ -500,6 +514,9 @@ fn n_near_well(
     let r = solve_component(&potential, energy, c, cell).ok()?;
     (r.status != Status::Separatrix && r.rotation_number.is_finite()).then_some(r.rotation_number)
 }
+
+/// Relative error bar of a κ_max that could not be solved from N = 0, ∂N/∂ε = 0.
+const CORNER_ERROR: f64 = 1e-4;
 
 fn polish_fold(
     body: &EllipsoidBody,
@@ -549,8 +566,10 @@ fn polish_fold(
     let mut step = 1e-6 * fold.kappa_max;
     let (mut a, mut b) = (fold.kappa_max, fold.kappa_max);
     let (mut fa, mut fb) = (m(a).ok()?, m(b).ok()?);
+    // Only close to the traced top: further off, M is not the fold's.
+    let (floor, ceiling) = (fold.kappa_max * 0.99, fold.kappa_max * 1.01);
     for _ in 0..30 {
-        if fa > 0.0 && fb < 0.0 {
+        if fa > 0.0 && fb < 0.0 || a < floor || b > ceiling {
             break;
         }
         if fa <= 0.0 {
@@ -563,7 +582,7 @@ fn polish_fold(
         }
         step *= 2.0;
     }
-    if !(fa > 0.0 && fb < 0.0) {
+    if !(fa > 0.0 && fb < 0.0) || a < floor || b > ceiling {
         return None;
     }
     let (root, width) = illinois(m, (a, fa), (b, fb), 1e-12).ok()?;
@@ -621,6 +640,7 @@ pub fn verdict(body: &EllipsoidBody, options: &VerdictOptions) -> Result<Verdict
             integer_brackets: 0,
             refinement_failures: 0,
             limit_failure: None,
+            undecided: None,
             limits: Vec::new(),
         },
     };
@@ -636,6 +656,7 @@ pub fn verdict(body: &EllipsoidBody, options: &VerdictOptions) -> Result<Verdict
     let set = CriticalSet::of(body, 400, 1e6)?;
     let cusp_kappa = set.cusp.map(|c| c.kappa);
     // The region of the hypothesis: κ > 0 (case 1) or κ > κ_max (case 2).
+    let mut undecided = None;
     let lo = match case {
         Case::Two => match kappa_max(body, &set, options.tol)? {
             Some((k, err)) => {
@@ -644,9 +665,16 @@ pub fn verdict(body: &EllipsoidBody, options: &VerdictOptions) -> Result<Verdict
                 // Just above the fold: its own error, and a relative step past it.
                 k + 4.0 * err + 1e-6 * k
             }
-            // No fold in the window: the N = 0 curve is not bounded in κ there; the whole
-            // half-plane above the cusp is examined.
-            None => cusp_kappa.unwrap_or(KAPPA_FLOOR),
+            // No fold found: the region of the hypothesis is unknown below some κ. Only the
+            // lines beyond every window tried are examined, and only a failure there (or one
+            // the high-energy limit proves) decides; otherwise the verdict is undecided.
+            None => {
+                undecided = Some(
+                    "kappa_max not found: no N = 0 fold was traced beside sigma_u near the cusp"
+                        .to_string(),
+                );
+                2.0 * cusp_kappa.unwrap_or(1.0) + 1.0
+            }
         },
         _ => KAPPA_FLOOR,
     };
@@ -711,7 +739,13 @@ pub fn verdict(body: &EllipsoidBody, options: &VerdictOptions) -> Result<Verdict
     } else {
         !candidates.is_empty()
     };
-    verdict.holds = Some(!resonant && limit_failure.is_none());
+    verdict.holds = if resonant || limit_failure.is_some() {
+        Some(false)
+    } else if undecided.is_some() {
+        None
+    } else {
+        Some(true)
+    };
     let margins = fail_margin(&sampler, &lines, &high_energy, n_lo, n_hi);
     verdict.fail_margin = margins.value();
     verdict.margins = Some(margins);
@@ -724,6 +758,7 @@ pub fn verdict(body: &EllipsoidBody, options: &VerdictOptions) -> Result<Verdict
         integer_brackets,
         refinement_failures,
         limit_failure: limit_failure.map(|(reason, _)| reason),
+        undecided: if verdict.holds.is_none() { undecided } else { None },
         limits: [
             "bottom: each line starts at the deepest minimum of V (the linearised N of the stable permanent rotation, limits::bottom_rotation_number)",
             "high energy: each line runs to epsilon = 1e12 V_low, where N = slope kappa / sqrt(epsilon) + O(1/epsilon); beyond the last line, N = N_inf(lambda) + O(1/kappa^2) (limits::HighEnergyLimit)",
@@ -1034,7 +1069,10 @@ fn refine(sampler: &Sampler<'_>, c: &Candidate) -> Option<Counterexample> {
         }
     };
     let r = sampler.solve(kappa, energy, &c.a, true)?;
-    if (r.rotation_number - k).abs() > r.error_estimate.max(sampler.cell.resonance_tol) {
+    // Only a value the solver vouches for: status ok (every error within the tolerance),
+    // and N on the integer within that tolerance.
+    if r.status != Status::Ok || (r.rotation_number - k).abs() > sampler.cell.tol + r.error_estimate
+    {
         return None;
     }
     if r.bounded != Some(false) {

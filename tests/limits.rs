@@ -99,7 +99,7 @@ fn extrema_of_the_limit_match_the_strongly_oblate_body() {
     let body = EllipsoidBody::ellipsoid(0.9, 20.0, 0.5, 0.5).unwrap();
     let lim = HighEnergyLimit::of(&body, 1e-12).unwrap();
     assert!((lim.n_min + 1.7611358).abs() < 2e-7, "{lim:?}");
-    let at = lim.lambda_at_min.unwrap();
+    let at = lim.lambda_at_min;
     assert!((at - 0.064).abs() < 0.01, "{lim:?}");
     // A minimum: N∞ is larger on either side, and the cell there agrees.
     for d in [-1e-3, 1e-3] {
