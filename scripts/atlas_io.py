@@ -5,7 +5,9 @@
     ds.rotation_number.sel(alpha=0.5, beta=3.0, component=0).plot(x="kappa", y="energy")
     components(ds, alpha=0.5, beta=3.0, kappa=0.8, energy=2.5)   # one cell, like `rubber-atlas cell`
 
-Dimensions: alpha, beta, kappa, energy, component. Per cell: n_components, cell_status
+Dimensions: alpha, beta, kappa, energy, component; a scene on another plane has
+(kappa, excess_energy) or (lambda, s) instead of (kappa, energy), and then carries kappa and
+energy per cell as coordinates (CF auxiliary coordinates). Per cell: n_components, cell_status
 (ok / no_motion / failed). Per cell and component (NaN where the component does not exist):
 the requested fields (theta_min, theta_max, period, omega_theta, omega_psi, rotation_number,
 drift, drift_radius, bounded, motion, status, error_estimate) and the estimated absolute

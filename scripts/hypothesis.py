@@ -35,7 +35,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 BIN = os.environ.get("RUBBER_ATLAS_BIN", str(ROOT / "target" / "release" / "rubber-atlas"))
-CATEGORIES = {"holds": 0, "fails": 1, "not covered": 2}
+CATEGORIES = {"holds": 0, "fails": 1, "not covered": 2, "undecided": 3}
 
 
 def run(*args: str) -> str:
@@ -57,8 +57,12 @@ def verdict(alpha: float, beta: float, nu: float, eta: float) -> dict:
                           "--json"))
 
 
-def label(holds) -> str:
-    return "not covered" if holds is None else ("holds" if holds else "fails")
+def label(holds, case="1") -> str:
+    """holds / fails; for a null verdict, `not covered`, or `undecided` in case 2 (κ_max not
+    found and nothing beyond it fails)."""
+    if holds is None:
+        return "undecided" if case == "2" else "not covered"
+    return "holds" if holds else "fails"
 
 
 def sweep(alphas, nu, eta, scan, beta_min, beta_max, jobs):
@@ -73,7 +77,7 @@ def map_rows(results) -> list[dict]:
     for r in results:
         for p in r["scan"]:
             h = p["high_energy"]
-            rows.append(dict(alpha=r["alpha"], beta=p["beta"], case=p["case"], verdict=label(p["holds"]),
+            rows.append(dict(alpha=r["alpha"], beta=p["beta"], case=p["case"], verdict=label(p["holds"], p["case"]),
                              kappa_max=np.nan if p["kappa_max"] is None else p["kappa_max"],
                              counterexamples=p["counterexamples"], slope=h["slope"], n_min=h["n_min"],
                              n_max=h["n_max"]))
@@ -85,16 +89,33 @@ def boundary_rows(results, nu, eta) -> list[dict]:
     for r in results:
         for b in r["boundaries"]:
             rows.append(dict(nu=nu, eta=eta, alpha=r["alpha"], beta=b["beta"], error=b["error"],
-                             quantity=b["quantity"], below=f"case {b['case_below']} {label(b['holds_below'])}",
-                             above=f"case {b['case_above']} {label(b['holds_above'])}"))
+                             quantity=b["quantity"],
+                             below=f"case {b['case_below']} {label(b['holds_below'], b['case_below'])}",
+                             above=f"case {b['case_above']} {label(b['holds_above'], b['case_above'])}"))
     return rows
 
 
-def curve_kind(row: dict) -> str:
-    """Boundaries of one kind join into one curve β(α)."""
+def curve_kind(row: dict) -> str | None:
+    """Boundaries of one mechanism join into one curve β(α) (whether the sampled plane or the
+    high-energy limit decided it at that α); the hair-thin band of undecided case-2 bodies
+    just above β² = 1 + α is not a curve of its own."""
     if row["quantity"].startswith("case"):
         return "case line beta^2 = 1 + alpha"
-    return f"{row['below']} | {row['above']}: {row['quantity']}"
+    if "undecided" in row["below"] or "undecided" in row["above"]:
+        return None
+    mechanism = row["quantity"].replace("fail_margin: ", "").split(" (sampled")[0].split(" (high-energy")[0]
+    return f"{row['below']} | {row['above']}: {mechanism}"
+
+
+def curves_of(brows: list[dict]) -> dict[tuple, dict[str, list]]:
+    """{(ν, η): {kind: [(α, β), ...]}}."""
+    out: dict[tuple, dict[str, list]] = {}
+    for b in brows:
+        kind = curve_kind(b)
+        if kind is not None:
+            out.setdefault((float(b["nu"]), float(b["eta"])), {}).setdefault(kind, []).append(
+                (float(b["alpha"]), float(b["beta"])))
+    return out
 
 
 def regions(rows: list[dict]) -> list[list[dict]]:
@@ -174,49 +195,77 @@ def write_h5(path: Path, tables: dict[str, list[dict]], attrs: dict) -> None:
                     g.create_dataset(key, data=np.array(values, dtype=float))
 
 
-def plot(rows, curves, others, evidence, png: Path, nu: float, eta: float) -> None:
+def plot(rows: list[dict], brows: list[dict], evidence: list[dict], png: Path, nu: float, eta: float) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
 
-    alphas = np.array(sorted({r["alpha"] for r in rows}))
-    betas = np.array(sorted({r["beta"] for r in rows if r["alpha"] == alphas[0]}))
+    # The raster holds the log-spaced scan; the two bodies 1e-9 either side of β² = 1 + α
+    # (the dashed line) are left out of it.
+    def on_grid(r):
+        return abs(float(r["beta"]) / np.sqrt(1.0 + float(r["alpha"])) - 1.0) > 1e-6
+
+    rows = [r for r in rows if on_grid(r)]
+    alphas = np.array(sorted({float(r["alpha"]) for r in rows}))
+    betas = np.array(sorted({float(r["beta"]) for r in rows if float(r["alpha"]) == alphas[0]}))
     grid = np.full((len(betas), len(alphas)), np.nan)
     for r in rows:
-        i = int(np.argmin(np.abs(betas - r["beta"])))
-        grid[i, int(np.searchsorted(alphas, r["alpha"]))] = CATEGORIES[r["verdict"]]
-    fig, ax = plt.subplots(figsize=(9, 6.5))
-    cmap = ListedColormap(["#bfe3bf", "#f2b8b5", "#dddddd"])
-    ax.pcolormesh(alphas, betas, grid, cmap=cmap, vmin=-0.5, vmax=2.5, shading="nearest")
-    styles = ["-", "-", "-", "-"]
-    for n, (kind, pts) in enumerate(sorted(curves.items())):
-        pts = sorted(pts, key=lambda p: p[0])
-        a, b = np.array(pts).T
-        if kind.startswith("case line"):
-            ax.plot(a, b, "k--", lw=1, label=r"$\beta^2 = 1 + \alpha$ (cases 1 | 2)")
-        else:
-            ax.plot(a, b, styles[n % 4], marker=".", ms=3, lw=1.6, label=kind.split(": fail_margin: ")[-1])
-    for (o_nu, o_eta), o_curves in others.items():
-        for kind, pts in o_curves.items():
+        i = int(np.argmin(np.abs(betas - float(r["beta"]))))
+        grid[i, int(np.argmin(np.abs(alphas - float(r["alpha"]))))] = CATEGORIES[r["verdict"]]
+    fig, ax = plt.subplots(figsize=(9.5, 6.5))
+    colours = ["#bfe3bf", "#f2b8b5", "#dddddd", "#f5e08a"]
+    ax.pcolormesh(alphas, betas, grid, cmap=ListedColormap(colours), vmin=-0.5, vmax=3.5, shading="nearest")
+    handles = [Patch(color=c, label=k) for k, c in zip(CATEGORIES, colours)]
+    all_curves = curves_of(brows)
+    styles = {}
+    for n, pair in enumerate(sorted(all_curves, key=lambda p: p != (nu, eta))):
+        main = pair == (nu, eta)
+        colour = "k" if main else f"C{n}"
+        for kind, pts in sorted(all_curves[pair].items()):
+            a, b = np.array(sorted(pts)).T
             if kind.startswith("case line"):
+                if main:
+                    line, = ax.plot(a, b, "k--", lw=1)
+                    styles.setdefault(r"$\beta^2 = 1 + \alpha$ (case 1 | case 2)", line)
                 continue
-            pts = sorted(pts, key=lambda p: p[0])
-            a, b = np.array(pts).T
-            ax.plot(a, b, ":", lw=1.2, label=f"nu = {o_nu}, eta = {o_eta}")
+            # A curve runs through the α with one boundary of this kind; where an α has
+            # several (the verdict alternates along β there), they are drawn as points.
+            counts = {x: int(np.sum(a == x)) for x in a}
+            single = np.array([counts[x] == 1 for x in a])
+            line, = ax.plot(np.where(single, a, np.nan), np.where(single, b, np.nan), "-" if main else ":",
+                            color=colour, marker="." if main else None, ms=3, lw=1.6 if main else 1.3)
+            ax.plot(a[~single], b[~single], ".", color=colour, ms=4)
+            name = f"boundary, nu = {pair[0]}, eta = {pair[1]}"
+            styles.setdefault(name, line)
+            if main:
+                mechanism = kind.split(": ")[-1]
+                mid = len(a) // 2
+                ax.annotate(mechanism, (a[mid], b[mid]), textcoords="offset points", xytext=(0, 6), fontsize=7,
+                            ha="center")
     for e in evidence:
-        if e.get("confirmed"):
-            ax.plot(e["alpha"], e["beta"], "k*", ms=9)
+        if str(e.get("confirmed")) == "True":
+            star, = ax.plot(float(e["alpha"]), float(e["beta"]), "k*", ms=10)
+            styles.setdefault("full-model trajectory on a counterexample", star)
     ax.set_yscale("log")
     ax.set_xlabel(r"$\alpha$")
     ax.set_ylabel(r"$\beta$")
-    ax.set_title(f"Boundedness hypothesis over the whole ($\\kappa$, $\\varepsilon$) plane ($\\nu$ = {nu}, "
-                 f"$\\eta$ = {eta})\ngreen holds, red fails, grey not covered; * trajectory evidence", fontsize=10)
-    ax.legend(fontsize=7, loc="lower right")
+    ax.set_title(f"The boundedness hypothesis over the whole ($\\kappa$, $\\varepsilon$) plane, "
+                 f"$\\nu$ = {nu}, $\\eta$ = {eta}", fontsize=10)
+    ax.legend(handles=handles + list(styles.values()), labels=[h.get_label() for h in handles] + list(styles),
+              fontsize=7, loc="lower right", framealpha=0.9)
     fig.tight_layout()
     fig.savefig(png, dpi=130)
     plt.close(fig)
+
+
+def read_csv(path: Path) -> list[dict]:
+    import csv
+
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
 
 
 def main() -> None:
@@ -238,28 +287,26 @@ def main() -> None:
     parser.add_argument("--other-betas", type=int, default=24, help="beta scan for the other pairs (default 24)")
     parser.add_argument("--jobs", type=int, default=2, help="verdict processes at a time (default 2)")
     parser.add_argument("--no-confirm", action="store_true", help="skip the trajectory evidence")
+    parser.add_argument("--replot", action="store_true",
+                        help="only redraw <out>.png from the tables an earlier run wrote")
     args = parser.parse_args()
+    out = Path(args.out)
+    if args.replot:
+        plot(read_csv(out.with_suffix(".csv")), read_csv(out.parent / f"{out.name}-boundaries.csv"),
+             read_csv(out.parent / f"{out.name}-evidence.csv"), out.with_suffix(".png"), args.nu, args.eta)
+        return
 
     start = time.time()
     alphas = [float(a) for a in np.linspace(0.0, 0.975, args.alphas)] if args.alphas > 1 else [0.5]
     results = sweep(alphas, args.nu, args.eta, args.betas, args.beta_min, args.beta_max, args.jobs)
     rows = map_rows(results)
     brows = boundary_rows(results, args.nu, args.eta)
-    curves: dict[str, list] = {}
-    for b in brows:
-        curves.setdefault(curve_kind(b), []).append((b["alpha"], b["beta"]))
     main_seconds = time.time() - start
-    others = {}
     for pair in filter(None, args.others.split(";")):
         o_nu, o_eta = (float(x) for x in pair.split(","))
         o_alphas = [float(a) for a in np.linspace(0.0, 0.975, args.other_alphas)]
         o_results = sweep(o_alphas, o_nu, o_eta, args.other_betas, args.beta_min, args.beta_max, args.jobs)
-        o_rows = boundary_rows(o_results, o_nu, o_eta)
-        brows += o_rows
-        o_curves: dict[str, list] = {}
-        for b in o_rows:
-            o_curves.setdefault(curve_kind(b), []).append((b["alpha"], b["beta"]))
-        others[(o_nu, o_eta)] = o_curves
+        brows += boundary_rows(o_results, o_nu, o_eta)
     evidence = []
     if not args.no_confirm:
         for region in regions(rows):
@@ -270,7 +317,6 @@ def main() -> None:
             e = confirm(body["alpha"], body["beta"], args.nu, args.eta)
             e["region_bodies"] = len(region)
             evidence.append(e)
-    out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     write_csv(out.with_suffix(".csv"), rows)
     write_csv(out.parent / f"{out.name}-boundaries.csv", brows)
@@ -278,7 +324,7 @@ def main() -> None:
     attrs = dict(nu=args.nu, eta=args.eta, program=run("--version").strip(),
                  command_line=" ".join(sys.argv), seconds_map=main_seconds)
     write_h5(out.with_suffix(".h5"), dict(map=rows, boundaries=brows, evidence=evidence), attrs)
-    plot(rows, curves, others, evidence, out.with_suffix(".png"), args.nu, args.eta)
+    plot(rows, brows, evidence, out.with_suffix(".png"), args.nu, args.eta)
     counts = {k: sum(r["verdict"] == k for r in rows) for k in CATEGORIES}
     print(f"hypothesis: {len(rows)} bodies ({counts}), {len(brows)} boundaries, "
           f"{sum(e.get('confirmed', False) for e in evidence)}/{len(evidence)} failure regions confirmed by the "

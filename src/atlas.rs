@@ -2,9 +2,11 @@
 //! slice), computes them with rayon one κ-row at a time, and lays the results out as the
 //! dense per-cell and per-component arrays of the atlas file (SPEC §3.2).
 
-use crate::cell::{solve_level, CellOptions, ComponentResult, Status};
+#[cfg(test)]
+use crate::cell::CellOptions;
+use crate::cell::{solve_high_energy_limit, solve_level, CellResult, ComponentResult, Status};
 use crate::error::{AtlasError, Result};
-use crate::scene::{Field, Scene};
+use crate::scene::{Field, Plane, Scene};
 use crate::torus::{EffectivePotential, MotionKind};
 use rayon::prelude::*;
 use std::ops::Range;
@@ -33,8 +35,15 @@ pub mod status_flag {
     pub const TOLERANCE_NOT_REACHED: u8 = 1;
     pub const FIXED_POINT: u8 = 2;
     pub const SEPARATRIX: u8 = 3;
-    pub const VALUES: [u8; 4] = [OK, TOLERANCE_NOT_REACHED, FIXED_POINT, SEPARATRIX];
-    pub const MEANINGS: &str = "ok tolerance_not_reached fixed_point separatrix";
+    pub const HIGH_ENERGY_LIMIT: u8 = 4;
+    pub const VALUES: [u8; 5] = [
+        OK,
+        TOLERANCE_NOT_REACHED,
+        FIXED_POINT,
+        SEPARATRIX,
+        HIGH_ENERGY_LIMIT,
+    ];
+    pub const MEANINGS: &str = "ok tolerance_not_reached fixed_point separatrix high_energy_limit";
 }
 
 /// A component's motion flag (`motion`).
@@ -58,6 +67,16 @@ pub enum Kind {
     Value,
     /// One u8 per cell and component slot.
     Flag,
+    /// One f64 per cell: κ or ε of the cell when they are not axes (CF auxiliary
+    /// coordinates).
+    CellValue,
+}
+
+impl Kind {
+    /// One value per cell (no component dimension).
+    pub fn per_cell(self) -> bool {
+        matches!(self, Kind::CellFlag | Kind::CellValue)
+    }
 }
 
 /// One variable of the atlas file.
@@ -105,6 +124,27 @@ fn flag(
         flags: Some(flags),
         value,
     }
+}
+
+/// The variables of a scene's file: its fields' ([`variables`]) and, where κ or ε is not an
+/// axis of the plane, that value per cell (a CF auxiliary coordinate).
+pub fn scene_variables(scene: &Scene) -> Vec<Variable> {
+    let mut vars = variables(&scene.fields);
+    for &name in scene.plane.auxiliary() {
+        vars.push(Variable {
+            name,
+            kind: Kind::CellValue,
+            long_name: if name == "kappa" {
+                "kappa = F2, the first integral of the reduction, of each cell"
+            } else {
+                "energy, the value of the reduced energy integral, of each cell"
+            },
+            units: "paper units (m = b3 = g = 1)",
+            flags: None,
+            value: |_| f64::NAN,
+        });
+    }
+    vars
 }
 
 /// The variables written for `fields`, in file order: `n_components` and `cell_status`
@@ -253,6 +293,7 @@ pub fn variables(fields: &[Field]) -> Vec<Variable> {
                             Status::ToleranceNotReached => status_flag::TOLERANCE_NOT_REACHED,
                             Status::FixedPoint => status_flag::FIXED_POINT,
                             Status::Separatrix => status_flag::SEPARATRIX,
+                            Status::HighEnergyLimit => status_flag::HIGH_ENERGY_LIMIT,
                         })
                     },
                 ),
@@ -287,6 +328,7 @@ impl Column {
             Kind::Value => Column::F64(vec![f64::NAN; len * COMPONENT_SLOTS]),
             Kind::Flag => Column::U8(vec![FLAG_FILL; len * COMPONENT_SLOTS]),
             Kind::CellFlag => Column::U8(vec![0; len]),
+            Kind::CellValue => Column::F64(vec![f64::NAN; len]),
         }
     }
 
@@ -326,13 +368,13 @@ impl Block {
         let mut columns: Vec<Column> = variables
             .iter()
             .map(|v| {
-                let n = if v.kind == Kind::CellFlag {
+                let n = if v.kind.per_cell() {
                     cells
                 } else {
                     cells * COMPONENT_SLOTS
                 };
                 match v.kind {
-                    Kind::Value => Column::F64(Vec::with_capacity(n)),
+                    Kind::Value | Kind::CellValue => Column::F64(Vec::with_capacity(n)),
                     Kind::Flag | Kind::CellFlag => Column::U8(Vec::with_capacity(n)),
                 }
             })
@@ -453,36 +495,72 @@ pub fn compute_rows(
     progress: &(dyn Fn(usize) + Sync),
 ) -> Block {
     let body = scene.body(alpha_index, beta_index);
-    let energies = &scene.energy.values;
+    let columns = &scene.energy.values;
+    let options = &scene.options;
     let blocks: Vec<Block> = rows
         .par_iter()
         .with_max_len(1)
         .map(|&row| {
-            let potential = EffectivePotential::new(&body, scene.kappa.values[row]);
-            let mut block = Block::empty(variables, energies.len());
-            for (j, &energy) in energies.iter().enumerate() {
-                fill_cell(&mut block, variables, j, &potential, energy, &scene.options);
+            let row_value = scene.kappa.values[row];
+            let mut block = Block::empty(variables, columns.len());
+            match scene.plane {
+                Plane::KappaEnergy | Plane::KappaExcess => {
+                    let potential = EffectivePotential::new(&body, row_value);
+                    // The excess energy is measured from the bottom of V at this κ.
+                    let base = match scene.plane {
+                        Plane::KappaExcess => potential.lowest_minimum().unwrap_or(f64::NAN),
+                        _ => 0.0,
+                    };
+                    for (j, &column) in columns.iter().enumerate() {
+                        let energy = if scene.plane == Plane::KappaExcess {
+                            base + column
+                        } else {
+                            column
+                        };
+                        fill_cell(&mut block, variables, j, (row_value, energy), || {
+                            solve_level(&potential, energy, options)
+                        });
+                    }
+                }
+                Plane::Compact => {
+                    // κ = λ/s, ε = 1/s²: every cell has its own κ; s = 0 is ε = ∞.
+                    for (j, &s) in columns.iter().enumerate() {
+                        if s == 0.0 {
+                            fill_cell(
+                                &mut block,
+                                variables,
+                                j,
+                                (f64::INFINITY, f64::INFINITY),
+                                || solve_high_energy_limit(&body, row_value, options),
+                            );
+                        } else {
+                            let (kappa, energy) = (row_value / s, 1.0 / (s * s));
+                            fill_cell(&mut block, variables, j, (kappa, energy), || {
+                                solve_level(&EffectivePotential::new(&body, kappa), energy, options)
+                            });
+                        }
+                    }
+                }
             }
-            progress(energies.len());
+            progress(columns.len());
             block
         })
         .collect();
     Block::concat(variables, blocks)
 }
 
+/// One cell of `block`: `solve` gives its components; `(kappa, energy)` are its κ and ε,
+/// written where they are auxiliary coordinates.
 fn fill_cell(
     block: &mut Block,
     variables: &[Variable],
     cell: usize,
-    potential: &EffectivePotential<'_, crate::Ellipsoid>,
-    energy: f64,
-    options: &CellOptions,
+    (kappa, energy): (f64, f64),
+    solve: impl FnOnce() -> Result<CellResult>,
 ) {
     // A panic in the solver is a bug, but one cell must not end a run of millions: it is
     // recorded as a failed cell.
-    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        solve_level(potential, energy, options)
-    }));
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(solve));
     let (status, components) = match result {
         Ok(Ok(c)) if c.status == Status::NoMotion => (cell_status::NO_MOTION, Vec::new()),
         Ok(Ok(c)) if c.components.len() > COMPONENT_SLOTS => (cell_status::FAILED, c.components),
@@ -497,6 +575,9 @@ fn fill_cell(
                 } else {
                     status
                 };
+            }
+            (Kind::CellValue, Column::F64(v)) => {
+                v[cell] = if var.name == "kappa" { kappa } else { energy };
             }
             (Kind::Value, Column::F64(v)) => {
                 for (slot, c) in components.iter().take(COMPONENT_SLOTS).enumerate() {
@@ -527,7 +608,9 @@ mod tests {
         let options = CellOptions::default();
         // A NaN energy makes the solver return an error; the cells around it are solved.
         for (cell, energy) in [2.5, f64::NAN, 0.1].into_iter().enumerate() {
-            fill_cell(&mut block, &variables, cell, &potential, energy, &options);
+            fill_cell(&mut block, &variables, cell, (0.8, energy), || {
+                solve_level(&potential, energy, &options)
+            });
         }
         let status = block.flags(&variables, "cell_status").unwrap();
         assert_eq!(

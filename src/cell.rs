@@ -84,6 +84,10 @@ pub enum Status {
     /// for double precision, or the node limit was reached); the values are still the best
     /// available and the error estimate says how good.
     ToleranceNotReached,
+    /// ε = ∞ (s = 0 of a compactified plane): θ_min, θ_max and N are the high-energy limit
+    /// (N∞(λ), [`crate::limits`]); T = 0 and ω_θ = ∞ there, ω_ψ = −N ω_θ; the drift is not
+    /// computed.
+    HighEnergyLimit,
 }
 
 /// Estimated absolute errors of the values of one component.
@@ -143,6 +147,66 @@ pub struct CellResult {
     pub status: Status,
     /// The components, sorted by θ_min.
     pub components: Vec<ComponentResult>,
+}
+
+/// The cell at ε = ∞ with λ = κ/√ε fixed: the torus sinθ ≥ λ/√2 of the limit system
+/// B θ′²/2 + λ²/(2 sin²θ) = 1 (`eqsys` without U), with N = N∞(λ) and its error. No motion
+/// for λ > √2; a fixed point at θ = π/2 (N = 0) for λ = √2.
+pub fn solve_high_energy_limit<S: Shape>(
+    body: &Body<S>,
+    lambda: f64,
+    options: &CellOptions,
+) -> Result<CellResult> {
+    crate::error::check_range("lambda", lambda, Some((0.0, true)), None, "must be >= 0")?;
+    options.validate()?;
+    let at_infinity = |components| CellResult {
+        kappa: f64::INFINITY,
+        energy: f64::INFINITY,
+        status: Status::Ok,
+        components,
+    };
+    if lambda > std::f64::consts::SQRT_2 {
+        return Ok(CellResult {
+            status: Status::NoMotion,
+            ..at_infinity(Vec::new())
+        });
+    }
+    let n = crate::limits::high_energy_rotation_number(body, lambda, options.tol)?;
+    let theta_min = (lambda / std::f64::consts::SQRT_2).asin();
+    let fixed = theta_min == std::f64::consts::FRAC_PI_2;
+    let omega_psi = if n.value == 0.0 {
+        0.0
+    } else {
+        -n.value.signum() * f64::INFINITY
+    };
+    Ok(at_infinity(vec![ComponentResult {
+        theta_min,
+        theta_max: PI - theta_min,
+        period: 0.0,
+        omega_theta: f64::INFINITY,
+        omega_psi,
+        rotation_number: n.value,
+        drift: f64::NAN,
+        drift_radius: f64::NAN,
+        bounded: None,
+        motion: if fixed {
+            MotionKind::FixedPoint
+        } else {
+            MotionKind::Libration
+        },
+        status: Status::HighEnergyLimit,
+        error_estimate: n.error,
+        errors: ErrorEstimates {
+            period: 0.0,
+            omega_theta: 0.0,
+            omega_psi: 0.0,
+            rotation_number: n.error,
+            drift: f64::NAN,
+            drift_radius: f64::NAN,
+        },
+        drift_vector: [f64::NAN; 2],
+        work: 0,
+    }]))
 }
 
 /// One cell, found from scratch (for many cells at one (body, κ), build the

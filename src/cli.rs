@@ -793,7 +793,7 @@ fn merge(args: MergeArgs) -> Result<()> {
 
 fn print_summary(summary: &sweep::Summary, out: &std::path::Path, threads: usize) {
     let [ok, no_motion, failed] = summary.cells_by_status;
-    let [c_ok, c_tol, c_fixed, c_sep] = summary.components_by_status;
+    let [c_ok, c_tol, c_fixed, c_sep, c_limit] = summary.components_by_status;
     let rate = summary.cells_computed as f64 / summary.seconds.max(1e-9);
     println!("wrote {}", out.display());
     println!(
@@ -802,7 +802,7 @@ fn print_summary(summary: &sweep::Summary, out: &std::path::Path, threads: usize
     );
     println!(
         "components by status: ok {c_ok}, tolerance_not_reached {c_tol}, fixed_point {c_fixed}, \
-         separatrix {c_sep}"
+         separatrix {c_sep}, high_energy_limit {c_limit}"
     );
     println!(
         "units: {} ({} resumed from an interrupted run, {} computed now)",

@@ -96,12 +96,60 @@ impl Axis {
             .collect()
     }
 
+    /// `num` values from `start` to `stop` inclusive, evenly spaced in log (both > 0; the
+    /// ends exactly `start` and `stop`).
+    pub fn logspace(start: f64, stop: f64, num: usize) -> Vec<f64> {
+        let mut v: Vec<f64> = Axis::linspace(start.ln(), stop.ln(), num)
+            .into_iter()
+            .map(f64::exp)
+            .collect();
+        v[0] = start;
+        if let Some(last) = v.last_mut() {
+            *last = stop;
+        }
+        v
+    }
+
     pub fn len(&self) -> usize {
         self.values.len()
     }
 
     pub fn is_empty(&self) -> bool {
         self.values.is_empty()
+    }
+}
+
+/// Which two axes span the (κ, ε) plane of each body (SPEC §3.2 and §4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Plane {
+    /// `kappa` and `energy`: κ and ε themselves.
+    KappaEnergy,
+    /// `kappa` and `excess_energy`: ε = V_min(κ) + e, measured from the bottom of V at each κ
+    /// (the deepest minimum), so that no cell falls below the bottom.
+    KappaExcess,
+    /// `lambda` and `s`: κ = λ/s, ε = 1/s² (λ = κ/√ε, s = 1/√ε). s = 0 is ε = ∞ itself, where
+    /// the cells are the high-energy limit N∞(λ) (paper `eqsys` without U); λ ≤ √2 has motion.
+    Compact,
+}
+
+impl Plane {
+    /// The names of the row and the column axis (the file's dimensions 3 and 4).
+    pub fn axis_names(self) -> [&'static str; 2] {
+        match self {
+            Plane::KappaEnergy => ["kappa", "energy"],
+            Plane::KappaExcess => ["kappa", "excess_energy"],
+            Plane::Compact => ["lambda", "s"],
+        }
+    }
+
+    /// κ and ε of each cell when they are not axes themselves: the file's 2-D (per slice)
+    /// CF auxiliary coordinates.
+    pub fn auxiliary(self) -> &'static [&'static str] {
+        match self {
+            Plane::KappaEnergy => &[],
+            Plane::KappaExcess => &["energy"],
+            Plane::Compact => &["kappa", "energy"],
+        }
     }
 }
 
@@ -116,8 +164,12 @@ pub struct Scene {
     pub eta: f64,
     pub alpha: Axis,
     pub beta: Axis,
+    /// The row axis of each slice: κ, or λ for the compactified plane.
     pub kappa: Axis,
+    /// The column axis: ε, the excess energy ε − V_min(κ), or s.
     pub energy: Axis,
+    /// Which axes the two are.
+    pub plane: Plane,
     /// Solver options (tolerance, method; drift only if an output needs it).
     pub options: CellOptions,
     /// The outputs asked for, in file order; `status` is always among them.
@@ -198,7 +250,18 @@ impl Reader<'_> {
                     .collect::<Result<Vec<_>>>()?
             }
             Some(Value::Table(t)) => {
-                self.only_keys(t, &full, &["start", "stop", "num"])?;
+                self.only_keys(t, &full, &["start", "stop", "num", "spacing"])?;
+                let log = match t.get("spacing") {
+                    None => false,
+                    Some(Value::String(m)) if m == "linear" => false,
+                    Some(Value::String(m)) if m == "log" => true,
+                    Some(v) => {
+                        return Err(self.error(
+                            &join(&full, "spacing"),
+                            format!("{v} is not \"linear\" or \"log\""),
+                        ))
+                    }
+                };
                 let start = self.required_number(t, &full, "start")?;
                 let stop = self.required_number(t, &full, "stop")?;
                 let num = match t.get("num") {
@@ -235,7 +298,17 @@ impl Reader<'_> {
                         "num = 1 needs start = stop (or give a list of values)",
                     ));
                 }
-                Axis::linspace(start, stop, num)
+                if log && start <= 0.0 {
+                    return Err(self.error(
+                        &join(&full, "start"),
+                        format!("{start} must be > 0 for log spacing"),
+                    ));
+                }
+                if log {
+                    Axis::logspace(start, stop, num)
+                } else {
+                    Axis::linspace(start, stop, num)
+                }
             }
             Some(v) => {
                 return Err(self.error(
@@ -335,11 +408,57 @@ impl Scene {
         let eta = reader.required_number(body, "body", "eta")?;
 
         let axes = reader.table(&root, "", "axes")?;
-        reader.only_keys(axes, "axes", &["alpha", "beta", "kappa", "energy"])?;
+        reader.only_keys(
+            axes,
+            "axes",
+            &[
+                "alpha",
+                "beta",
+                "kappa",
+                "energy",
+                "excess_energy",
+                "lambda",
+                "s",
+            ],
+        )?;
         let alpha = reader.axis(axes, "alpha")?;
         let beta = reader.axis(axes, "beta")?;
-        let kappa = reader.axis(axes, "kappa")?;
-        let energy = reader.axis(axes, "energy")?;
+        let has = |k: &str| axes.contains_key(k);
+        let plane = match (
+            has("kappa"),
+            has("energy"),
+            has("excess_energy"),
+            has("lambda"),
+            has("s"),
+        ) {
+            (true, true, false, false, false) => Plane::KappaEnergy,
+            (true, false, true, false, false) => Plane::KappaExcess,
+            (false, false, false, true, true) => Plane::Compact,
+            _ => return Err(reader.error(
+                "axes",
+                "give the plane as kappa with energy, kappa with excess_energy, or lambda with s",
+            )),
+        };
+        let [row_name, column_name] = plane.axis_names();
+        let kappa = reader.axis(axes, row_name)?;
+        let energy = reader.axis(axes, column_name)?;
+        if plane == Plane::Compact {
+            if kappa.values[0] < 0.0 {
+                return Err(reader.error(
+                    "axes.lambda",
+                    format!(
+                        "{} must be >= 0 (lambda = kappa / sqrt(energy))",
+                        kappa.values[0]
+                    ),
+                ));
+            }
+            if energy.values[0] < 0.0 {
+                return Err(reader.error(
+                    "axes.s",
+                    format!("{} must be >= 0 (s = 1 / sqrt(energy))", energy.values[0]),
+                ));
+            }
+        }
         // Every body of the grid must be valid: check the extremes of each axis.
         for &a in &[alpha.values[0], *alpha.values.last().unwrap()] {
             for &b in &[beta.values[0], *beta.values.last().unwrap()] {
@@ -451,6 +570,7 @@ impl Scene {
             beta,
             kappa,
             energy,
+            plane,
             options,
             fields,
             text: text.to_string(),

@@ -38,8 +38,9 @@ pub struct Summary {
     pub components: u64,
     /// Cells by `cell_status`: ok, no_motion, failed.
     pub cells_by_status: [u64; 3],
-    /// Components by `status`: ok, tolerance_not_reached, fixed_point, separatrix.
-    pub components_by_status: [u64; 4],
+    /// Components by `status`: ok, tolerance_not_reached, fixed_point, separatrix,
+    /// high_energy_limit.
+    pub components_by_status: [u64; 5],
     /// Work units of this run, and how many of them an interrupted run had finished.
     pub units: usize,
     pub units_resumed: usize,
@@ -51,13 +52,13 @@ pub struct Summary {
 
 impl Summary {
     /// Words of a unit's counts in the journal.
-    const WORDS: usize = 9;
+    const WORDS: usize = 10;
 
     /// The counts of a unit, for the journal.
     fn words(&self) -> [u64; Self::WORDS] {
         let [a, b, c] = self.cells_by_status;
-        let [d, e, f, g] = self.components_by_status;
-        [self.cells, self.components, a, b, c, d, e, f, g]
+        let [d, e, f, g, h] = self.components_by_status;
+        [self.cells, self.components, a, b, c, d, e, f, g, h]
     }
 
     fn from_words(w: &[u64]) -> Summary {
@@ -65,7 +66,7 @@ impl Summary {
             cells: w[0],
             components: w[1],
             cells_by_status: [w[2], w[3], w[4]],
-            components_by_status: [w[5], w[6], w[7], w[8]],
+            components_by_status: [w[5], w[6], w[7], w[8], w[9]],
             ..Summary::default()
         }
     }
@@ -102,7 +103,7 @@ impl Summary {
         }
         if let Some(status) = block.flags(variables, "status") {
             for &s in status {
-                if s <= status_flag::SEPARATRIX {
+                if s <= status_flag::HIGH_ENERGY_LIMIT {
                     self.components_by_status[usize::from(s)] += 1;
                 }
             }
@@ -202,7 +203,7 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
         Journal::create(&journal_dir, fingerprint, &scene.text)?
     };
 
-    let variables = atlas::variables(&scene.fields);
+    let variables = atlas::scene_variables(scene);
     let all_units = atlas::units(scene.shape());
     let mine = &all_units[request.shard.units(all_units.len())];
     let cells_of = |u: &Unit| u.rows.len() * scene.energy.len();
@@ -314,7 +315,7 @@ pub fn merge(
     let first = shards[0].as_path();
     let scene_text = read_root_text(first, "scene")?;
     let scene = Scene::parse(&scene_text, &first.display().to_string())?;
-    let variables = atlas::variables(&scene.fields);
+    let variables = atlas::scene_variables(&scene);
     let all_units = atlas::units(scene.shape());
     let fingerprint = format!("{:016x}", scene.fingerprint());
     let mut by_index: Vec<Option<(PathBuf, AtlasFile)>> = Vec::new();

@@ -174,6 +174,16 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         &self.critical
     }
 
+    /// The bottom of V: its deepest minimum (None only if V has no minimum, which the
+    /// ellipsoid never has).
+    pub fn lowest_minimum(&self) -> Option<f64> {
+        self.critical
+            .iter()
+            .filter(|p| p.kind == CriticalKind::Minimum)
+            .map(|p| p.value)
+            .min_by(f64::total_cmp)
+    }
+
     /// V at an angle.
     #[inline]
     pub fn value(&self, a: Angle) -> f64 {

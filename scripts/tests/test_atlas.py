@@ -119,3 +119,31 @@ def test_a_partial_file_is_not_opened_as_an_atlas(tmp_path):
     partial.write_bytes(b"")
     with pytest.raises(ValueError, match="unfinished"):
         open_atlas(partial)
+
+
+COMPACT = """name = "compact"
+[body]
+nu = 0.5
+eta = 0.5
+[axes]
+alpha = [0.5]
+beta = [0.5, 3.0]
+lambda = { start = 0.05, stop = 1.4, num = 8 }
+s = { start = 0.0, stop = 0.8, num = 9 }
+[outputs]
+fields = ["rotation_number", "status", "error_estimate"]
+"""
+
+
+def test_compact_plane_has_kappa_and_energy_as_coordinates(make_atlas):
+    """The (lambda, s) plane reaches energy = infinity at s = 0; kappa and energy per cell are
+    CF auxiliary coordinates, which xarray shows as coordinates of every variable."""
+    ds = open_atlas(make_atlas("compact", COMPACT))
+    assert set(ds.rotation_number.dims) == {"alpha", "beta", "lambda", "s", "component"}
+    assert {"kappa", "energy"} <= set(ds.coords) and "kappa" not in ds.data_vars
+    cell = ds.sel(alpha=0.5, beta=3.0).isel(**{"lambda": 3, "s": 4})
+    lam, s = float(cell["lambda"]), float(cell["s"])
+    assert float(cell.kappa) == lam / s and float(cell.energy) == 1 / s**2
+    limit = ds.sel(alpha=0.5, beta=3.0, s=0.0)
+    assert np.isinf(limit.energy).all()
+    assert (flag_names(ds.status)[int(limit.status.isel(**{"lambda": 0}, component=0))] == "high_energy_limit")

@@ -1,90 +1,97 @@
-"""scripts/hypothesis.py on a small (α, β) atlas made in the test: one body of each case of
-the hypothesis, κ_max of the paper's type (c) body from the fold command, the verdict files,
-and the trajectory check of a resonance (the evidence a failure would carry)."""
+"""`rubber-atlas verdict` through its command line (the SPEC §4 contract, bad input) and
+scripts/hypothesis.py on a small (α, β) grid: the map, the boundary curves, and the
+trajectory evidence of each failure region (the full model's centre of mass runs away by
+n·|Δζ| after n periods)."""
 from __future__ import annotations
 
+import csv
+import json
 import os
 import subprocess
 import sys
 from pathlib import Path
 
 import h5py
-import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "scripts"))
-
-from hypothesis import Verdict, confirm, integer_crossings, judge, save  # noqa: E402
-
 BIN = os.environ.get("RUBBER_ATLAS_BIN", str(ROOT / "target" / "release" / "rubber-atlas"))
-SCENE = """name = "hyp"
-[body]
-nu = 0.5
-eta = 0.5
-[axes]
-alpha = [0.0, 0.5]
-beta = [0.5, 3.0]
-kappa = { start = 0.0, stop = 2.0, num = 41 }
-energy = { start = 0.3, stop = 4.5, num = 43 }
-[solver]
-tolerance = 1e-9
-[outputs]
-fields = ["rotation_number", "drift_radius", "bounded", "status", "error_estimate"]
-"""
+SCRIPT = ROOT / "scripts" / "hypothesis.py"
 
 
-@pytest.fixture(scope="module")
-def atlas(make_atlas):
-    return make_atlas("hyp", SCENE)
+def verdict(*args: str) -> dict:
+    out = subprocess.run([BIN, "verdict", *args, "--json"], check=True, capture_output=True, text=True).stdout
+    return json.loads(out)
 
 
-def test_verdicts_by_case_and_kappa_max(atlas, tmp_path):
-    verdicts = {(v.alpha, v.beta): v for v in judge(atlas)}
-    assert verdicts[(0.0, 0.5)].diagram_type == "d" and verdicts[(0.0, 0.5)].case == 1
-    assert verdicts[(0.5, 0.5)].diagram_type == "a" and verdicts[(0.5, 0.5)].case == 1
-    assert verdicts[(0.0, 3.0)].verdict == "not covered"
-    c = verdicts[(0.5, 3.0)]
-    assert c.diagram_type == "c" and c.case == 2
-    assert abs(c.kappa_max - 1.10784) < 1e-4
-    # The integer resonances of type (c) lie below κ_max, and the atlas's highest one is near
-    # the fold: a brute-force reading of the atlas. (Cells are 0.05 in κ and 0.1 in ε; near
-    # its fold the N = 0 tongue is thinner than an ε-cell, so the grid sees it end at
-    # κ = 1.0. tests/resonance.rs brackets the fold with a fine scan.)
-    assert c.integer_resonance and c.resonance_kappa <= c.kappa_max + 0.05
-    assert c.kappa_max - c.resonance_kappa < 0.15, c
-    for key in [(0.5, 0.5), (0.5, 3.0)]:
-        assert verdicts[key].verdict == "holds", verdicts[key]
-    # α = 0, β < 1 (type d): every libration is symmetric about the equator, so N = 0 exactly
-    # and the body rolls off in a straight line, though β² < 1 + α: the hypothesis fails.
-    d = verdicts[(0.0, 0.5)]
-    assert d.verdict == "fails" and d.evidence_integer == 0.0 and abs(d.evidence_n) < 1e-12, d
-    c = confirm(d, 0.5, 0.5)
-    assert c["confirmed"], c
-    save(list(verdicts.values()), tmp_path / "out" / "h", 0.5, 0.5)
-    with h5py.File(tmp_path / "out" / "h.h5") as f:
-        assert f["verdict"].shape == (2, 2)
-        assert np.isfinite(f["kappa_max"][()]).sum() == 1
-    assert (tmp_path / "out" / "h.png").stat().st_size > 10_000
-    assert (tmp_path / "out" / "h.csv").read_text().count("\n") == 5
+def test_contract_keys_and_the_issue_bodies():
+    v = verdict("--alpha=0.5", "--beta=0.5", "--nu=0.5", "--eta=0.5")
+    assert v["case"] == "1" and v["holds"] is False and v["kappa_max"] is None
+    for key in ["slope", "n_min", "lambda_at_min", "n_max", "lambda_at_max"]:
+        assert isinstance(v["high_energy"][key], float), key
+    c = v["counterexamples"][0]
+    for key in ["kappa", "energy", "rotation_number", "theta_min", "theta_max"]:
+        assert isinstance(c[key], float), key
+    # Re-solved by the cell command: N on the integer, the path unbounded.
+    cell = json.loads(subprocess.run(
+        [BIN, "cell", "--alpha=0.5", "--beta=0.5", "--nu=0.5", "--eta=0.5", f"--kappa={c['kappa']!r}",
+         f"--energy={c['energy']!r}", "--json"], check=True, capture_output=True, text=True).stdout)
+    comp = min(cell["components"], key=lambda x: abs(x["theta_min"] - c["theta_min"]))
+    assert abs(comp["rotation_number"] - c["integer"]) < 1e-9 and comp["bounded"] is False
+    v = verdict("--alpha=0.9", "--beta=20", "--nu=0.5", "--eta=0.5")
+    assert v["case"] == "2" and v["holds"] is False and abs(v["kappa_max"] - 3.919) < 1e-3
+    assert all(c["kappa"] > v["kappa_max"] for c in v["counterexamples"])
+    v = verdict("--alpha=0.5", "--beta=3", "--nu=0.5", "--eta=0.5")
+    assert v["holds"] is True and v["counterexamples"] == []
+    v = verdict("--alpha=0", "--beta=2", "--nu=0.5", "--eta=0.5")
+    assert v["case"] == "not_covered" and v["holds"] is None
 
 
-def test_integer_crossings_ignore_jumps_and_kappa_zero():
-    kappa = np.array([0.0, 0.5, 1.0])
-    energy = np.array([1.0, 2.0, 3.0])
-    n = np.full((3, 3, 1), np.nan)
-    n[:, :, 0] = [[0.2, -0.2, 0.3], [0.4, 0.9, 1.1], [-0.7, 0.9, 0.3]]
-    found = integer_crossings(kappa, energy, n, np.ones_like(n))
-    # κ = 0 row is skipped; 0.9 → 1.1 crosses 1 (the cell nearer 1 is kept: 0.9 by a rounding);
-    # 0.4 → -0.7 is a jump of 1.1 (a separatrix).
-    assert {(k, e, i) for k, e, _, _, i, _ in found} == {(0.5, 2.0, 1.0)}
+def test_boundaries_contract():
+    b = verdict("--alpha=0.5", "--nu=0.5", "--eta=0.5", "--boundaries", "--beta-min=0.6", "--beta-max=0.9",
+                "--scan=4")
+    assert b["alpha"] == 0.5 and len(b["boundaries"]) == 1
+    one = b["boundaries"][0]
+    assert abs(one["beta"] - 0.744478) < 1e-5 and 0 < one["error"] < 1e-4
 
 
-def test_the_trajectory_check_sees_a_resonance_drift_away():
-    # A cell next to the N = 0 curve of the type (c) body: the check traces the curve there and
-    # follows the centre of mass for 10 and 40 periods; on the resonance it drifts 4 times as far.
-    v = Verdict(0.5, 3.0, "c", 2, True, 0.5, 1.10784, "fails", evidence_kappa=0.5, evidence_energy=3.18,
-                evidence_n=0.01, evidence_drift_radius=10.0, evidence_integer=0.0)
-    c = confirm(v, 0.5, 0.5)
-    assert c["confirmed"], c
-    assert abs(c["rotation_number"]) < 1e-9
+@pytest.mark.parametrize("args", [
+    ["--alpha=-inf", "--beta=1", "--nu=0.5", "--eta=0.5"],
+    ["--alpha=1", "--beta=1", "--nu=0.5", "--eta=0.5"],
+    ["--alpha=0.5", "--beta=nan", "--nu=0.5", "--eta=0.5"],
+    ["--alpha=0.5", "--beta=1", "--nu=3", "--eta=0.5"],
+    ["--alpha=0.5", "--beta=1", "--nu=0.5", "--eta=0.5", "--resolution=2"],
+    ["--alpha=0.5", "--beta=1", "--nu=0.5", "--eta=0.5", "--scan=4"],
+    ["--alpha=0.5", "--beta=1", "--nu=0.5", "--eta=0.5", "--boundaries"],
+    ["--alpha=0.5", "--nu=0.5", "--eta=0.5", "--boundaries", "--beta-min=5", "--beta-max=1"],
+    ["--alpha=0.5", "--beta=1", "--eta=0.5"],
+])
+def test_bad_input_is_one_line_and_exit_2(args):
+    p = subprocess.run([BIN, "verdict", *args], capture_output=True, text=True)
+    assert p.returncode == 2, p
+    assert p.stdout == "" and len(p.stderr.strip().splitlines()) == 1, p.stderr
+    assert "panicked" not in p.stderr
+
+
+def test_map_boundaries_and_evidence(tmp_path):
+    out = tmp_path / "hyp"
+    p = subprocess.run([sys.executable, str(SCRIPT), "--out", str(out), "--alphas", "2", "--betas", "5",
+                        "--beta-min", "0.3", "--beta-max", "30", "--others", "0.1,1", "--other-alphas", "2",
+                        "--other-betas", "4"], capture_output=True, text=True, env={**os.environ, "RUBBER_ATLAS_BIN": BIN})
+    assert p.returncode == 0, p.stderr
+    rows = list(csv.DictReader(open(out.with_suffix(".csv"))))
+    # α = 0 and 0.975, five β each plus the two sides of the case line.
+    assert len(rows) == 2 * 7
+    by = {(float(r["alpha"]), round(float(r["beta"]), 6)): r for r in rows}
+    assert by[(0.0, 0.3)]["verdict"] == "fails" and by[(0.0, 30.0)]["verdict"] == "not covered"
+    boundaries = list(csv.DictReader(open(tmp_path / "hyp-boundaries.csv")))
+    assert any(b["quantity"].startswith("case") and abs(float(b["beta"]) - 1.0) < 1e-12 for b in boundaries)
+    assert any(float(b["nu"]) == 0.1 for b in boundaries)
+    evidence = list(csv.DictReader(open(tmp_path / "hyp-evidence.csv")))
+    assert evidence and all(e["confirmed"] == "True" for e in evidence)
+    for e in evidence:
+        d = json.loads(e["distance"])
+        assert abs(d[1] / d[0] - 2.0) < 1e-5
+    with h5py.File(out.with_suffix(".h5")) as f:
+        assert set(f) == {"map", "boundaries", "evidence"} and f.attrs["nu"] == 0.5
+    assert out.with_suffix(".png").stat().st_size > 10_000

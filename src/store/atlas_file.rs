@@ -5,7 +5,7 @@
 
 use crate::atlas::{Block, Column, Kind, Unit, Variable, COMPONENT_SLOTS, FLAG_FILL};
 use crate::error::{AtlasError, Result};
-use crate::scene::Scene;
+use crate::scene::{Plane, Scene};
 use hdf5::types::VarLenUnicode;
 use ndarray::s;
 use std::ffi::CString;
@@ -119,6 +119,21 @@ impl AtlasFile {
         for (name, value) in attributes {
             write_attr(&file, name, value)?;
         }
+        let [row_name, column_name] = scene.plane.axis_names();
+        let (row_long, column_long) = match scene.plane {
+            Plane::KappaEnergy => (
+                "kappa = F2, the first integral of the reduction",
+                "energy, the value of the reduced energy integral",
+            ),
+            Plane::KappaExcess => (
+                "kappa = F2, the first integral of the reduction",
+                "excess energy: energy minus the bottom of V (its deepest minimum) at this kappa",
+            ),
+            Plane::Compact => (
+                "lambda = kappa / sqrt(energy), fixed along the high-energy limit",
+                "s = 1 / sqrt(energy): s = 0 is energy = infinity (the high-energy limit)",
+            ),
+        };
         let coords: [(&str, &[f64], &str, &str); 4] = [
             (
                 "alpha",
@@ -133,15 +148,15 @@ impl AtlasFile {
                 "1",
             ),
             (
-                "kappa",
+                row_name,
                 &scene.kappa.values,
-                "kappa = F2, the first integral of the reduction",
+                row_long,
                 "paper units (m = b3 = g = 1)",
             ),
             (
-                "energy",
+                column_name,
                 &scene.energy.values,
-                "energy, the value of the reduced energy integral",
+                column_long,
                 "paper units (m = b3 = g = 1)",
             ),
         ];
@@ -172,8 +187,16 @@ impl AtlasFile {
         let rows = crate::atlas::rows_per_unit(shape);
         let mut datasets = Vec::with_capacity(variables.len());
         for v in variables {
-            let per_cell = v.kind == Kind::CellFlag;
-            let d = if per_cell {
+            let per_cell = v.kind.per_cell();
+            let d = if v.kind == Kind::CellValue {
+                file.new_dataset::<f64>()
+                    .chunk([1, 1, rows, ne])
+                    .shuffle()
+                    .deflate(DEFLATE_LEVEL)
+                    .fill_value(f64::NAN)
+                    .shape([na, nb, nk, ne])
+                    .create(v.name)?
+            } else if per_cell {
                 file.new_dataset::<u8>()
                     .chunk([1, 1, rows, ne])
                     .shuffle()
@@ -201,7 +224,7 @@ impl AtlasFile {
             text_attr(&d, "long_name", v.long_name)?;
             text_attr(&d, "units", v.units)?;
             match v.kind {
-                Kind::Value => d
+                Kind::Value | Kind::CellValue => d
                     .new_attr::<f64>()
                     .create("_FillValue")?
                     .write_scalar(&f64::NAN)?,
@@ -217,6 +240,12 @@ impl AtlasFile {
                     .create("flag_values")?
                     .write_raw(values)?;
                 text_attr(&d, "flag_meanings", meanings)?;
+            }
+            // κ and ε per cell, where they are not axes: CF auxiliary coordinates of every
+            // variable of the grid.
+            let auxiliary = scene.plane.auxiliary();
+            if !auxiliary.is_empty() && v.kind != Kind::CellValue {
+                text_attr(&d, "coordinates", &auxiliary.join(" "))?;
             }
             let dims = if per_cell { 4 } else { 5 };
             for (i, scale) in scales.iter().take(dims).enumerate() {
@@ -283,7 +312,7 @@ impl AtlasFile {
                 unit.rows.start as u64,
                 0,
             ];
-            if v.kind != Kind::CellFlag {
+            if !v.kind.per_cell() {
                 offset.push(0);
             }
             let status = hdf5::sync::sync(|| unsafe {
@@ -325,6 +354,11 @@ impl AtlasFile {
                     ),
                     Kind::Value => Column::F64(
                         d.read_slice::<f64, _, ndarray::Ix3>(s![ia, ib, r.clone(), .., ..])?
+                            .into_raw_vec_and_offset()
+                            .0,
+                    ),
+                    Kind::CellValue => Column::F64(
+                        d.read_slice::<f64, _, ndarray::Ix2>(s![ia, ib, r.clone(), ..])?
                             .into_raw_vec_and_offset()
                             .0,
                     ),
@@ -376,7 +410,7 @@ pub fn encode_unit(variables: &[Variable], block: &Block, shape: [usize; 4]) -> 
         .iter()
         .zip(&block.columns)
         .map(|(v, column)| {
-            let width = if v.kind == Kind::CellFlag {
+            let width = if v.kind.per_cell() {
                 1
             } else {
                 COMPONENT_SLOTS
