@@ -13,7 +13,7 @@ const BIN: &str = env!("CARGO_BIN_EXE_rubber-atlas");
 
 /// (α, β, ν, η): the paper's type (c), the counterexamples, type (d), type (b), the
 /// extremes of the map's range and beyond it.
-const BODIES: [(f64, f64, f64, f64); 12] = [
+const BODIES: [(f64, f64, f64, f64); 15] = [
     (0.5, 3.0, 0.5, 0.5),
     (0.5, 0.5, 0.5, 0.5),
     (0.9, 20.0, 0.5, 0.5),
@@ -26,6 +26,9 @@ const BODIES: [(f64, f64, f64, f64); 12] = [
     (0.3, 300.0, 1.0, 1.0),
     (0.999, 300.0, 1.0, 1000.0),
     (1e-6, 3.0, 0.01, 1000.0),
+    (0.0, 0.01, 0.5, 0.5),
+    (0.5, 0.001, 0.5, 0.5),
+    (0.3, 1000.0, 0.5, 0.5),
 ];
 
 fn main() {

@@ -360,6 +360,7 @@ fn verdict(args: VerdictArgs) -> Result<()> {
         tol: args.tol,
         resolution: args.resolution,
         counterexamples: true,
+        coarse_first: false,
     };
     if !args.boundaries
         && (args.beta_min.is_some() || args.beta_max.is_some() || args.scan.is_some())
@@ -416,6 +417,10 @@ fn verdict(args: VerdictArgs) -> Result<()> {
     }
     let beta = args.beta.unwrap_or(1.0);
     let body = EllipsoidBody::ellipsoid(args.alpha, beta, args.nu, args.eta)?;
+    let options = VerdictOptions {
+        coarse_first: true,
+        ..options
+    };
     let v = verdict::verdict(&body, &options)?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&v)?);

@@ -83,6 +83,10 @@ pub struct VerdictOptions {
     /// Refine the integer brackets into counterexamples (off: only the fail margin and the
     /// count of brackets, as the root-finding of [`boundaries`] needs).
     pub counterexamples: bool,
+    /// Search at half the resolution first and stop there if it finds a counterexample
+    /// (the `verdict` command; off for the scans of [`boundaries`], whose margins must all
+    /// come from one resolution).
+    pub coarse_first: bool,
 }
 
 impl Default for VerdictOptions {
@@ -91,6 +95,7 @@ impl Default for VerdictOptions {
             tol: 1e-10,
             resolution: 64,
             counterexamples: true,
+            coarse_first: false,
         }
     }
 }
@@ -679,13 +684,38 @@ pub fn verdict(body: &EllipsoidBody, options: &VerdictOptions) -> Result<Verdict
         _ => KAPPA_FLOOR,
     };
     let linear_top = (3.0 * lo).max(4.0).max(3.0 * cusp_kappa.unwrap_or(0.0));
-    let kappas = kappa_lines(lo, linear_top, options.resolution);
+    // A failure needs one confirmed counterexample: with `coarse_first`, half the
+    // resolution is searched first, and the full one only if that finds none (a verdict that
+    // holds always rests on the full sampling).
+    let mut resolution = options.resolution;
+    let mut coarse = None;
+    if options.coarse_first && options.counterexamples && resolution >= 16 {
+        let half = resolution / 2;
+        let kappas = kappa_lines(lo, linear_top, half);
+        let sampler = Sampler {
+            body,
+            cell,
+            energies: half,
+        };
+        let lines: Vec<Vec<Sample>> = kappas.par_iter().map(|&k| sampler.line(k)).collect();
+        if !counterexamples(&sampler, &brackets(&lines, options.tol))
+            .0
+            .is_empty()
+        {
+            resolution = half;
+            coarse = Some((kappas, lines));
+        }
+    }
     let sampler = Sampler {
         body,
         cell,
-        energies: options.resolution,
+        energies: resolution,
     };
-    let lines: Vec<Vec<Sample>> = kappas.par_iter().map(|&k| sampler.line(k)).collect();
+    let (kappas, lines) = coarse.unwrap_or_else(|| {
+        let kappas = kappa_lines(lo, linear_top, resolution);
+        let lines: Vec<Vec<Sample>> = kappas.par_iter().map(|&k| sampler.line(k)).collect();
+        (kappas, lines)
+    });
     let candidates = brackets(&lines, options.tol);
     let all: Vec<&Sample> = lines.iter().flatten().collect();
     let (n_lo, n_hi) = all
@@ -752,7 +782,7 @@ pub fn verdict(body: &EllipsoidBody, options: &VerdictOptions) -> Result<Verdict
     verdict.evidence = Evidence {
         kappa_range: [kappas[0], kappa_top],
         kappa_lines: kappas.len(),
-        energies_per_line: options.resolution,
+        energies_per_line: resolution,
         components_solved: all.len(),
         rotation_number_range: [n_lo, n_hi],
         integer_brackets,

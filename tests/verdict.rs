@@ -158,6 +158,25 @@ fn boundaries_stay_put_when_the_resolution_doubles() {
 }
 
 #[test]
+fn the_half_resolution_shortcut_never_changes_a_verdict() {
+    // `verdict` searches half the resolution first and stops at a confirmed counterexample.
+    for (alpha, beta) in [(0.5, 0.5), (0.5, 3.0), (0.9, 20.0), (0.5, 1.1), (0.0, 0.3)] {
+        let body = EllipsoidBody::ellipsoid(alpha, beta, 0.5, 0.5).unwrap();
+        let full = verdict(&body, &VerdictOptions::default()).unwrap();
+        let quick = VerdictOptions {
+            coarse_first: true,
+            ..VerdictOptions::default()
+        };
+        let quick = verdict(&body, &quick).unwrap();
+        assert_eq!(full.holds, quick.holds, "α = {alpha}, β = {beta}");
+        assert_eq!(
+            full.counterexamples.is_empty(),
+            quick.counterexamples.is_empty()
+        );
+    }
+}
+
+#[test]
 fn bad_options_are_refused() {
     let body = EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 0.5).unwrap();
     for (tol, resolution) in [(0.0, 64), (f64::NAN, 64), (1e-10, 2), (1e-10, 1 << 20)] {
