@@ -46,11 +46,17 @@ def flag_names(variable: xr.DataArray) -> dict[int, str]:
     return {int(v): n for v, n in zip(values, names)}
 
 
-def components(ds: xr.Dataset, alpha: float, beta: float, kappa: float, energy: float) -> list[dict]:
+def components(ds: xr.Dataset, alpha: float, beta: float, **cell: float) -> list[dict]:
     """The components of one grid cell as dicts (keys as in `rubber-atlas cell --json`, with
-    status and motion as names), sorted by theta_min. The coordinates must be grid values (to
-    1e-12)."""
-    point = {"alpha": alpha, "beta": beta, "kappa": kappa, "energy": energy}
+    status and motion as names), sorted by theta_min. The cell is given by the grid values (to
+    1e-12) of the file's own plane: `kappa=…, energy=…`, `kappa=…, excess_energy=…` or
+    `lambda_=…, s=…` (`lambda_` since `lambda` is a Python keyword)."""
+    cell = {("lambda" if k == "lambda_" else k): v for k, v in cell.items()}
+    planes = [d for d in ds.rotation_number.dims if d not in ("alpha", "beta", "component")] \
+        if "rotation_number" in ds else [d for d in ds.cell_status.dims if d not in ("alpha", "beta")]
+    if sorted(cell) != sorted(planes):
+        raise KeyError(f"give the cell by {', '.join(planes)} (this file's plane), not {', '.join(cell) or 'nothing'}")
+    point = {"alpha": alpha, "beta": beta, **cell}
     index = {}
     for name, value in point.items():
         axis = ds[name].values

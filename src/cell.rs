@@ -173,6 +173,9 @@ pub fn solve_high_energy_limit<S: Shape>(
     }
     let n = crate::limits::high_energy_rotation_number(body, lambda, options.tol)?;
     let theta_min = (lambda / std::f64::consts::SQRT_2).asin();
+    // λ = 0 is κ = 0: rolling over the top along a meridian, as at every finite ε above
+    // ε_min (N = 0 there).
+    let over_the_top = lambda == 0.0;
     let fixed = theta_min == std::f64::consts::FRAC_PI_2;
     let omega_psi = if n.value == 0.0 {
         0.0
@@ -181,7 +184,11 @@ pub fn solve_high_energy_limit<S: Shape>(
     };
     Ok(at_infinity(vec![ComponentResult {
         theta_min,
-        theta_max: PI - theta_min,
+        theta_max: if over_the_top {
+            theta_min + TAU
+        } else {
+            PI - theta_min
+        },
         period: 0.0,
         omega_theta: f64::INFINITY,
         omega_psi,
@@ -189,7 +196,9 @@ pub fn solve_high_energy_limit<S: Shape>(
         drift: f64::NAN,
         drift_radius: f64::NAN,
         bounded: None,
-        motion: if fixed {
+        motion: if over_the_top {
+            MotionKind::Rotation
+        } else if fixed {
             MotionKind::FixedPoint
         } else {
             MotionKind::Libration

@@ -185,6 +185,24 @@ fn odd_part_integral<S: Shape>(body: &Body<S>, x0: f64, abs_tol: f64) -> Estimat
     }
 }
 
+/// 0 ≤ λ ≤ √2: the high-energy limit has motion only there (κ²/2 ≤ ε).
+fn check_lambda(lambda: f64) -> Result<f64> {
+    check_range(
+        "lambda",
+        lambda,
+        Some((0.0, true)),
+        Some((SQRT_2, true)),
+        "must satisfy 0 <= lambda <= sqrt(2) (no motion above: kappa^2/2 <= energy)",
+    )
+}
+
+/// x₀ = cosθ at the turning points of the high-energy limit, x₀² = 1 − λ²/2 (0 beyond √2).
+fn turning_cosine(lambda: f64) -> f64 {
+    ((1.0 - lambda / SQRT_2) * (1.0 + lambda / SQRT_2))
+        .max(0.0)
+        .sqrt()
+}
+
 /// N∞(λ): the rotation number in the limit ε → ∞ at fixed λ = κ/√ε, for 0 ≤ λ ≤ √2 (the
 /// allowed set is sinθ ≥ λ/√2), to the absolute accuracy `tol`.
 pub fn high_energy_rotation_number<S: Shape>(
@@ -192,16 +210,8 @@ pub fn high_energy_rotation_number<S: Shape>(
     lambda: f64,
     tol: f64,
 ) -> Result<Estimate> {
-    check_range(
-        "lambda",
-        lambda,
-        Some((0.0, true)),
-        Some((SQRT_2, true)),
-        "must satisfy 0 <= lambda <= sqrt(2) (no motion above: kappa^2/2 <= energy)",
-    )?;
-    let x0 = ((1.0 - lambda / SQRT_2) * (1.0 + lambda / SQRT_2))
-        .max(0.0)
-        .sqrt();
+    check_lambda(lambda)?;
+    let x0 = turning_cosine(lambda);
     let factor = lambda * x0 / (SQRT_2 * PI);
     if factor == 0.0 {
         return Ok(Estimate {
@@ -229,24 +239,8 @@ pub fn normalized_high_energy_rotation_number<S: Shape>(
     lambda: f64,
     tol: f64,
 ) -> Result<Estimate> {
-    check_range(
-        "lambda",
-        lambda,
-        Some((0.0, true)),
-        Some((SQRT_2, true)),
-        "must satisfy 0 <= lambda <= sqrt(2)",
-    )?;
-    // At λ = √2 the limit x₀ → 0, approached as NORMALIZED_END says.
-    let x0 = ((1.0 - lambda / SQRT_2) * (1.0 + lambda / SQRT_2))
-        .max(0.0)
-        .sqrt()
-        .max(NORMALIZED_END);
-    let factor = 1.0 / (SQRT_2 * PI * x0);
-    let integral = odd_part_integral(body, x0, 0.25 * tol / factor);
-    Ok(Estimate {
-        value: factor * integral.value,
-        error: factor * integral.error,
-    })
+    check_lambda(lambda)?;
+    Ok(high_energy_pair(body, lambda, tol).1)
 }
 
 /// lim N∞(λ)/λ as λ → 0: how N tends to 0 at fixed κ as ε → ∞ (N ≈ slope · κ/√ε).
@@ -288,10 +282,8 @@ const EXTREMA_SCAN: usize = 96;
 
 /// N∞(λ) and Ñ(λ) from one integral, each to the absolute accuracy `tol`.
 pub fn high_energy_pair<S: Shape>(body: &Body<S>, lambda: f64, tol: f64) -> (Estimate, Estimate) {
-    let x0 = ((1.0 - lambda / SQRT_2) * (1.0 + lambda / SQRT_2))
-        .max(0.0)
-        .sqrt()
-        .max(NORMALIZED_END);
+    // At λ = √2 the limit x₀ → 0, approached as NORMALIZED_END says.
+    let x0 = turning_cosine(lambda).max(NORMALIZED_END);
     let c = SQRT_2 * PI;
     // Ñ = I/(c x₀) and N∞ = λ x₀ I / c = λ x₀² Ñ: I to c x₀ tol/4 serves both.
     let i = odd_part_integral(body, x0, 0.25 * c * x0 * tol);

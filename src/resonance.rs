@@ -154,17 +154,9 @@ pub(crate) fn bracketed_root(
     Some(0.5 * (a + b))
 }
 
-/// The levels of the maxima of V at one κ, sorted: the separatrices. Between two of them
-/// N of one component is continuous in ε; it diverges only at a separatrix.
+/// The levels of the maxima of V at one κ, sorted: the separatrices.
 fn separatrices<S: Shape>(potential: &EffectivePotential<'_, S>) -> Vec<f64> {
-    let mut v: Vec<f64> = potential
-        .critical_points()
-        .iter()
-        .filter(|p| p.kind == CriticalKind::Maximum)
-        .map(|p| p.value)
-        .collect();
-    v.sort_by(f64::total_cmp);
-    v
+    potential.separatrix_levels()
 }
 
 /// Where a point lies among the separatrices: the level nearest to it and on which side

@@ -119,6 +119,11 @@ impl Axis {
     }
 }
 
+/// The largest |κ| of a cell: κ² (in V) stays finite with room to spare.
+const MAX_KAPPA: f64 = 1e150;
+/// The smallest s > 0 of a compactified plane: ε = 1/s² ≤ 1e300.
+const MIN_S: f64 = 1e-150;
+
 /// Which two axes span the (κ, ε) plane of each body (SPEC §3.2 and §4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Plane {
@@ -441,8 +446,40 @@ impl Scene {
         };
         let [row_name, column_name] = plane.axis_names();
         let kappa = reader.axis(axes, row_name)?;
-        let energy = reader.axis(axes, column_name)?;
+        let mut energy = reader.axis(axes, column_name)?;
+        // κ and ε of every cell must be finite numbers whose squares do not overflow.
+        let largest = |a: &Axis| a.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let smallest_positive = |a: &Axis| {
+            a.values
+                .iter()
+                .filter(|v| **v > 0.0)
+                .fold(f64::INFINITY, |m, v| m.min(*v))
+        };
+        if plane != Plane::Compact && largest(&kappa) > MAX_KAPPA {
+            return Err(reader.error(
+                "axes.kappa",
+                format!(
+                    "{} is above {MAX_KAPPA:e} (kappa^2 would overflow)",
+                    largest(&kappa)
+                ),
+            ));
+        }
         if plane == Plane::Compact {
+            let s_min = smallest_positive(&energy);
+            if s_min < MIN_S || largest(&kappa) / s_min > MAX_KAPPA {
+                return Err(reader.error(
+                    "axes.s",
+                    format!(
+                        "{s_min:e} is too small: energy = 1/s^2 must stay below 1e300 and kappa = lambda/s below {MAX_KAPPA:e} (s = 0 is the limit energy = infinity itself)"
+                    ),
+                ));
+            }
+            // −0 is 0: the limit column.
+            for v in energy.values.iter_mut() {
+                if *v == 0.0 {
+                    *v = 0.0;
+                }
+            }
             if kappa.values[0] < 0.0 {
                 return Err(reader.error(
                     "axes.lambda",

@@ -184,6 +184,28 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             .min_by(f64::total_cmp)
     }
 
+    /// θ of every minimum of V, in increasing θ: the wells, one family of tori each.
+    pub fn minimum_sites(&self) -> Vec<f64> {
+        self.critical
+            .iter()
+            .filter(|p| p.kind == CriticalKind::Minimum)
+            .map(|p| p.site.theta)
+            .collect()
+    }
+
+    /// The levels of the maxima of V, sorted: the separatrices. Between two of them N of one
+    /// component is continuous in ε; it diverges only at a separatrix.
+    pub fn separatrix_levels(&self) -> Vec<f64> {
+        let mut v: Vec<f64> = self
+            .critical
+            .iter()
+            .filter(|p| p.kind == CriticalKind::Maximum)
+            .map(|p| p.value)
+            .collect();
+        v.sort_by(f64::total_cmp);
+        v
+    }
+
     /// V at an angle.
     #[inline]
     pub fn value(&self, a: Angle) -> f64 {

@@ -213,16 +213,6 @@ fn kappa_lines(lo: f64, linear_top: f64, resolution: usize) -> Vec<f64> {
     k
 }
 
-/// The deepest minimum of V at one κ.
-fn bottom<S: Shape>(potential: &EffectivePotential<'_, S>) -> Option<f64> {
-    potential
-        .critical_points()
-        .iter()
-        .filter(|p| p.kind == CriticalKind::Minimum)
-        .map(|p| p.value)
-        .min_by(f64::total_cmp)
-}
-
 /// The energy of base grid point i at the bottom `low`: ε = low / (1 − q)².
 fn grid_energy(low: f64, q: f64) -> f64 {
     low / ((1.0 - q) * (1.0 - q))
@@ -238,20 +228,9 @@ impl Sampler<'_> {
     /// Every component at every sampled energy of the κ-line.
     fn line(&self, kappa: f64) -> Vec<Sample> {
         let potential = EffectivePotential::new(self.body, kappa);
-        let minima: Vec<f64> = potential
-            .critical_points()
-            .iter()
-            .filter(|p| p.kind == CriticalKind::Minimum)
-            .map(|p| p.site.theta)
-            .collect();
-        let mut levels: Vec<f64> = potential
-            .critical_points()
-            .iter()
-            .filter(|p| p.kind == CriticalKind::Maximum)
-            .map(|p| p.value)
-            .collect();
-        levels.sort_by(f64::total_cmp);
-        let Some(low) = bottom(&potential) else {
+        let minima = potential.minimum_sites();
+        let levels = potential.separatrix_levels();
+        let Some(low) = potential.lowest_minimum() else {
             return Vec::new();
         };
         let mut energies: Vec<(f64, Option<usize>)> = (0..self.energies)
@@ -326,25 +305,12 @@ impl Sampler<'_> {
         drift: bool,
     ) -> Option<crate::cell::ComponentResult> {
         let potential = EffectivePotential::new(self.body, kappa);
-        let minima: Vec<f64> = potential
-            .critical_points()
-            .iter()
-            .filter(|p| p.kind == CriticalKind::Minimum)
-            .map(|p| p.site.theta)
-            .collect();
-        let levels = potential
-            .critical_points()
-            .iter()
-            .filter(|p| p.kind == CriticalKind::Maximum)
-            .count();
-        if (minima.len(), levels) != of.shape {
+        let minima = potential.minimum_sites();
+        let levels = potential.separatrix_levels();
+        if (minima.len(), levels.len()) != of.shape {
             return None;
         }
-        let gap = potential
-            .critical_points()
-            .iter()
-            .filter(|p| p.kind == CriticalKind::Maximum && p.value < energy)
-            .count();
+        let gap = levels.iter().filter(|&&l| l < energy).count();
         if gap != of.gap {
             return None;
         }
@@ -452,11 +418,11 @@ fn fold_windows(body: &EllipsoidBody, set: &CriticalSet) -> Vec<FoldWindow> {
         .map_or(cusp.energy, |t| body.shape.potential(t));
     let mut out = Vec::new();
     let k0 = 0.5 * cusp.kappa;
-    if let Some(low) = bottom(&EffectivePotential::new(body, k0)) {
+    if let Some(low) = EffectivePotential::new(body, k0).lowest_minimum() {
         let top = cusp.energy + (cusp.energy - top_of_u).max(0.05 * cusp.energy);
         out.push(((k0, 1.5 * cusp.kappa + 0.05), (low, top), 24));
     }
-    if let Some(low) = bottom(&EffectivePotential::new(body, 0.01)) {
+    if let Some(low) = EffectivePotential::new(body, 0.01).lowest_minimum() {
         let top = cusp.energy + 2.0 * (cusp.energy - low).max(1.0);
         out.push(((0.01, 2.0 * cusp.kappa + 0.5), (low, top), 48));
     }
@@ -507,10 +473,8 @@ fn n_near_well(
 ) -> Option<f64> {
     let potential = EffectivePotential::new(body, kappa);
     let minimum = potential
-        .critical_points()
-        .iter()
-        .filter(|p| p.kind == CriticalKind::Minimum)
-        .map(|p| p.site.theta)
+        .minimum_sites()
+        .into_iter()
         .min_by(|a, b| (a - well).abs().total_cmp(&(b - well).abs()))?;
     let components = potential.components(energy).ok()?;
     let c = components.iter().find(|c| {
@@ -1087,7 +1051,7 @@ fn refine(sampler: &Sampler<'_>, c: &Candidate) -> Option<Counterexample> {
             let q = grid_q(c.a.grid?, sampler.energies);
             let at = |t: f64| -> Option<(f64, f64)> {
                 let kappa = c.a.kappa + t * (b.kappa - c.a.kappa);
-                let low = bottom(&EffectivePotential::new(sampler.body, kappa))?;
+                let low = EffectivePotential::new(sampler.body, kappa).lowest_minimum()?;
                 Some((kappa, grid_energy(low, q)))
             };
             let f = |t: f64| {

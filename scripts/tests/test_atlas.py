@@ -95,7 +95,7 @@ def test_a_sample_of_cells_equals_the_cell_command(demo):
             check=True, capture_output=True, text=True,
         ).stdout
         expected = json.loads(out)["components"]
-        got = components(ds, 0.5, 3.0, kappa, energy)
+        got = components(ds, 0.5, 3.0, kappa=kappa, energy=energy)
         assert len(got) == len(expected), (kappa, energy)
         for g, e in zip(got, expected):
             for name in fields:
@@ -144,6 +144,10 @@ def test_compact_plane_has_kappa_and_energy_as_coordinates(make_atlas):
     cell = ds.sel(alpha=0.5, beta=3.0).isel(**{"lambda": 3, "s": 4})
     lam, s = float(cell["lambda"]), float(cell["s"])
     assert float(cell.kappa) == lam / s and float(cell.energy) == 1 / s**2
+    got = components(ds, 0.5, 3.0, lambda_=lam, s=s)
+    assert got and got[0]["rotation_number"] == float(cell.rotation_number.isel(component=0))
+    with pytest.raises(KeyError):
+        components(ds, 0.5, 3.0, kappa=1.0, energy=2.0)
     limit = ds.sel(alpha=0.5, beta=3.0, s=0.0)
     assert np.isinf(limit.energy).all()
     assert (flag_names(ds.status)[int(limit.status.isel(**{"lambda": 0}, component=0))] == "high_energy_limit")
