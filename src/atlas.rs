@@ -470,9 +470,26 @@ impl Shard {
 
     /// The contiguous range of unit indices that belongs to this shard out of `total`.
     pub fn units(&self, total: usize) -> Range<usize> {
-        let start = total * (self.index - 1) / self.count;
-        let stop = total * self.index / self.count;
-        start..stop
+        // In 128 bits: total · index does not overflow for any usize shard.
+        let at = |i: usize| (total as u128 * i as u128 / self.count as u128) as usize;
+        at(self.index - 1)..at(self.index)
+    }
+
+    /// Checks that this shard of a grid of `total` work units has at least one unit.
+    pub fn check_against(&self, total: usize) -> Result<()> {
+        if self.index == 0 || self.index > self.count {
+            return Err(AtlasError::Atlas {
+                path: format!("shard {self}"),
+                reason: "needs 1 <= I <= N".into(),
+            });
+        }
+        if self.count > total {
+            return Err(AtlasError::Atlas {
+                path: format!("shard {self}"),
+                reason: format!("the grid has only {total} work units: use at most {total} shards"),
+            });
+        }
+        Ok(())
     }
 }
 

@@ -20,7 +20,13 @@ use std::path::PathBuf;
 
 /// Atlases of the dynamics of a "rubber" ellipsoid of revolution rolling on a plane.
 #[derive(Debug, Parser)]
-#[command(name = "rubber-atlas", version, about, long_about = None)]
+#[command(
+    name = "rubber-atlas",
+    version,
+    about,
+    long_about = None,
+    arg_required_else_help = true
+)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
@@ -54,37 +60,37 @@ pub enum Command {
 #[derive(Debug, Args)]
 pub struct VerdictArgs {
     /// α = a/b3: displacement of the centre of mass along the axis, 0 <= α < 1.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub alpha: f64,
     /// β = b1/b3 (not with --boundaries).
     #[arg(
         long,
-        allow_negative_numbers = true,
+        allow_hyphen_values = true,
         required_unless_present = "boundaries",
         conflicts_with = "boundaries"
     )]
     pub beta: Option<f64>,
     /// ν = i3/i1, 0 < ν <= 2.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub nu: f64,
     /// η = m b3²/i1 > 0.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub eta: f64,
     /// The β at which the verdict changes along β at this α, each by root-finding.
     #[arg(long)]
     pub boundaries: bool,
     /// Smallest β searched by --boundaries [default: 0.05].
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub beta_min: Option<f64>,
     /// Largest β searched by --boundaries [default: 50].
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub beta_max: Option<f64>,
     /// Log-spaced β of the scan behind --boundaries (the line β² = 1 + α is added)
     /// [default: 48].
     #[arg(long)]
     pub scan: Option<usize>,
     /// Tolerance of the cell solver (N at a counterexample equals the integer to this).
-    #[arg(long, default_value_t = 1e-10, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 1e-10, allow_hyphen_values = true)]
     pub tol: f64,
     /// κ-lines of each kind and energies per line of the sampling (doubling it halves the
     /// spacing).
@@ -100,32 +106,32 @@ pub struct ResonanceArgs {
     #[command(flatten)]
     pub shape: ShapeArgs,
     /// ν = i3/i1, 0 < ν <= 2.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub nu: f64,
     /// η = m b3²/i1 > 0.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub eta: f64,
     /// The rotation number of the curves: P/Q (e.g. 0, 1, -1/7) or a decimal.
     #[arg(long, value_name = "P/Q", allow_hyphen_values = true)]
     pub rotation_number: String,
     /// The window: smallest κ (> 0; N = 0 at κ = 0).
-    #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 0.01, allow_hyphen_values = true)]
     pub kappa_min: f64,
     /// The window: largest κ.
-    #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 2.0, allow_hyphen_values = true)]
     pub kappa_max: f64,
     /// The window: smallest ε [default: the lowest minimum of V over the window].
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub energy_min: Option<f64>,
     /// The window: largest ε.
-    #[arg(long, default_value_t = 5.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 5.0, allow_hyphen_values = true)]
     pub energy_max: f64,
     /// Rows of κ (and energies per row) of the seed scan; curves are also followed between
     /// rows, but a closed curve that crosses no row is missed.
     #[arg(long, default_value_t = 48)]
     pub grid: usize,
     /// Tolerance of the cell solver (N on the curve equals P/Q to this).
-    #[arg(long, default_value_t = 1e-10, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 1e-10, allow_hyphen_values = true)]
     pub tol: f64,
     /// Print the fold of the curve of largest κ as JSON {"kappa_max": …, "energy": …}.
     #[arg(long)]
@@ -193,19 +199,14 @@ pub enum MethodArg {
 pub struct StartArgs {
     /// Energy ε (`cell`: every component; `trajectory`: start at the lower turning point of
     /// component --component with θ̇ = 0).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub energy: Option<f64>,
     /// Initial inclination θ(0) (`cell`: only the component that holds it).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub theta0: Option<f64>,
-    /// Initial θ̇(0) (with --theta0).
-    #[arg(
-        long,
-        default_value_t = 0.0,
-        requires = "theta0",
-        allow_negative_numbers = true
-    )]
-    pub theta_dot0: f64,
+    /// Initial θ̇(0) (with --theta0) [default: 0].
+    #[arg(long, requires = "theta0", allow_hyphen_values = true)]
+    pub theta_dot0: Option<f64>,
 }
 
 impl StartArgs {
@@ -214,7 +215,7 @@ impl StartArgs {
         let start = Start {
             kappa,
             theta0,
-            theta_dot0: self.theta_dot0,
+            theta_dot0: self.theta_dot0.unwrap_or(0.0),
         };
         start.check()?;
         Ok(start)
@@ -228,13 +229,13 @@ pub struct CellArgs {
     #[command(flatten)]
     pub start: StartArgs,
     /// Accuracy: relative for T, ω, drift; absolute for N. 1e-15 <= TOL <= 0.1.
-    #[arg(long, default_value_t = 1e-10, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 1e-10, allow_hyphen_values = true)]
     pub tol: f64,
     /// How to compute the period integrals.
     #[arg(long, value_enum, default_value_t = MethodArg::Quadrature)]
     pub method: MethodArg,
     /// |N − round(N)| at or below this (or N's error estimate) counts as a resonance.
-    #[arg(long, default_value_t = 1e-9, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 1e-9, allow_hyphen_values = true)]
     pub resonance_tol: f64,
     /// Print one JSON object (keys of SPEC §3.1).
     #[arg(long)]
@@ -245,10 +246,10 @@ pub struct CellArgs {
 #[derive(Debug, Args)]
 pub struct ShapeArgs {
     /// α = a/b3: displacement of the centre of mass along the axis, 0 <= α < 1.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub alpha: f64,
     /// β = b1/b3: < 1 prolate, > 1 oblate, 1 sphere.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub beta: f64,
 }
 
@@ -258,13 +259,13 @@ pub struct LevelArgs {
     #[command(flatten)]
     pub shape: ShapeArgs,
     /// ν = i3/i1, 0 < ν <= 2.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub nu: f64,
     /// η = m b3²/i1 > 0.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub eta: f64,
     /// κ, the value of the integral F2 = J ω3.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub kappa: f64,
 }
 
@@ -285,10 +286,10 @@ pub struct DiagramArgs {
     #[command(flatten)]
     pub shape: ShapeArgs,
     /// ν = i3/i1 (does not change the critical set; recorded in the output).
-    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
     pub nu: f64,
     /// η = m b3²/i1 (does not change the critical set; recorded in the output).
-    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
     pub eta: f64,
     /// Print the critical set as one JSON object.
     #[arg(long, conflicts_with = "out")]
@@ -300,7 +301,7 @@ pub struct DiagramArgs {
     #[arg(long, default_value_t = 2000)]
     pub samples: usize,
     /// Truncate the sampled curves at this κ.
-    #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 3.0, allow_hyphen_values = true)]
     pub kappa_max: f64,
 }
 
@@ -319,20 +320,21 @@ pub struct TrajectoryArgs {
     pub level: LevelArgs,
     #[command(flatten)]
     pub start: StartArgs,
-    /// Which component of the level set (κ, ε) to start on, counted from the smallest θ.
-    #[arg(long, default_value_t = 0, requires = "energy")]
-    pub component: usize,
+    /// Which component of the level set (κ, ε) to start on, counted from the smallest θ
+    /// (with --energy) [default: 0].
+    #[arg(long, requires = "energy")]
+    pub component: Option<usize>,
     /// Length in θ-periods of the starting component.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub periods: Option<f64>,
     /// Length in time units √(b3/g).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub t_end: Option<f64>,
     /// Number of output intervals (the file has SAMPLES + 1 rows).
     #[arg(long, default_value_t = 2000)]
     pub samples: usize,
     /// Relative and absolute tolerance of the DOP853 integrator.
-    #[arg(long, default_value_t = 1e-12, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 1e-12, allow_hyphen_values = true)]
     pub tol: f64,
     /// Which equations to integrate.
     #[arg(long, value_enum, default_value_t = ModelArg::Reduced)]
@@ -526,6 +528,13 @@ fn parse_rotation_number(text: &str) -> Result<f64> {
 }
 
 fn resonance(args: ResonanceArgs) -> Result<()> {
+    if args.fold && args.out.is_some() {
+        return Err(AtlasError::Atlas {
+            path: "resonance".into(),
+            reason: "--fold prints the fold as JSON; it does not go with --out".into(),
+        }
+        .into());
+    }
     let body = EllipsoidBody::ellipsoid(args.shape.alpha, args.shape.beta, args.nu, args.eta)?;
     let target = parse_rotation_number(&args.rotation_number)?;
     let energy_min = match args.energy_min {
@@ -750,7 +759,8 @@ fn run_scene(args: RunArgs) -> Result<()> {
             }
             .into())
         }
-        Some(n) => n,
+        // More threads than cores only add overhead: capped at the cores.
+        Some(n) => n.min(std::thread::available_parallelism().map_or(1, |c| c.get())),
         None => std::thread::available_parallelism().map_or(1, |n| n.get()),
     };
     // The global pool, so that the run's serial parts (file creation, writing) stay on the
@@ -821,7 +831,29 @@ fn print_summary(summary: &sweep::Summary, out: &std::path::Path, threads: usize
     );
 }
 
+/// Refuses options that the chosen start would silently ignore (clap's `requires` cannot see
+/// this through the flattened start group).
+fn check_start(start: &StartArgs, component: Option<usize>) -> Result<()> {
+    let refuse = |reason: &str| -> Result<()> {
+        Err(AtlasError::Atlas {
+            path: "options".into(),
+            reason: reason.into(),
+        }
+        .into())
+    };
+    if start.theta_dot0.is_some() && start.theta0.is_none() {
+        return refuse("--theta-dot0 goes with --theta0 (with --energy the start is at rest at a turning point)");
+    }
+    if component.is_some() && start.energy.is_none() {
+        return refuse(
+            "--component goes with --energy (with --theta0 the start chooses the component)",
+        );
+    }
+    Ok(())
+}
+
 fn cell(args: CellArgs) -> Result<()> {
+    check_start(&args.start, None)?;
     let body = args.level.body()?;
     let options = CellOptions {
         tol: args.tol,
@@ -839,7 +871,7 @@ fn cell(args: CellArgs) -> Result<()> {
             let start = args.start.at_theta0(args.level.kappa, t)?;
             options.validate()?;
             let potential = EffectivePotential::new(&body, start.kappa);
-            let energy = start.energy(&body);
+            let energy = start.checked_energy(&body)?;
             let component = start.component_in(&potential)?;
             CellResult {
                 kappa: start.kappa,
@@ -1085,6 +1117,7 @@ fn write_diagram(out: &std::path::Path, set: &CriticalSet) -> Result<()> {
 }
 
 fn trajectory(args: TrajectoryArgs) -> Result<()> {
+    check_start(&args.start, args.component)?;
     let body = args.level.body()?;
     if !args.level.kappa.is_finite() {
         return Err(AtlasError::InvalidParameter {
@@ -1121,9 +1154,13 @@ fn trajectory(args: TrajectoryArgs) -> Result<()> {
                 }
                 .into());
             }
-            Start::at_energy(&body, args.level.kappa, e, args.component)?
+            Start::at_energy(&body, args.level.kappa, e, args.component.unwrap_or(0))?
         }
-        (None, Some(t)) => args.start.at_theta0(args.level.kappa, t)?,
+        (None, Some(t)) => {
+            let start = args.start.at_theta0(args.level.kappa, t)?;
+            start.checked_energy(&body)?;
+            start
+        }
         _ => unreachable!("clap requires exactly one of --energy, --theta0"),
     };
     let t_end = match (args.periods, args.t_end) {

@@ -8,7 +8,7 @@ use thiserror::Error;
 #[non_exhaustive]
 pub enum AtlasError {
     /// A parameter outside its allowed range, or not a finite number.
-    #[error("invalid {name} = {value}: {reason}")]
+    #[error("invalid {name} = {}: {reason}", show(*value))]
     InvalidParameter {
         name: &'static str,
         value: f64,
@@ -51,6 +51,16 @@ impl AtlasError {
             path: path.display().to_string(),
             reason: reason.to_string(),
         }
+    }
+}
+
+/// A number as a person reads it in a message: exponent notation far from 1 (1e200, not
+/// two hundred digits).
+fn show(value: f64) -> String {
+    if value != 0.0 && value.is_finite() && !(1e-4..1e16).contains(&value.abs()) {
+        format!("{value:e}")
+    } else {
+        format!("{value}")
     }
 }
 

@@ -23,6 +23,11 @@ fn main() -> ExitCode {
             let _ = e.print();
             return ExitCode::SUCCESS;
         }
+        Err(e) if e.kind() == clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+            // No command given: the whole help, with the usage and the commands.
+            let _ = e.print();
+            return ExitCode::from(2);
+        }
         Err(e) => {
             // One line: clap's message up to its usage block, folded.
             let text = e.render().to_string();

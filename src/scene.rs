@@ -325,6 +325,13 @@ impl Reader<'_> {
                 ))
             }
         };
+        // start/stop/num near the limits of a double can overflow to inf or NaN.
+        if let Some(v) = values.iter().find(|v| !v.is_finite()) {
+            return Err(self.error(
+                &full,
+                format!("the axis overflows to {v}: keep start and stop well inside +-1e308"),
+            ));
+        }
         if let Some(i) = values.windows(2).position(|w| w[1] <= w[0]) {
             return Err(self.error(
                 &full,

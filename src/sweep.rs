@@ -183,6 +183,10 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
             "exists; use --force to overwrite it (a finished run has nothing to resume)",
         ));
     }
+    // Before anything is written: the shard must have work units of its own.
+    request
+        .shard
+        .check_against(atlas::units(scene.shape()).len())?;
     let fingerprint = scene.fingerprint();
     let journal_dir = Journal::dir_for(out);
     let journal = if journal_dir.exists() {
@@ -311,6 +315,14 @@ pub fn merge(
     if shards.is_empty() {
         return Err(AtlasError::atlas(out, "no shard files given"));
     }
+    if let Some(path) = shards.iter().find(|p| !p.is_file()) {
+        let why = if path.exists() {
+            "is not a regular file"
+        } else {
+            "does not exist"
+        };
+        return Err(AtlasError::atlas(path, why));
+    }
     // The scene, from the first shard; every shard must carry the same one.
     let first = shards[0].as_path();
     let scene_text = read_root_text(first, "scene")?;
@@ -337,7 +349,19 @@ pub fn merge(
         ) else {
             return Err(AtlasError::atlas(path, "has no shard_index / shard_count"));
         };
-        let n = n as usize;
+        // The attributes are the file's word: checked before any use.
+        let (index, n) = match (usize::try_from(index), usize::try_from(n)) {
+            (Ok(i), Ok(n)) => (i, n),
+            _ => {
+                return Err(AtlasError::atlas(
+                    path,
+                    format!("has shard_index {index} / shard_count {n}, not a shard"),
+                ))
+            }
+        };
+        Shard { index, count: n }
+            .check_against(all_units.len())
+            .map_err(|e| AtlasError::atlas(path, e))?;
         if *count.get_or_insert(n) != n {
             return Err(AtlasError::atlas(
                 path,
@@ -348,7 +372,7 @@ pub fn merge(
             ));
         }
         by_index.resize_with(n, || None);
-        let slot = &mut by_index[index as usize - 1];
+        let slot = &mut by_index[index - 1];
         if let Some((other, _)) = slot {
             return Err(AtlasError::atlas(
                 path,

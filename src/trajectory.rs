@@ -95,6 +95,24 @@ impl Start {
         ReducedSystem::new(body, self.kappa).energy(self.theta0, self.theta_dot0)
     }
 
+    /// The energy of this start, refused (naming θ̇(0), or κ) where it overflows.
+    pub fn checked_energy<S: Shape>(&self, body: &Body<S>) -> Result<f64> {
+        let energy = self.energy(body);
+        if energy.is_finite() {
+            return Ok(energy);
+        }
+        let (name, value) = if self.theta_dot0 != 0.0 {
+            ("theta-dot0", self.theta_dot0)
+        } else {
+            ("kappa", self.kappa)
+        };
+        Err(AtlasError::InvalidParameter {
+            name,
+            value,
+            reason: "gives an infinite energy B theta_dot^2/2 + V",
+        })
+    }
+
     /// The component of the level set that holds θ(0).
     pub fn component<S: Shape>(&self, body: &Body<S>) -> Result<Component> {
         self.component_in(&EffectivePotential::new(body, self.kappa))

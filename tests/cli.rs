@@ -375,3 +375,175 @@ fn a_trajectory_started_by_energy_on_a_rotation_rolls_over_the_top_once_per_peri
     );
     assert!((last[2] - first[2]).abs() < 1e-8);
 }
+
+/// Issue 13, items 4, 8, 9 and 10: panics, an overflowing grid, options that were silently
+/// ignored, and messages.
+#[test]
+fn edge_inputs_get_one_line_and_never_a_panic() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("s.toml");
+    let grid = |energy: &str| {
+        format!(
+            "name = \"s\"\n[body]\nnu = 0.5\neta = 0.5\n[axes]\nalpha = [0.5]\nbeta = [3.0]\n\
+             kappa = {{ start = 0.0, stop = 1.0, num = 4 }}\nenergy = {energy}\n\
+             [outputs]\nfields = [\"rotation_number\", \"status\"]\n"
+        )
+    };
+    std::fs::write(&scene, grid("{ start = 1.0, stop = 3.0, num = 4 }")).unwrap();
+    let scene_s = scene.to_str().unwrap();
+    // Outputs in a folder of their own: a refusal must leave it empty.
+    let outs = dir.path().join("out");
+    std::fs::create_dir(&outs).unwrap();
+    let out = outs.join("o.h5");
+    let out_s = out.to_str().unwrap();
+    // A shard index that overflowed `Shard::units`, and more shards than work units.
+    let huge = "498560650640798693/498560650640798693";
+    assert_refused(
+        &["run", scene_s, "--out", out_s, "--shard", huge],
+        "work units",
+        Some(&out),
+    );
+    assert_refused(
+        &["run", scene_s, "--out", out_s, "--shard", "2/3"],
+        "work units",
+        Some(&out),
+    );
+    // A grid whose step overflows (inf · 0 = NaN passed the monotonic check).
+    let nan = dir.path().join("nan.toml");
+    std::fs::write(&nan, grid("{ start = -1.7e308, stop = 1.7e308, num = 2 }")).unwrap();
+    assert_refused(
+        &["run", nan.to_str().unwrap(), "--out", out_s],
+        "axes.energy",
+        Some(&out),
+    );
+    // Options the chosen start would ignore.
+    let mut cell: Vec<&str> = vec!["cell"];
+    cell.extend(BODY);
+    cell.extend(["--kappa", "1", "--energy", "2.5", "--theta-dot0", "5"]);
+    assert_refused(&cell, "--theta-dot0", None);
+    let t = outs.join("t.csv");
+    let t_s = t.to_str().unwrap();
+    assert_refused(
+        &trajectory_args(&["--component", "1", "--periods", "1", "--out", t_s]),
+        "--component",
+        Some(&t),
+    );
+    let mut fold: Vec<&str> = vec!["resonance"];
+    fold.extend(BODY);
+    fold.extend(["--rotation-number", "0", "--fold", "--out", t_s]);
+    assert_refused(&fold, "--fold", Some(&t));
+    // Messages: -inf as a value, a huge θ̇(0), a missing merge input.
+    let mut inf: Vec<&str> = vec!["cell", "--alpha", "-inf", "--beta", "3", "--nu", "0.5"];
+    inf.extend(["--eta", "0.5", "--kappa", "1", "--energy", "2"]);
+    assert_refused(&inf, "invalid alpha = -inf", None);
+    let mut fast: Vec<&str> = vec!["cell"];
+    fast.extend(BODY);
+    fast.extend(["--kappa", "1", "--theta0", "1", "--theta-dot0", "1e200"]);
+    assert_refused(&fast, "invalid theta-dot0 = 1e200", None);
+    let missing = dir.path().join("missing.h5");
+    assert_refused(
+        &["merge", missing.to_str().unwrap(), "--out", out_s],
+        "does not exist",
+        Some(&out),
+    );
+    // No command: the usage and the commands, exit 2.
+    let o = run(&[]);
+    assert_eq!(o.status.code(), Some(2));
+    let text = String::from_utf8_lossy(&o.stdout).into_owned() + &stderr(&o);
+    assert!(
+        text.contains("Usage:") && text.contains("verdict"),
+        "{text}"
+    );
+    // Threads beyond the cores are capped, not spawned.
+    let o = run(&[
+        "run",
+        scene_s,
+        "--out",
+        out_s,
+        "--threads",
+        "18446744073709551615",
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+/// Issue 13 item 4: merging shard files whose shard attributes are not those of a shard.
+#[test]
+fn merge_refuses_impossible_shard_attributes() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("m.toml");
+    std::fs::write(
+        &scene,
+        "name = \"m\"\n[body]\nnu = 0.5\neta = 0.5\n[axes]\nalpha = [0.5]\nbeta = [0.8, 3.0]\n\
+         kappa = { start = 0.0, stop = 1.0, num = 4 }\nenergy = { start = 1.0, stop = 3.0, num = 4 }\n\
+         [outputs]\nfields = [\"rotation_number\", \"status\"]\n",
+    )
+    .unwrap();
+    let shard = |i: usize| dir.path().join(format!("m{i}.h5"));
+    for i in 1..=2 {
+        let o = run(&[
+            "run",
+            scene.to_str().unwrap(),
+            "--out",
+            shard(i).to_str().unwrap(),
+            "--shard",
+            &format!("{i}/2"),
+            "--quiet",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let outs = dir.path().join("out");
+    std::fs::create_dir(&outs).unwrap();
+    let out = outs.join("merged.h5");
+    for (name, value) in [
+        ("shard_index", 0i64),
+        ("shard_index", 7),
+        ("shard_index", -1),
+        ("shard_count", 0),
+        ("shard_count", 1 << 40),
+    ] {
+        let bad = dir.path().join("bad.h5");
+        std::fs::copy(shard(2), &bad).unwrap();
+        {
+            let f = hdf5::File::open_rw(&bad).unwrap();
+            f.delete_attr(name).unwrap();
+            f.new_attr::<i64>()
+                .create(name)
+                .unwrap()
+                .write_scalar(&value)
+                .unwrap();
+        }
+        assert_refused(
+            &[
+                "merge",
+                shard(1).to_str().unwrap(),
+                bad.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            "bad.h5",
+            Some(&out),
+        );
+    }
+}
+
+/// Issue 13 item 4: output into a closed pipe ends the process without a panic.
+#[test]
+fn a_closed_pipe_ends_a_command_quietly() {
+    use std::process::Stdio;
+    let mut args: Vec<&str> = vec!["cell"];
+    args.extend(BODY);
+    args.extend(["--kappa", "1", "--energy", "2.5", "--json"]);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_rubber-atlas"))
+        .args(&args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take()); // the reader goes away before anything is written
+    let o = child.wait_with_output().unwrap();
+    use std::os::unix::process::ExitStatusExt;
+    let ok = o.status.code() == Some(0) || o.status.signal() == Some(13);
+    assert!(ok, "{:?}: {}", o.status, stderr(&o));
+    assert!(!stderr(&o).contains("panicked"), "{}", stderr(&o));
+}
