@@ -238,7 +238,7 @@ def fig_xy(out: Path) -> Path:
     cases = [(0.8, 0.4670288, 7, "(a) N = −1/7, κ = 0.8"), (1.0, 2.1, 40, "(b) quasi-periodic, κ = 1")]
     with tempfile.TemporaryDirectory() as d:
         for ax, (kappa, theta0, periods, title) in zip(axes, cases):
-            path = Path(d) / "xy.csv"
+            path = Path(d) / f"xy-{kappa}.csv"
             run("trajectory", *body_args(alpha, beta), "--kappa", kappa, "--theta0", theta0, "--periods", periods,
                 "--samples", 200 * periods, "--out", path)
             cols, _ = read_table(path)

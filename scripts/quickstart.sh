@@ -23,12 +23,12 @@ print(ds)
 # The same body (the paper's Figs. php, res and xy): diagram type (c).
 alpha=0.5 beta=3 nu=0.5 eta=0.5
 echo "quickstart: rubber-atlas diagram --alpha $alpha --beta $beta --nu $nu --eta $eta"
-"$bin" diagram --alpha "$alpha" --beta "$beta" --nu "$nu" --eta "$eta" --out atlas/out/paper-c-diagram.h5
+"$bin" diagram --alpha "$alpha" --beta "$beta" --nu "$nu" --eta "$eta" --out atlas/out/paper-c-diagram.h5 --force
 echo "quickstart: trajectory of Fig. xy (kappa = 0.8, theta0 = 0.4670288, 7 periods), reduced and full model"
 for model in reduced full; do
   "$bin" trajectory --alpha "$alpha" --beta "$beta" --nu "$nu" --eta "$eta" --kappa 0.8 \
     --theta0 0.4670288 --periods 7 --samples 7000 --model "$model" \
-    --out "atlas/out/paper-xy-$model.h5"
+    --out "atlas/out/paper-xy-$model.h5" --force
 done
 .venv/bin/python scripts/plot_trajectory.py atlas/out/paper-xy-reduced.h5 --out atlas/out/paper-xy.png
 echo "quickstart: done; see atlas/out/ (demo.h5, demo.png, paper-c-diagram.h5, paper-xy-*.h5, paper-xy.png)"

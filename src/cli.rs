@@ -10,7 +10,7 @@ use rubber_atlas::error::AtlasError;
 use rubber_atlas::resonance::{self, ResonanceOptions};
 use rubber_atlas::scene::Scene;
 use rubber_atlas::store::atlas_file::AttrValue;
-use rubber_atlas::store::{write_table, Column};
+use rubber_atlas::store::{check_output, write_table, Column};
 use rubber_atlas::sweep::{self, RunRequest};
 use rubber_atlas::torus::EffectivePotential;
 use rubber_atlas::trajectory::{integrate, Model, Start};
@@ -142,6 +142,9 @@ pub struct ResonanceArgs {
     /// Write the curves to FILE (.csv, .h5 or .hdf5), one row per point.
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
+    /// Overwrite an existing --out file.
+    #[arg(long)]
+    pub force: bool,
 }
 
 #[derive(Debug, Args)]
@@ -297,6 +300,9 @@ pub struct DiagramArgs {
     /// Write the sampled curves to FILE (.csv, .h5 or .hdf5).
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
+    /// Overwrite an existing --out file.
+    #[arg(long)]
+    pub force: bool,
     /// Samples of θ0 per half (θ0 < π/2, θ0 > π/2) of the fixed-point curves.
     #[arg(long, default_value_t = 2000)]
     pub samples: usize,
@@ -342,6 +348,9 @@ pub struct TrajectoryArgs {
     /// Output file: .csv, .h5 or .hdf5.
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
+    /// Overwrite an existing --out file.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// Runs one parsed command line.
@@ -528,6 +537,9 @@ fn parse_rotation_number(text: &str) -> Result<f64> {
 }
 
 fn resonance(args: ResonanceArgs) -> Result<()> {
+    if let Some(out) = &args.out {
+        check_output(out, args.force, &[], &TABLE_EXTENSIONS)?;
+    }
     if args.fold && args.out.is_some() {
         return Err(AtlasError::Atlas {
             path: "resonance".into(),
@@ -742,6 +754,13 @@ fn run_scene(args: RunArgs) -> Result<()> {
             ))
         }
     });
+    // Before any work: never a directory, device, symlink or the scene itself.
+    check_output(
+        &out,
+        args.force || args.resume,
+        &[&args.scene],
+        &ATLAS_EXTENSIONS,
+    )?;
     if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
         if !parent.is_dir() {
             return Err(AtlasError::Atlas {
@@ -787,6 +806,8 @@ fn run_scene(args: RunArgs) -> Result<()> {
 }
 
 fn merge(args: MergeArgs) -> Result<()> {
+    let inputs: Vec<&std::path::Path> = args.shards.iter().map(|p| p.as_path()).collect();
+    check_output(&args.out, args.force, &inputs, &ATLAS_EXTENSIONS)?;
     let summary = sweep::merge(
         &args.shards,
         &args.out,
@@ -960,7 +981,15 @@ fn positive_finite(name: &'static str, value: f64) -> Result<f64> {
     }
 }
 
+/// Tables (`diagram`, `trajectory`, `resonance`).
+const TABLE_EXTENSIONS: [&str; 3] = ["csv", "h5", "hdf5"];
+/// Atlases (`run`, `merge`).
+const ATLAS_EXTENSIONS: [&str; 2] = ["h5", "hdf5"];
+
 fn diagram(args: DiagramArgs) -> Result<()> {
+    if let Some(out) = &args.out {
+        check_output(out, args.force, &[], &TABLE_EXTENSIONS)?;
+    }
     let body = EllipsoidBody::ellipsoid(args.shape.alpha, args.shape.beta, args.nu, args.eta)?;
     let set = CriticalSet::of(&body, args.samples, args.kappa_max)?;
     if args.json {
@@ -1118,6 +1147,7 @@ fn write_diagram(out: &std::path::Path, set: &CriticalSet) -> Result<()> {
 
 fn trajectory(args: TrajectoryArgs) -> Result<()> {
     check_start(&args.start, args.component)?;
+    check_output(&args.out, args.force, &[], &TABLE_EXTENSIONS)?;
     let body = args.level.body()?;
     if !args.level.kappa.is_finite() {
         return Err(AtlasError::InvalidParameter {

@@ -51,6 +51,73 @@ fn output_error(path: &Path, e: impl std::fmt::Display) -> AtlasError {
     }
 }
 
+/// Checks an output path before any work is done (issue 13): it must name a file (not end in
+/// a separator) with one of `extensions`, in an existing folder; if something is there it
+/// must be a regular file — never a directory, a device, a FIFO or a symlink, even with
+/// `force` — and is replaced only with `force`; and it must not be one of the command's
+/// `inputs`.
+pub fn check_output(path: &Path, force: bool, inputs: &[&Path], extensions: &[&str]) -> Result<()> {
+    let refuse = |reason: String| Err(output_error(path, reason));
+    let text = path.as_os_str().to_string_lossy();
+    if text.is_empty() || text.ends_with(std::path::MAIN_SEPARATOR) {
+        return refuse("is a folder, not a file name".into());
+    }
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_lowercase())
+        .unwrap_or_default();
+    if !extensions.contains(&ext.as_str()) {
+        return refuse(format!(
+            "unknown extension {:?} (expected {})",
+            ext,
+            extensions
+                .iter()
+                .map(|e| format!(".{e}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+    }
+    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        if !parent.is_dir() {
+            return refuse(format!("the folder {} does not exist", parent.display()));
+        }
+    }
+    match std::fs::symlink_metadata(path) {
+        Ok(meta) if !meta.file_type().is_file() => {
+            let kind = if meta.file_type().is_dir() {
+                "a directory"
+            } else if meta.file_type().is_symlink() {
+                "a symbolic link"
+            } else {
+                "not a regular file (a device, FIFO or socket)"
+            };
+            return refuse(format!(
+                "is {kind}; refusing to replace it, even with --force"
+            ));
+        }
+        Ok(_) => {
+            let same = |input: &&&Path| match (
+                std::fs::canonicalize(path),
+                std::fs::canonicalize(input),
+            ) {
+                (Ok(a), Ok(b)) => a == b,
+                _ => false,
+            };
+            if let Some(input) = inputs.iter().find(same) {
+                return refuse(format!(
+                    "is an input of this command ({}); never written over",
+                    input.display()
+                ));
+            }
+            if !force {
+                return refuse("exists; use --force to overwrite it".into());
+            }
+        }
+        Err(_) => {}
+    }
+    Ok(())
+}
+
 /// `path` with `suffix` appended to its file name (`x.h5` → `x.h5<suffix>`), in the same
 /// directory: where an output is written before it is renamed into place.
 pub(crate) fn with_suffix(path: &Path, suffix: &str) -> PathBuf {

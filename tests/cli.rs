@@ -547,3 +547,99 @@ fn a_closed_pipe_ends_a_command_quietly() {
     assert!(ok, "{:?}: {}", o.status, stderr(&o));
     assert!(!stderr(&o).contains("panicked"), "{}", stderr(&o));
 }
+
+/// Issue 13, items 5 and 6: outputs are checked before any work; only a regular file is ever
+/// replaced, and only with --force; an input is never written over; directories, symlinks,
+/// devices, folder paths and unknown extensions are refused.
+#[test]
+fn outputs_are_checked_before_any_work_and_never_replace_what_is_not_a_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let table = d.join("d.csv");
+    let table_s = table.to_str().unwrap();
+    let mut diagram: Vec<&str> = vec!["diagram"];
+    diagram.extend(BODY);
+    diagram.extend(["--out", table_s]);
+    assert!(run(&diagram).status.success());
+    let o = run(&diagram);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--force"), "{}", stderr(&o));
+    let mut forced = diagram.clone();
+    forced.push("--force");
+    assert!(run(&forced).status.success());
+    // A symlink, a directory and a device are never replaced, even with --force.
+    let link = d.join("l.csv");
+    std::os::unix::fs::symlink(&table, &link).unwrap();
+    let folder = d.join("adir.h5");
+    std::fs::create_dir(&folder).unwrap();
+    let mut traj = trajectory_args(&["--periods", "1", "--force", "--out"]);
+    traj.push(link.to_str().unwrap());
+    let o = run(&traj);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("symbolic link"), "{}", stderr(&o));
+    assert!(std::fs::symlink_metadata(&link)
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    let mut dev: Vec<&str> = vec!["resonance"];
+    dev.extend(BODY);
+    dev.extend(["--rotation-number", "0", "--force", "--out", "/dev/null"]);
+    assert_eq!(run(&dev).status.code(), Some(2));
+    assert!(std::fs::metadata("/dev/null")
+        .unwrap()
+        .file_type()
+        .is_char_device_like());
+    // `run` refuses a directory, a folder path, the scene itself and a foreign extension at
+    // once, before computing anything.
+    let scene = d.join("s.toml");
+    std::fs::write(
+        &scene,
+        "name = \"s\"\n[body]\nnu = 0.5\neta = 0.5\n[axes]\nalpha = [0.5]\nbeta = [3.0]\n\
+         kappa = { start = 0.0, stop = 2.0, num = 400 }\nenergy = { start = 0.5, stop = 4.5, num = 400 }\n",
+    )
+    .unwrap();
+    let text = std::fs::read(&scene).unwrap();
+    let scene_s = scene.to_str().unwrap();
+    let folder_slash = format!("{}/o.h5/", d.display());
+    let txt = d.join("o.txt");
+    for (out, needle) in [
+        (folder.to_str().unwrap(), "directory"),
+        (folder_slash.as_str(), "folder"),
+        (scene_s, "extension"),
+        (txt.to_str().unwrap(), "extension"),
+    ] {
+        let started = std::time::Instant::now();
+        let o = run(&["run", scene_s, "--out", out, "--force", "--quiet"]);
+        assert_eq!(o.status.code(), Some(2), "{out}: {}", stderr(&o));
+        assert!(stderr(&o).contains(needle), "{out}: {}", stderr(&o));
+        // 160,000 cells would take about a second: refused long before.
+        assert!(
+            started.elapsed().as_secs_f64() < 0.5,
+            "{out}: not refused at once"
+        );
+    }
+    assert_eq!(std::fs::read(&scene).unwrap(), text);
+    assert!(!txt.exists() && folder.read_dir().unwrap().next().is_none());
+    // merge never writes over one of its shards.
+    let shard = d.join("one.h5");
+    assert!(
+        run(&["run", scene_s, "--out", shard.to_str().unwrap(), "--quiet"])
+            .status
+            .success()
+    );
+    let shard_s = shard.to_str().unwrap();
+    let o = run(&["merge", shard_s, "--out", shard_s, "--force"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("input"), "{}", stderr(&o));
+}
+
+trait CharDevice {
+    fn is_char_device_like(&self) -> bool;
+}
+
+impl CharDevice for std::fs::FileType {
+    fn is_char_device_like(&self) -> bool {
+        use std::os::unix::fs::FileTypeExt;
+        self.is_char_device()
+    }
+}
