@@ -20,13 +20,15 @@ pub const COMPONENT_SLOTS: usize = 3;
 /// Cells per work unit, about: the unit of resume and of sharding.
 const UNIT_CELLS: usize = 4096;
 
-/// A cell's status (`cell_status`): motion, no motion, or the solver failed on it.
+/// A cell's status (`cell_status`): motion, no motion, the solver failed on it, or it was
+/// never computed in this file (a shard's cells of other shards: the file's fill value).
 pub mod cell_status {
     pub const OK: u8 = 0;
     pub const NO_MOTION: u8 = 1;
     pub const FAILED: u8 = 2;
-    pub const VALUES: [u8; 3] = [OK, NO_MOTION, FAILED];
-    pub const MEANINGS: &str = "ok no_motion failed";
+    pub const NOT_COMPUTED: u8 = 3;
+    pub const VALUES: [u8; 4] = [OK, NO_MOTION, FAILED, NOT_COMPUTED];
+    pub const MEANINGS: &str = "ok no_motion failed not_computed";
 }
 
 /// A component's status flag (`status`).

@@ -468,3 +468,55 @@ fn three_shards_merged_equal_a_single_run() {
     assert!(String::from_utf8_lossy(&mixed.stderr).contains("same scene"));
     assert!(!refused.exists());
 }
+
+/// Issue 13 item 2: a shard file opened alone shows the cells it did not compute as
+/// `not_computed` (its own flag value, the file's fill value), never as `ok`.
+#[test]
+fn a_shard_opened_alone_marks_the_cells_it_did_not_compute() {
+    use rubber_atlas::atlas::{cell_status, units, Shard};
+    let dir = tempfile::tempdir().unwrap();
+    let scene = small_scene(dir.path());
+    let shard = dir.path().join("one.h5");
+    ok(&run(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        shard.to_str().unwrap(),
+        "--shard",
+        "1/2",
+        "--quiet",
+    ]));
+    let parsed = rubber_atlas::scene::Scene::from_file(&scene).unwrap();
+    let all = units(parsed.shape());
+    let mine = (Shard { index: 1, count: 2 }).units(all.len());
+    let f = hdf5::File::open(&shard).unwrap();
+    let status = f
+        .dataset("cell_status")
+        .unwrap()
+        .read::<u8, ndarray::Ix4>()
+        .unwrap();
+    let meanings = f
+        .dataset("cell_status")
+        .unwrap()
+        .attr("flag_meanings")
+        .unwrap()
+        .read_scalar::<hdf5::types::VarLenUnicode>()
+        .unwrap();
+    assert!(meanings.as_str().ends_with("not_computed"));
+    let (mut computed, mut not) = (0, 0);
+    for (i, u) in all.iter().enumerate() {
+        for row in u.rows.clone() {
+            for e in 0..parsed.shape()[3] {
+                let s = status[[u.alpha_index, u.beta_index, row, e]];
+                if mine.contains(&i) {
+                    assert!(s <= cell_status::FAILED, "unit {i}: {s}");
+                    computed += 1;
+                } else {
+                    assert_eq!(s, cell_status::NOT_COMPUTED, "unit {i}");
+                    not += 1;
+                }
+            }
+        }
+    }
+    assert!(computed > 0 && not > 0);
+}

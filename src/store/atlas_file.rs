@@ -197,11 +197,18 @@ impl AtlasFile {
                     .shape([na, nb, nk, ne])
                     .create(v.name)?
             } else if per_cell {
+                // Where no unit was written (another shard's cells), `cell_status` reads
+                // `not_computed`, never `ok`; `n_components` reads 0.
+                let fill = if v.name == "cell_status" {
+                    crate::atlas::cell_status::NOT_COMPUTED
+                } else {
+                    0u8
+                };
                 file.new_dataset::<u8>()
                     .chunk([1, 1, rows, ne])
                     .shuffle()
                     .deflate(DEFLATE_LEVEL)
-                    .fill_value(0u8)
+                    .fill_value(fill)
                     .shape([na, nb, nk, ne])
                     .create(v.name)?
             } else if v.kind == Kind::Value {
