@@ -74,17 +74,15 @@ pub struct Fold {
 }
 
 /// The component around the well nearest `well` at (κ, ε), solved.
-fn evaluate<S: Shape>(
+pub(crate) fn evaluate<S: Shape>(
     potential: &EffectivePotential<'_, S>,
     energy: f64,
     well: f64,
     options: &CellOptions,
 ) -> Option<CurvePoint> {
     let minimum = potential
-        .critical_points()
-        .iter()
-        .filter(|p| p.kind == CriticalKind::Minimum)
-        .map(|p| p.site.theta)
+        .minimum_sites()
+        .into_iter()
         .min_by(|a, b| (a - well).abs().total_cmp(&(b - well).abs()))?;
     let components = potential.components(energy).ok()?;
     let (index, component) = components
@@ -152,11 +150,6 @@ pub(crate) fn bracketed_root(
         }
     }
     Some(0.5 * (a + b))
-}
-
-/// The levels of the maxima of V at one κ, sorted: the separatrices.
-fn separatrices<S: Shape>(potential: &EffectivePotential<'_, S>) -> Vec<f64> {
-    potential.separatrix_levels()
 }
 
 /// Where a point lies among the separatrices: the level nearest to it and on which side
@@ -303,7 +296,7 @@ impl<S: Shape> Tracer<'_, S> {
     /// the point's gap between separatrices.
     fn gradient(&self, p: &CurvePoint) -> Option<(f64, f64)> {
         let potential = EffectivePotential::new(self.body, p.kappa);
-        let distance = side_of(&separatrices(&potential), p.energy)
+        let distance = side_of(&potential.separatrix_levels(), p.energy)
             .map_or(f64::INFINITY, |s| (p.energy - s.level).abs());
         let h = (1e-7f64).min(0.01 * distance / self.scale.1).max(1e-15);
         let (hk, he) = (h * self.scale.0, h * self.scale.1);
@@ -333,7 +326,7 @@ impl<S: Shape> Tracer<'_, S> {
         let target = self.options.target;
         let tol = self.tol();
         let side = side_of(
-            &separatrices(&EffectivePotential::new(self.body, from.kappa)),
+            &EffectivePotential::new(self.body, from.kappa).separatrix_levels(),
             from.energy,
         );
         let in_gap = |levels: &[f64], x: f64| {
@@ -345,7 +338,7 @@ impl<S: Shape> Tracer<'_, S> {
                 return None;
             }
             let potential = EffectivePotential::new(self.body, kappa);
-            let (lo, hi) = gap_for(&separatrices(&potential), side);
+            let (lo, hi) = gap_for(&potential.separatrix_levels(), side);
             let (lo, hi) = (lo.max(e.0), hi.min(e.1));
             if lo >= hi {
                 return None;
@@ -364,7 +357,7 @@ impl<S: Shape> Tracer<'_, S> {
             }
             let f = |x: f64| {
                 let potential = EffectivePotential::new(self.body, x);
-                if !in_gap(&separatrices(&potential), energy) {
+                if !in_gap(&potential.separatrix_levels(), energy) {
                     return None;
                 }
                 evaluate(&potential, energy, from.well, &self.options.cell)
@@ -375,7 +368,8 @@ impl<S: Shape> Tracer<'_, S> {
             self.at(root, energy, from.well)?
         };
         let potential = EffectivePotential::new(self.body, point.kappa);
-        (self.on_curve(&point) && in_gap(&separatrices(&potential), point.energy)).then_some(point)
+        (self.on_curve(&point) && in_gap(&potential.separatrix_levels(), point.energy))
+            .then_some(point)
     }
 
     /// The curve through `seed` (on N = p/q), followed both ways until it leaves the window,
@@ -506,7 +500,7 @@ impl<S: Shape> Tracer<'_, S> {
             .into_par_iter()
             .flat_map_iter(|kappa| {
                 let potential = EffectivePotential::new(self.body, kappa);
-                let levels = separatrices(&potential);
+                let levels = potential.separatrix_levels();
                 let wells: Vec<f64> = potential
                     .critical_points()
                     .iter()

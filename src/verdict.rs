@@ -7,8 +7,9 @@
 //! critical set lives), and on each line the energy ε = V_low/(1 − q)², q ∈ [0, 1), with V_low
 //! the bottom of V at that κ, so q = 0 is the bottom of the deepest well (the linearised N)
 //! and q → 1 is ε → ∞ (N ≈ slope·κ/√ε → 0). Beyond the last line N tends to N∞(λ),
-//! λ = κ/√ε = √2 (1 − q) V… (the high-energy limit). Levels just above and below every
-//! separatrix are added, where N → ±∞.
+//! λ = κ/√ε (the high-energy limit, [`crate::limits`]). Levels just above and below every
+//! separatrix are added: there the period grows like −log|ε − V(θ_s)| while ψ advances at
+//! ψ̇(θ_s), so N → ∓∞ (unless ψ̇(θ_s) = 0) and every integer of that sign is crossed.
 //!
 //! On a connected family of tori N is continuous, so an integer k lies on a resonance curve
 //! wherever two neighbouring samples of one family (same well, same gap between separatrix
@@ -471,17 +472,8 @@ fn n_near_well(
     well: f64,
     cell: &CellOptions,
 ) -> Option<f64> {
-    let potential = EffectivePotential::new(body, kappa);
-    let minimum = potential
-        .minimum_sites()
-        .into_iter()
-        .min_by(|a, b| (a - well).abs().total_cmp(&(b - well).abs()))?;
-    let components = potential.components(energy).ok()?;
-    let c = components.iter().find(|c| {
-        c.kind == MotionKind::Libration && c.theta_min() <= minimum && minimum <= c.theta_max()
-    })?;
-    let r = solve_component(&potential, energy, c, cell).ok()?;
-    (r.status != Status::Separatrix && r.rotation_number.is_finite()).then_some(r.rotation_number)
+    resonance::evaluate(&EffectivePotential::new(body, kappa), energy, well, cell)
+        .map(|p| p.rotation_number)
 }
 
 /// Relative error bar of a κ_max that could not be solved from N = 0, ∂N/∂ε = 0.
@@ -756,8 +748,8 @@ pub fn verdict(body: &EllipsoidBody, options: &VerdictOptions) -> Result<Verdict
         limits: [
             "bottom: each line starts at the deepest minimum of V (the linearised N of the stable permanent rotation, limits::bottom_rotation_number)",
             "high energy: each line runs to epsilon = 1e12 V_low, where N = slope kappa / sqrt(epsilon) + O(1/epsilon); beyond the last line, N = N_inf(lambda) + O(1/kappa^2) (limits::HighEnergyLimit)",
-            "kappa -> 0 (case 1): below kappa = 1e-6, N -> +1/2 or -1/2 near one pole and O(kappa) across both (limits::small_kappa_limit)",
-            "separatrices: levels 1e-1 ... 1e-13 (relative) on both sides of every maximum of V, where N -> +-infinity (limits::separatrix_limit_sign)",
+            "kappa -> 0 (case 1): below kappa = 1e-6, N -> +1/2 or -1/2 near one pole and O(kappa) across both (limits::small_kappa_limit, tested against cells)",
+            "separatrices: levels 1e-1 ... 1e-13 (relative) on both sides of every maximum of V, where N -> +-infinity",
         ]
         .into_iter()
         .filter(|l| case == Case::One || !l.starts_with("kappa -> 0"))
