@@ -112,6 +112,12 @@ pub trait Shape: Send + Sync {
         self.potential_prime(a.theta())
     }
 
+    /// U″ at an angle given by its sine and cosine.
+    #[inline]
+    fn potential_second_at(&self, a: Angle) -> f64 {
+        self.potential_second(a.theta())
+    }
+
     /// |r|² at an angle given by its sine and cosine.
     #[inline]
     fn contact_distance_sq_at(&self, a: Angle) -> f64 {
@@ -191,6 +197,22 @@ impl Ellipsoid {
         (self.beta * self.beta * s * s + c * c).sqrt()
     }
 
+    /// (U, w) = (Z + α cosθ, cosθ + αZ) at an angle, with Z = `z`, to full relative precision
+    /// also where they cancel (cosθ < 0 and α → 1, near θ = π): there Z + α cosθ =
+    /// β² sin²θ / (Z + |cosθ|) + (1 − α)|cosθ| and cosθ + αZ = β² sin²θ / (Z + |cosθ|) −
+    /// (1 − α) Z, from Z² − cos²θ = β² sin²θ (1 − α is exact for α ≥ ½).
+    #[inline]
+    pub fn height_and_offset_at(&self, a: Angle, z: f64) -> (f64, f64) {
+        // For α ≤ ½, Z + α cosθ ≥ Z/2 (Z ≥ |cosθ|): no cancellation, and a symmetric
+        // body (α = 0) keeps U(π − θ) = U(θ) exactly.
+        if a.cos >= 0.0 || self.alpha <= 0.5 {
+            return (z + self.alpha * a.cos, a.cos + self.alpha * z);
+        }
+        let lift = self.beta * self.beta * a.sin * a.sin / (z - a.cos);
+        let rest = 1.0 - self.alpha;
+        (lift - rest * a.cos, lift - rest * z)
+    }
+
     /// Z at an angle given by its sine and cosine.
     #[inline]
     pub fn centre_height_at(&self, a: Angle) -> f64 {
@@ -243,7 +265,7 @@ impl Shape for Ellipsoid {
     /// U(θ) = Z(θ) + α cosθ.
     #[inline]
     fn potential(&self, theta: f64) -> f64 {
-        self.centre_height(theta) + self.alpha * theta.cos()
+        self.potential_at(Angle::new(theta))
     }
 
     /// U′(θ) = −α sinθ + (β² − 1) sinθ cosθ / Z.
@@ -256,11 +278,7 @@ impl Shape for Ellipsoid {
     /// U″(θ) = −α cosθ + (β² − 1) [cos 2θ / Z − sinθ cosθ Z′ / Z²].
     #[inline]
     fn potential_second(&self, theta: f64) -> f64 {
-        let (s, c) = theta.sin_cos();
-        let z = self.centre_height(theta);
-        let zp = (self.beta * self.beta - 1.0) * s * c / z;
-        -self.alpha * c
-            + (self.beta * self.beta - 1.0) * ((c * c - s * s) / z - s * c * zp / (z * z))
+        self.potential_second_at(Angle::new(theta))
     }
 
     /// |r|² = (β⁴ sin²θ + (cosθ + αZ)²) / Z² (SPEC §1.2; the paper's `eqsysell` prints
@@ -272,12 +290,22 @@ impl Shape for Ellipsoid {
 
     #[inline]
     fn potential_at(&self, a: Angle) -> f64 {
-        self.centre_height_at(a) + self.alpha * a.cos
+        self.height_and_offset_at(a, self.centre_height_at(a)).0
     }
 
     #[inline]
     fn potential_prime_at(&self, a: Angle) -> f64 {
         a.sin * ((self.beta * self.beta - 1.0) * a.cos / self.centre_height_at(a) - self.alpha)
+    }
+
+    /// U″ = −α cosθ + (β² − 1) [(cos²θ − sin²θ) / Z − sinθ cosθ Z′ / Z²].
+    #[inline]
+    fn potential_second_at(&self, a: Angle) -> f64 {
+        let z = self.centre_height_at(a);
+        let b = self.beta * self.beta - 1.0;
+        let zp = b * a.sin * a.cos / z;
+        -self.alpha * a.cos
+            + b * ((a.cos * a.cos - a.sin * a.sin) / z - a.sin * a.cos * zp / (z * z))
     }
 
     /// Z varies on the scale β near the equator of a prolate ellipsoid and 1/β near the
@@ -294,10 +322,7 @@ impl Shape for Ellipsoid {
 
     #[inline]
     fn contact_distance_sq_at(&self, a: Angle) -> f64 {
-        let z = self.centre_height_at(a);
-        let b2 = self.beta * self.beta;
-        let w = a.cos + self.alpha * z;
-        (b2 * b2 * a.sin * a.sin + w * w) / (z * z)
+        self.potential_and_contact_distance_sq_at(a).1
     }
 
     /// (U(x) − U(y)) / sin(x − y) without cancellation, from Z(x)² − Z(y)² = (β² − 1)
@@ -322,11 +347,8 @@ impl Shape for Ellipsoid {
     fn potential_and_contact_distance_sq_at(&self, a: Angle) -> (f64, f64) {
         let z = self.centre_height_at(a);
         let b2 = self.beta * self.beta;
-        let w = a.cos + self.alpha * z;
-        (
-            z + self.alpha * a.cos,
-            (b2 * b2 * a.sin * a.sin + w * w) / (z * z),
-        )
+        let (u, w) = self.height_and_offset_at(a, z);
+        (u, (b2 * b2 * a.sin * a.sin + w * w) / (z * z))
     }
 }
 

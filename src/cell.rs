@@ -275,12 +275,173 @@ pub fn solve_component<S: Shape>(
     if let Some(saddle) = separatrix(component, energy) {
         return Ok(on_separatrix(potential, component, &saddle, options));
     }
-    let tol = options.tol;
-    let raw = match options.method {
-        Method::Quadrature => potential.integrate(energy, component, tol, options.drift)?,
-        Method::Ode => period_ode::integrate(potential, energy, component, tol, options.drift)?,
-    };
+    let mut raw = integrate(potential, energy, component, options)?;
+    let offset = level_offset_error(potential, energy, component, &raw, options);
+    raw.period_error += offset.period;
+    raw.psi_advance_error += offset.psi_advance;
+    if let Some(d) = raw.drift.as_mut() {
+        d.error += offset.drift;
+    }
     Ok(finish(component, raw, options))
+}
+
+/// T, Δψ and Δζ of a libration or rotation by the chosen method.
+fn integrate<S: Shape>(
+    potential: &EffectivePotential<'_, S>,
+    energy: f64,
+    component: &Component,
+    options: &CellOptions,
+) -> Result<PeriodIntegrals> {
+    let tol = options.tol;
+    match options.method {
+        Method::Quadrature => potential.integrate(energy, component, tol, options.drift),
+        Method::Ode => period_ode::integrate(potential, energy, component, tol, options.drift),
+    }
+}
+
+/// Errors of T, Δψ and |Δζ| caused by an offset of the energy the integrals are taken at.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct EnergyErrors {
+    period: f64,
+    psi_advance: f64,
+    drift: f64,
+}
+
+/// The error of a libration's integrals from the level of its turning points: they are the
+/// roots of V − ε measured from a critical point c inside, ε − V(c) − (V(θ) − V(c)), whose
+/// constant term carries the rounding of V(c) (a few ulps of its L1 size, whatever the gap)
+/// and whose roots are rounded to a double; the integrals are then exact for an energy
+/// within δε of ε. The error is |dX/dε| δε for X = T, Δψ, Δζ. The crude bound
+/// |dX/dε| ≤ 2 ‖X‖ / (ε − V_min) (T ∝ (ε − V_min)^p with |p| ≤ ½ at a flat bottom, 0 at a
+/// harmonic one; saddles are bounded separately) is used when it is far below the
+/// tolerance; otherwise, and near a pole at small κ, where the turning point is where ε and
+/// U nearly cancel and X varies on the scale of κ, the slope is measured by differences at
+/// ε ± h, h = 256 δε.
+fn level_offset_error<S: Shape>(
+    potential: &EffectivePotential<'_, S>,
+    energy: f64,
+    component: &Component,
+    raw: &PeriodIntegrals,
+    options: &CellOptions,
+) -> EnergyErrors {
+    if component.kind != MotionKind::Libration {
+        return EnergyErrors::default();
+    }
+    let Some(bottom) = component.minimum().copied() else {
+        return EnergyErrors::default();
+    };
+    let eps = f64::EPSILON;
+    let scale = component
+        .interior
+        .iter()
+        .map(|p| potential.value_scale(p.site.angle()))
+        .fold(0.0, f64::max);
+    // The rounding of ε − V(c) and of each turning point (one ulp of θ in its chart).
+    let ends = [component.lower, component.upper];
+    let chart = |site: &crate::torus::Site| site.theta.min(site.from_pi).abs();
+    let delta = 4.0 * eps * (scale + energy.abs())
+        + ends
+            .iter()
+            .map(|e| 2.0 * eps * chart(e) * potential.slope(e.angle()).abs())
+            .sum::<f64>();
+    let depth = (energy - bottom.value).max(delta);
+    // ∫|ψ̇| dt, bounded by T max|ψ̇| over the bottom and the ends away from the poles (at an
+    // end near a pole ψ̇ peaks in a sliver of time whose share the relative bounds cover).
+    let far_from_pole = |site: &&crate::torus::Site| chart(site) > 0.1;
+    let psi_scale = raw.psi_advance.abs()
+        + 2.0
+            * raw.period
+            * ends
+                .iter()
+                .chain(std::iter::once(&bottom.site))
+                .filter(far_from_pole)
+                .map(|e| potential.psi_rate(e.angle()).abs())
+                .fold(0.0, f64::max);
+    let drift_scale = raw.drift.map_or(0.0, |d| d.scale);
+    // Each turning point is a double, up to an ulp off (in its chart): besides the energy
+    // they shift the orbit, which moves Δψ by δθ ∫ |dψ̇/dθ| dt (large against Δψ itself where
+    // ψ̇ changes sign inside, as round θ = π/2).
+    let psi_shift = 2.0
+        * eps
+        * raw.period
+        * ends
+            .iter()
+            .chain(std::iter::once(&bottom.site))
+            .filter(far_from_pole)
+            .map(|e| chart(e) * potential.psi_rate_slope(e.angle()).abs())
+            .fold(0.0, f64::max);
+    let crude = EnergyErrors {
+        period: 2.0 * delta / depth * raw.period,
+        psi_advance: 2.0 * delta / depth * psi_scale + psi_shift,
+        drift: 2.0 * delta / depth * drift_scale,
+    };
+    let k2 = potential.kappa * potential.kappa;
+    let near_pole = k2 > 0.0
+        && ends.iter().any(|e| {
+            let a = e.angle();
+            chart(e) < 0.1 && 0.5 * k2 / (a.sin * a.sin) < 1e-3 * potential.value_scale(a)
+        });
+    let small = |error: f64, allowed: f64| error <= 0.05 * options.tol * allowed;
+    if !near_pole
+        && small(crude.period, raw.period)
+        && small(crude.psi_advance, TAU)
+        && small(crude.drift, drift_scale)
+    {
+        return crude;
+    }
+    // The step stays well inside the family: below a quarter of the depth and of the
+    // distance to every saddle at or next to the component.
+    let saddles = component
+        .interior
+        .iter()
+        .chain(component.neighbours.iter().flatten())
+        .filter(|p| p.kind != CriticalKind::Minimum)
+        .map(|p| (energy - p.value).abs())
+        .fold(f64::INFINITY, f64::min);
+    let h = (256.0 * delta).min(0.25 * depth).min(0.25 * saddles);
+    if h < 16.0 * delta {
+        return crude;
+    }
+    let at = |e: f64| -> Option<PeriodIntegrals> {
+        integrate(
+            potential,
+            e,
+            &libration_around(potential, e, &bottom)?,
+            options,
+        )
+        .ok()
+    };
+    let (Some(up), Some(down)) = (at(energy + h), at(energy - h)) else {
+        return crude;
+    };
+    // |dX/dε| from the larger one-sided difference, twice over, plus the differences'
+    // own errors.
+    let slope = |x: f64, x_up: f64, x_down: f64, errors: f64| {
+        2.0 * (x_up - x).abs().max((x - x_down).abs()) / h * delta + errors * delta / h
+    };
+    let drift = match (raw.drift, up.drift, down.drift) {
+        (Some(d), Some(u), Some(w)) => {
+            let dist = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+            2.0 * dist(u.value, d.value).max(dist(d.value, w.value)) / h * delta
+                + (u.error + d.error + w.error) * delta / h
+        }
+        _ => 0.0,
+    };
+    EnergyErrors {
+        period: slope(
+            raw.period,
+            up.period,
+            down.period,
+            up.period_error + raw.period_error + down.period_error,
+        ),
+        psi_advance: slope(
+            raw.psi_advance,
+            up.psi_advance,
+            down.psi_advance,
+            up.psi_advance_error + raw.psi_advance_error + down.psi_advance_error,
+        ) + psi_shift,
+        drift,
+    }
 }
 
 fn finish(component: &Component, raw: PeriodIntegrals, options: &CellOptions) -> ComponentResult {
@@ -365,7 +526,7 @@ fn separatrix(component: &Component, energy: f64) -> Option<CriticalPoint> {
         .chain(component.neighbours.iter().flatten())
         .find(|p| {
             p.kind != CriticalKind::Minimum
-                && (energy - p.value).abs() <= 4.0 * f64::EPSILON * p.value.abs().max(1.0)
+                && (energy - p.value).abs() <= 4.0 * f64::EPSILON * p.scale
         })
         .copied()
 }
@@ -442,7 +603,7 @@ fn fixed_point<S: Shape>(
         (2.0 * rho * (0.5 * psi_advance).sin().abs(), rho)
     };
     let rel = 16.0 * f64::EPSILON;
-    ComponentResult {
+    let mut result = ComponentResult {
         theta_min: component.theta_min(),
         theta_max: component.theta_max(),
         period,
@@ -466,5 +627,80 @@ fn fixed_point<S: Shape>(
         },
         drift_vector: [f64::NAN; 2],
         work: 0,
+    };
+    add_window_error(potential, &m, options, &mut result);
+    result
+}
+
+/// The libration at `energy` round the minimum `bottom`, if there is one.
+fn libration_around<S: Shape>(
+    potential: &EffectivePotential<'_, S>,
+    energy: f64,
+    bottom: &CriticalPoint,
+) -> Option<Component> {
+    potential.components(energy).ok()?.into_iter().find(|c| {
+        c.kind == MotionKind::Libration
+            && c.lower.theta < bottom.site.theta
+            && bottom.site.theta < c.upper.theta
+    })
+}
+
+/// The fixed-point window: ε within a few ulps of V(θ0) is taken as V(θ0), though the true
+/// orbit there is a libration up to w = 8 eps ‖V(θ0)‖ above the bottom, whose values differ
+/// from the linearised ones by about w dX/dε (large against N where ψ̇ changes sign at θ0,
+/// as near θ = π/2). The slope is measured on the libration at e₁ = 2²⁰ w above the bottom
+/// (or a quarter of the way to the nearest saddle), and 2 w |X(e₁) − X₀| / e₁ plus the
+/// share of X(e₁)'s own error is added to every error estimate.
+fn add_window_error<S: Shape>(
+    potential: &EffectivePotential<'_, S>,
+    bottom: &CriticalPoint,
+    options: &CellOptions,
+    result: &mut ComponentResult,
+) {
+    let window = 8.0 * f64::EPSILON * bottom.scale;
+    let saddle = potential
+        .critical_points()
+        .iter()
+        .filter(|p| p.kind != CriticalKind::Minimum && p.value > bottom.value)
+        .map(|p| p.value - bottom.value)
+        .fold(f64::INFINITY, f64::min);
+    let rise = (window * (1u64 << 20) as f64).min(0.25 * saddle);
+    let neighbour = (rise > window)
+        .then(|| {
+            let energy = bottom.value + rise;
+            let c = libration_around(potential, energy, bottom)?;
+            solve_component(potential, energy, &c, options).ok()
+        })
+        .flatten();
+    let Some(far) = neighbour else {
+        // No room for a libration: the values hold only to the rounding of the level.
+        result.status = Status::ToleranceNotReached;
+        return;
+    };
+    let share = window / rise;
+    let add = |x0: f64, x1: f64, e1: f64| {
+        if x0.is_finite() && x1.is_finite() {
+            2.0 * share * (x1 - x0).abs() + share * e1
+        } else {
+            0.0
+        }
+    };
+    let e = &mut result.errors;
+    e.period += add(result.period, far.period, far.errors.period);
+    e.omega_theta += add(result.omega_theta, far.omega_theta, far.errors.omega_theta);
+    e.omega_psi += add(result.omega_psi, far.omega_psi, far.errors.omega_psi);
+    e.rotation_number += add(
+        result.rotation_number,
+        far.rotation_number,
+        far.errors.rotation_number,
+    );
+    if options.drift {
+        e.drift += add(result.drift, far.drift, far.errors.drift);
+        e.drift_radius += add(
+            result.drift_radius,
+            far.drift_radius,
+            far.errors.drift_radius,
+        );
     }
+    result.error_estimate = e.rotation_number;
 }

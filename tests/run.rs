@@ -248,11 +248,15 @@ fn atlas_values_equal_the_cell_command() {
         let components = json["components"].as_array().unwrap();
         assert_eq!(components.len(), count[cell] as usize);
         for (slot, c) in components.iter().enumerate() {
+            // The scene asks for no drift and `cell` computes it: the drift's convergence may
+            // take the quadrature a level further, so N agrees within its estimate (equal bits
+            // are not promised).
             let expected = c["rotation_number"].as_f64().unwrap();
-            assert_eq!(
-                n[cell * 3 + slot].to_bits(),
-                expected.to_bits(),
-                "cell {cell}"
+            let estimate = c["errors"]["rotation_number"].as_f64().unwrap();
+            assert!(
+                (n[cell * 3 + slot] - expected).abs() <= estimate,
+                "cell {cell}: {} against {expected} ± {estimate}",
+                n[cell * 3 + slot]
             );
             checked += 1;
         }

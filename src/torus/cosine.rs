@@ -265,12 +265,15 @@ impl Map {
         piece: &Piece,
     ) -> impl Iterator<Item = Map> {
         let pole_distance = piece.left.site.theta.min(piece.right.site.from_pi);
-        let plain = Map::Plain {
+        let near_pole = v.kappa != 0.0 && pole_distance < piece.length;
+        // Far below the plain map's first node (a ψ̇ peak as narrow as the distance to the
+        // pole, which the plain sums would step over and look converged): Mercator's only.
+        let unresolved = pole_distance < 1e-6 * piece.length;
+        let plain = (!(near_pole && unresolved)).then_some(Map::Plain {
             length: piece.length,
-        };
-        let mercator =
-            (v.kappa != 0.0 && pole_distance < piece.length).then(|| Map::mercator(piece));
-        std::iter::once(plain).chain(mercator)
+        });
+        let mercator = near_pole.then(|| Map::mercator(piece));
+        plain.into_iter().chain(mercator)
     }
 
     fn mercator(piece: &Piece) -> Self {
@@ -365,10 +368,9 @@ fn end_sample<S: Shape>(
     let tilt = piece.tilt / piece.length;
     let slope = v.slope(a);
     let g = if left { tilt - slope } else { slope - tilt };
-    let k2 = v.kappa * v.kappa;
-    let terms = k2 * (a.cos / (a.sin * a.sin * a.sin)).abs()
-        + v.body.shape.potential_prime_at(a).abs()
-        + tilt.abs();
+    let w = v.kappa / a.sin;
+    let terms =
+        w * w * (a.cos / a.sin).abs() + v.body.shape.potential_prime_at(a).abs() + tilt.abs();
     let g_error = 8.0 * EPS * terms;
     if g.is_nan() || g <= 1e3 * g_error {
         return None;

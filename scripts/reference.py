@@ -1,0 +1,322 @@
+"""An independent high-precision reference for one cell of rubber-atlas: every component of
+{V ≤ ε}, its turning points, T and N = −Δψ/2π, by mpmath at 50 significant digits.
+
+It shares no code with the Rust solver, only the formulas of SPEC §1.2–1.3. Points near a pole
+are held in the pole's chart (θ or π − θ), so that turning points at 1e-100 from a pole keep
+their digits; the critical points of V are the roots of g = sin³θ V′, found by a scan that is
+uniform in the middle and logarithmic towards both poles, where g′ and g are both scanned so
+that a pair of close roots between two scan points is not missed; T and Δψ are tanh-sinh
+quadratures (mpmath.quad) split at every critical point and at π/2, each with its own error
+estimate, which must be far below the solver's.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mpmath
+
+DIGITS = 50
+# Digits the quadrature rule is run to (its integrand is evaluated at DIGITS).
+QUAD_DIGITS = 24
+
+
+@dataclass(frozen=True)
+class Point:
+    """θ held in the chart of its nearer pole: θ = x (side 0) or θ = π − x (side 1)."""
+
+    x: mpmath.mpf
+    side: int
+
+    @property
+    def theta(self):
+        return self.x if self.side == 0 else mpmath.pi - self.x
+
+    def sin_cos(self):
+        s, c = mpmath.sin(self.x), mpmath.cos(self.x)
+        return (s, c) if self.side == 0 else (s, -c)
+
+
+def at(theta) -> Point:
+    theta = mpmath.mpf(theta)
+    return Point(theta, 0) if theta <= mpmath.pi / 2 else Point(mpmath.pi - theta, 1)
+
+
+@dataclass
+class Component:
+    """[θ_min, θ_max] (on the κ = 0 circle θ_min may be negative), its kind, and T, N with the
+    quadrature's own error estimates."""
+
+    theta_min: float
+    theta_max: float
+    kind: str
+    period: float
+    rotation_number: float
+    period_error: float
+    rotation_error: float
+
+
+class Cell:
+    """V(θ) = κ²/(2 sin²θ) + Z(θ) + α cosθ of one (body, κ), at `digits` digits."""
+
+    def __init__(self, alpha, beta, nu, eta, kappa, digits: int = DIGITS):
+        self.digits = digits
+        with mpmath.workdps(digits):
+            self.alpha, self.beta, self.nu, self.eta, self.kappa = map(mpmath.mpf, (alpha, beta, nu, eta, kappa))
+
+    # Shape functions of SPEC §1.2 at (sin θ, cos θ).
+    def _z(self, s, c):
+        return mpmath.sqrt(self.beta**2 * s * s + c * c)
+
+    def potential(self, p: Point):
+        s, c = p.sin_cos()
+        u = self._z(s, c) + self.alpha * c
+        return u if self.kappa == 0 else self.kappa**2 / (2 * s * s) + u
+
+    def g(self, p: Point):
+        """sin³θ V′(θ) = −κ² cosθ + sin³θ U′(θ): no pole."""
+        s, c = p.sin_cos()
+        u_prime = -self.alpha * s + (self.beta**2 - 1) * s * c / self._z(s, c)
+        return -self.kappa**2 * c + s**3 * u_prime
+
+    def inertia(self, s, c):
+        z = self._z(s, c)
+        return 1 / self.eta + (self.beta**4 * s * s + (c + self.alpha * z) ** 2) / (z * z)
+
+    def integral_factor(self, s, c):
+        z = self._z(s, c)
+        return mpmath.sqrt((c * c + self.nu * s * s) / self.eta + (z + self.alpha * c) ** 2)
+
+    # Critical points.
+    def _scan(self):
+        """Scan points in (0, π) as chart points: log-spaced towards both poles, uniform between."""
+        tiny = mpmath.mpf(10) ** (-min(self.digits * 2, 300))
+        if self.kappa != 0:
+            # The critical point nearest a pole sits at θ³ ≈ κ²/|U″|: reach far below it.
+            tiny = min(tiny, abs(self.kappa) ** mpmath.mpf(2) / 10**6)
+        logs = [tiny * (mpmath.mpf(0.1) / tiny) ** (mpmath.mpf(i) / 400) for i in range(400)]
+        middle = [mpmath.mpf(0.1) + (mpmath.pi / 2 - mpmath.mpf(0.1)) * i / 1500 for i in range(1501)]
+        left = [Point(x, 0) for x in logs + middle]
+        right = [Point(x, 1) for x in reversed(logs + middle[:-1])]
+        return left + right
+
+    def critical_points(self) -> list[Point]:
+        """Roots of g in (0, π), sorted by θ (κ ≠ 0), or of U′ on (0, π) plus 0 and π (κ = 0)."""
+        with mpmath.workdps(self.digits):
+            grid = self._scan()
+            values = [self.g(p) for p in grid]
+            roots = []
+            if all(v == 0 for v in values):
+                # A flat U at κ = 0 (the homogeneous sphere): no isolated critical points.
+                grid, values = [], []
+            for i in range(len(grid) - 1):
+                a, b, fa, fb = grid[i], grid[i + 1], values[i], values[i + 1]
+                if fa == 0:
+                    roots.append(a)
+                elif fa * fb < 0:
+                    roots.append(self._bisect_points(self.g, a, b))
+                elif 0 < i and fa * values[i - 1] > 0 and abs(fa) < abs(values[i - 1]) and abs(fa) <= abs(fb):
+                    # |g| has a local minimum near a: a pair of roots may hide there.
+                    roots.extend(self._hidden_pair(grid[i - 1], b))
+            roots = sorted(set(roots), key=lambda p: p.theta)
+            if self.kappa == 0:
+                eps = mpmath.mpf(10) ** (-self.digits // 2)
+                roots = [Point(mpmath.mpf(0), 0)] + [r for r in roots if r.x > eps] + [Point(mpmath.mpf(0), 1)]
+            return roots
+
+    def _hidden_pair(self, a: Point, b: Point):
+        """Roots of g between a and b when g keeps its sign at both: minimise |g| by golden
+        section; if g changes sign at the minimiser, bisect both sides."""
+        if a.side != b.side:
+            return []
+        f = lambda x: abs(self.g(Point(x, a.side)))  # noqa: E731
+        lo, hi = min(a.x, b.x), max(a.x, b.x)
+        ratio = (mpmath.sqrt(5) - 1) / 2
+        for _ in range(200):
+            m1, m2 = hi - ratio * (hi - lo), lo + ratio * (hi - lo)
+            if f(m1) < f(m2):
+                hi = m2
+            else:
+                lo = m1
+        m = Point((lo + hi) / 2, a.side)
+        gm, ga = self.g(m), self.g(a)
+        if gm == 0 or gm * ga > 0:
+            return [m] if gm == 0 else []
+        return [self._bisect_points(self.g, a, m), self._bisect_points(self.g, m, b)]
+
+    def _bisect_points(self, f, a: Point, b: Point) -> Point:
+        """A sign change of f between chart points a and b (same side or across π/2)."""
+        if a.side != b.side:
+            mid = Point(mpmath.pi / 2, 0)
+            fm = f(mid)
+            if fm == 0:
+                return mid
+            return self._bisect_points(f, a, mid) if f(a) * fm < 0 else self._bisect_points(f, Point(mpmath.pi / 2, 1), b)
+        side = a.side
+        lo, hi = a.x, b.x
+        flo, fhi = f(a), f(b)
+        if (flo > 0) == (fhi > 0):
+            # No sign change left (the root sits at an end to the working precision, as at
+            # θ = π/2 seen from both charts).
+            return a if abs(flo) <= abs(fhi) else b
+        eps = mpmath.mpf(2) ** (-mpmath.mp.prec + 2)
+        while abs(hi - lo) > eps * max(abs(lo), abs(hi)):
+            mid = (lo + hi) / 2
+            fm = f(Point(mid, side))
+            if fm == 0:
+                return Point(mid, side)
+            if (fm > 0) == (flo > 0):
+                lo, flo = mid, fm
+            else:
+                hi = mid
+        return Point((lo + hi) / 2, side)
+
+    # Components and integrals.
+    def components(self, energy, quad_digits: int | None = None) -> list[Component]:
+        """Every component of {V ≤ ε} with T and N (an empty list: no motion)."""
+        with mpmath.workdps(self.digits):
+            e = mpmath.mpf(energy)
+            crit = self.critical_points()
+            if self.kappa == 0:
+                return self._circle(e, crit)
+            nodes = [None] + crit + [None]
+            level = lambda p: self.potential(p) - e  # noqa: E731
+            inside = [n is not None and level(n) <= 0 for n in nodes]
+            ends: list[Point] = []
+            for i in range(len(nodes) - 1):
+                if inside[i] == inside[i + 1]:
+                    continue
+                a = nodes[i] if nodes[i] is not None else Point(mpmath.mpf(0), 0)
+                b = nodes[i + 1] if nodes[i + 1] is not None else Point(mpmath.mpf(0), 1)
+                # A pole is +∞: start the bisection just inside it, where V > ε surely.
+                if nodes[i] is None:
+                    a = self._inside_pole(0, e, crit[0].x if crit and crit[0].side == 0 else None)
+                if nodes[i + 1] is None:
+                    b = self._inside_pole(1, e, crit[-1].x if crit and crit[-1].side == 1 else None)
+                ends.append(self._bisect_points(level, a, b))
+            result = []
+            for lo, hi in zip(ends[0::2], ends[1::2]):
+                interior = [c for c in crit if lo.theta < c.theta < hi.theta]
+                period, advance, et, ea = self._integrate(e, lo, hi, interior)
+                result.append(
+                    Component(float(lo.theta), float(hi.theta), "libration", float(period),
+                              float(-advance / (2 * mpmath.pi)), float(et), float(ea / (2 * mpmath.pi)))
+                )
+            return result
+
+    def _inside_pole(self, side: int, e, nearest=None) -> Point:
+        """A point between the pole and its nearest critical point where V > ε (κ ≠ 0)."""
+        x = mpmath.mpf("1e-3") if nearest is None else min(mpmath.mpf("1e-3"), nearest / 2)
+        while self.potential(Point(x, side)) <= e:
+            x /= 10
+        return Point(x, side)
+
+    def _circle(self, e, crit) -> list[Component]:
+        """κ = 0: U on the circle, symmetric in θ → −θ; critical points 0, roots, π."""
+        values = [self.potential(c) for c in crit]
+        top = max(values)
+        if e > top:
+            # Rolling over the top: T = 2 ∫₀^π (both halves of the circle).
+            period, _, et, _ = self._integrate(e, Point(mpmath.mpf(0), 0), Point(mpmath.mpf(0), 1), crit[1:-1], ends=False)
+            peak = crit[values.index(top)].theta
+            return [Component(float(peak), float(peak + 2 * mpmath.pi), "rotation", float(period / 2 * 2), 0.0, float(et), 0.0)]
+        if e < min(values):
+            return []
+        level = lambda p: self.potential(p) - e  # noqa: E731
+        # Turning points on [0, π] (θ ≥ 0); the components around 0 and π are mirrored.
+        ends = []
+        for a, b, va, vb in zip(crit, crit[1:], values, values[1:]):
+            if (va <= e) != (vb <= e):
+                ends.append(self._bisect_points(level, a, b))
+        result = []
+        marks = ([crit[0]] if values[0] <= e else []) + ends + ([crit[-1]] if values[-1] <= e else [])
+        for lo, hi in zip(marks[0::2], marks[1::2]):
+            interior = [c for c in crit if lo.theta < c.theta < hi.theta]
+            at_zero, at_pi = lo.theta == 0, hi.theta == mpmath.pi
+            period, _, et, _ = self._integrate(e, lo, hi, interior, ends=False)
+            # Half of a libration: ×2 (integral out and back); around a pole ×2 again.
+            factor = 2 * (2 if at_zero or at_pi else 1)
+            t_min = -hi.theta if at_zero else lo.theta
+            t_max = 2 * mpmath.pi - lo.theta if at_pi else hi.theta
+            comp = Component(float(t_min), float(t_max), "libration", float(period / 2 * factor), 0.0,
+                             float(et / 2 * factor), 0.0)
+            result.append(comp)
+            if not (at_zero or at_pi):
+                # The mirror image θ → 2π − θ is a component of its own on the circle.
+                result.append(Component(float(2 * mpmath.pi - hi.theta), float(2 * mpmath.pi - lo.theta), "libration",
+                                        comp.period, 0.0, comp.period_error, 0.0))
+        return result
+
+    def _integrate(self, e, lo: Point, hi: Point, interior, ends: bool = True):
+        """(T, Δψ, error T, error Δψ) of a libration between turning points lo < hi: twice the
+        integrals over [θ_min, θ_max], split at interior critical points and π/2."""
+        cuts = [lo] + list(interior) + [hi]
+        half = Point(mpmath.pi / 2, 0)
+        if lo.theta < mpmath.pi / 2 < hi.theta and all(abs(c.theta - mpmath.pi / 2) > 1e-20 for c in cuts):
+            cuts = sorted(cuts + [half], key=lambda p: p.theta)
+        period, advance, et, ea = mpmath.mpf(0), mpmath.mpf(0), mpmath.mpf(0), mpmath.mpf(0)
+        for a, b in zip(cuts, cuts[1:]):
+            if a.theta == b.theta:
+                continue
+            side = 0 if b.theta <= mpmath.pi / 2 else 1
+            xa = a.x if a.side == side else mpmath.pi - a.x
+            xb = b.x if b.side == side else mpmath.pi - b.x
+
+            lo_x, hi_x = min(xa, xb), max(xa, xb)
+            width = hi_x - lo_x
+
+            def rates(u, side=side, start=lo_x, step=width):
+                # dt/dθ + i ψ̇ dt/dθ at θ = start + step·u, evaluated at the full precision (the
+                # nodes u near 0 keep their distance to the turning point exactly).
+                with mpmath.workdps(self.digits):
+                    p = Point(start + step * u, side)
+                    gap = e - self.potential(p)
+                    if gap <= 0:
+                        return mpmath.mpc(0)
+                    s, c = p.sin_cos()
+                    dt = mpmath.sqrt(self.inertia(s, c) / (2 * gap))
+                    psi = -self.kappa * c / (self.integral_factor(s, c) * s * s) if self.kappa != 0 else 0
+                    return mpmath.mpc(dt, psi * dt) * abs(step)
+
+            # Each half measured from its own end, where the singularity sits; the rule itself
+            # runs at QUAD_DIGITS (its error estimate must reach 1e-30, not 1e-50).
+            value, err = mpmath.mpc(0), mpmath.mpf(0)
+            for start, step in ((lo_x, width), (hi_x, -width)):
+                with mpmath.workdps(QUAD_DIGITS):
+                    # u = w² removes the 1/√u of a turning point (mpmath's nodes near an end lose
+                    # digits to 1 + x, so the singularity must not sit there).
+                    v, er = mpmath.quad(lambda w: 2 * w * rates(w * w, start=start, step=step),
+                                        _splits(start / width if self.kappa != 0 else 1), error=True, maxdegree=10)
+                value += v
+                err += er
+            t, a_, t_err, a_err = value.real, value.imag, err, err
+            period += t
+            advance += a_
+            et += t_err
+            ea += a_err
+        return 2 * period, 2 * advance, 2 * et, 2 * ea
+
+
+def _splits(distance):
+    """Points in w = √u for one half-piece whose end lies `distance` (in units of the piece's
+    width) from the pole: ψ̇ ~ κ/θ² and the turning point's curvature vary on that scale, which
+    mpmath's nodes cannot resolve near an end, so the half is cut geometrically down to it."""
+    top = mpmath.sqrt(mpmath.mpf(0.5))
+    if distance >= mpmath.mpf("1e-3") or distance <= 0:
+        return [0, top]
+    points = [top]
+    while points[-1] ** 2 > distance / 10:
+        points.append(points[-1] / 4)
+    return [0] + points[::-1]
+
+
+def reference(alpha, beta, nu, eta, kappa, energy, digits: int = DIGITS) -> list[Component]:
+    """The components of the cell (α, β, ν, η, κ, ε) with T and N at `digits` digits."""
+    return Cell(alpha, beta, nu, eta, kappa, digits).components(energy)
+
+
+def critical_levels(alpha, beta, nu, eta, kappa, digits: int = DIGITS) -> list[tuple[float, float]]:
+    """(θ, V) of every critical point of V, as floats."""
+    cell = Cell(alpha, beta, nu, eta, kappa, digits)
+    with mpmath.workdps(digits):
+        return [(float(p.theta), float(cell.potential(p))) for p in cell.critical_points()]

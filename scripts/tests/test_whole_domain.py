@@ -1,0 +1,61 @@
+"""`rubber-atlas cell` over the whole parameter domain against the independent 50-digit
+reference of scripts/reference.py (issue 12): seeded random cells and every reproduction of the
+issue. No value with status ok may be off its reference by more than its error estimate; every
+other status must still carry an estimate that covers the error (or say the values are
+undefined, as on a separatrix); and the components must be the reference's wherever ε is not
+within rounding of a critical level."""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "scripts"))
+
+import whole_domain  # noqa: E402
+from reference import Cell, reference  # noqa: E402
+
+CELLS = int(os.environ.get("WHOLE_DOMAIN_CELLS", "120"))
+
+
+def test_reference_is_exact_on_closed_forms():
+    """The reference against formulas it does not use: the sphere at κ = 0 rolls uniformly,
+    T = 2π √(B/(2(ε − 1))) (B constant), and a small libration has T → 2π √(B/V″)."""
+    eta = 0.7
+    b = 1 / eta + 1.0  # β = 1, α = 0: |r|² = 1
+    comps = reference(0.0, 1.0, 0.5, eta, 0.0, 1.5)
+    assert len(comps) == 1 and comps[0].kind == "rotation"
+    assert comps[0].period == pytest.approx(2 * math.pi * math.sqrt(b / (2 * 0.5)), rel=1e-15)
+    # Small libration of the prolate body round θ = π/2 (α = 0, κ = 0): V″ = (1 − β²)/β.
+    beta = 0.5
+    cell = Cell(0.0, beta, 0.5, eta, 0.0)
+    comps = reference(0.0, beta, 0.5, eta, 0.0, beta + 1e-14)
+    b = 1 / eta + beta**2
+    assert comps[0].period == pytest.approx(2 * math.pi * math.sqrt(b * beta / (1 - beta**2)), rel=1e-12)
+    assert len(cell.critical_points()) == 3  # 0, π/2 and π on [0, π]
+
+
+def test_reference_finds_the_tiny_well_at_a_pole():
+    """Reproduction 5 of issue 12: a second component [1.90e-4, 5.43e-4]."""
+    comps = reference(0.5, 1.2247452796398115, 1.0, 1.0, 1e-10, 1.500000000000156)
+    assert [round(c.theta_min, 7) for c in comps] == [0.0001903, 0.0022367]
+
+
+@pytest.mark.parametrize("case", whole_domain.reproductions(), ids=lambda c: c.origin.replace(" ", "-"))
+def test_reproductions_are_right_or_honest(case):
+    outcome = whole_domain.check(case)
+    assert not outcome.problems, outcome.problems
+
+
+def test_whole_domain_is_honest():
+    """A seeded random sample over the domain of issue 12 (seed 12)."""
+    outcomes = whole_domain.check_all(whole_domain.sample(12, CELLS))
+    report = whole_domain.summary(outcomes)
+    print(report)
+    assert sum(o.ok_components for o in outcomes) > CELLS // 2, report
+    assert not any(o.problems for o in outcomes), report

@@ -1,0 +1,258 @@
+"""`rubber-atlas cell` over the whole parameter domain against the 50-digit reference of
+`reference.py`: seeded random cells (α ∈ [0, 1) with 0 and 0.999999, β and η ∈ [1e-3, 1e3],
+ν ∈ (0, 2], |κ| ∈ [1e-8, 1e4] and 0; energies 1e-12 … 1e6 above a minimum of V and within
+1e-15 … 1e-3 of a separatrix) plus the reproductions of issue 12. For every component it
+checks that a value with status `ok` lies within its error estimate of the reference, that
+every other status is honest, and that the components are the reference's wherever ε is not
+within rounding of a critical level.
+
+    python scripts/whole_domain.py --cells 300 --seed 12 [--out summary.csv]
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import math
+import multiprocessing
+import os
+import random
+import subprocess
+import sys
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "scripts"))
+
+from reference import critical_levels, reference  # noqa: E402
+
+BIN = os.environ.get("RUBBER_ATLAS_BIN", str(ROOT / "target" / "release" / "rubber-atlas"))
+EPS = 2.0**-52
+
+# The reproductions of issue 12 (α, β, ν, η, κ, ε).
+REPRODUCTIONS = [
+    (0.8478956570577875, 1.2298206204723992, 0.06259862657904014, 1.5731670664558515, 0.0, 1.8478956570582228),
+    (0.0, 0.0033982945561224095, 1.7587523537601242, 0.05874604850259599, 0.0006310113896403989, 0.0033984936438150753),
+    (0.0, 1.0, 0.0707967427595448, 9.674901385232333, -7.425413555813775e-07, 1.0000000000467661),
+    (0.2, 0.001, 0.1, 300.0, 1e-10, 1.2),
+    (0.3161336860565129, 0.0013808808126377825, 1.6448744417864798, 103.34515890135052, 3451.2460913378322,
+     5955549.792868211),
+    (0.5, 1.2247452796398115, 1.0, 1.0, 1e-10, 1.500000000000156),
+    (0.999999, 0.0015267025376685998, 0.576404134748566, 0.07763191150403917, 5.235375405830439e-06,
+     1.0060490242139052e-06),
+    (0.28052480264473717, 930.4224637063154, 1.83105713931796, 640.5402923520068, 0.0003012641545661357,
+     106504.57206157087),
+    (0.5, 3.0, 0.5, 0.5, 0.05, 3.047808563257975),
+    (0.5, 3.0, 0.5, 0.5, 1e-160, 2.0),
+    (0.5, 3.0, 0.5, 0.5, 1e-200, 1.6),
+]
+
+
+@dataclass
+class Case:
+    alpha: float
+    beta: float
+    nu: float
+    eta: float
+    kappa: float
+    energy: float
+    origin: str
+    # For a sampled cell: random numbers that place ε against the critical levels of V.
+    recipe: tuple | None = None
+
+
+def resolve(case: Case) -> Case:
+    """The cell with its energy: 30 % within 1e-15 … 1e-3 (relative) of a separatrix, else
+    1e-12 … 1e6 (relative to max(|V_min|, 1)) above a minimum of V."""
+    if case.recipe is None:
+        return case
+    pick, mode, sign, near, above = case.recipe
+    levels = critical_levels(case.alpha, case.beta, case.nu, case.eta, case.kappa)
+    values = [v for _, v in levels]
+    minima = [v for i, (_, v) in enumerate(levels) if _is_minimum(levels, i, case.kappa)]
+    maxima = [v for i, (_, v) in enumerate(levels) if _is_maximum(levels, i, case.kappa)]
+    if maxima and mode < 0.3:
+        top = maxima[int(pick * len(maxima))]
+        return Case(**{**asdict(case), "energy": top * (1 + sign * 10**near), "origin": "separatrix", "recipe": None})
+    bottom = minima[int(pick * len(minima))]
+    scale = max(abs(min(values)), 1.0)
+    return Case(**{**asdict(case), "energy": bottom + scale * 10**above, "origin": "random", "recipe": None})
+
+
+@dataclass
+class Outcome:
+    case: Case
+    # One line per problem found; empty: the cell is right and honest.
+    problems: list[str] = field(default_factory=list)
+    components: int = 0
+    ok_components: int = 0
+    # Largest true error / estimate over the status-ok values (T and N).
+    worst_ratio: float = 0.0
+    # Whether ε lies within rounding of a critical level (component count not checked).
+    ambiguous: bool = False
+
+
+def _loguniform(rng: random.Random, lo: float, hi: float) -> float:
+    return math.exp(rng.uniform(math.log(lo), math.log(hi)))
+
+
+def sample(seed: int, count: int) -> list[Case]:
+    """`count` seeded random cells over the domain of issue 12."""
+    rng = random.Random(seed)
+    cases = []
+    while len(cases) < count:
+        alpha = rng.choice([0.0, 0.999999, rng.uniform(0, 1), rng.uniform(0, 1), rng.uniform(0, 1)])
+        beta = rng.choice([_loguniform(rng, 1e-3, 1e3), _loguniform(rng, 0.3, 3), math.sqrt(1 + alpha)])
+        nu = rng.uniform(1e-3, 2)
+        eta = _loguniform(rng, 1e-3, 1e3)
+        kappa = 0.0 if rng.random() < 0.12 else rng.choice([-1, 1]) * _loguniform(rng, 1e-8, 1e4)
+        # The energy is placed against the critical levels in the worker (see `resolve`).
+        recipe = (rng.random(), rng.random(), rng.choice([-1, 1]), rng.uniform(-15, -3), rng.uniform(-12, 6))
+        cases.append(Case(alpha, beta, nu, eta, kappa, math.nan, "random", recipe))
+    return cases
+
+
+def _neighbours(levels, i, kappa):
+    n = len(levels)
+    if kappa != 0:
+        left = levels[i - 1][1] if i > 0 else math.inf
+        right = levels[i + 1][1] if i + 1 < n else math.inf
+    else:
+        # On the circle [0, π] mirrored: θ = 0 and π are their own mirror neighbours.
+        left = levels[i - 1][1] if i > 0 else levels[1][1]
+        right = levels[i + 1][1] if i + 1 < n else levels[n - 2][1]
+    return left, right
+
+
+def _is_minimum(levels, i, kappa):
+    left, right = _neighbours(levels, i, kappa)
+    return levels[i][1] <= left and levels[i][1] <= right
+
+
+def _is_maximum(levels, i, kappa):
+    left, right = _neighbours(levels, i, kappa)
+    return levels[i][1] > left and levels[i][1] > right
+
+
+def reproductions() -> list[Case]:
+    return [Case(*r, origin=f"reproduction {i + 1}") for i, r in enumerate(REPRODUCTIONS)]
+
+
+def run_cell(case: Case, method: str = "quadrature") -> dict:
+    args = [BIN, "cell", f"--alpha={case.alpha!r}", f"--beta={case.beta!r}", f"--nu={case.nu!r}",
+            f"--eta={case.eta!r}", f"--kappa={case.kappa!r}", f"--energy={case.energy!r}", "--method", method,
+            "--json"]
+    out = subprocess.run(args, capture_output=True, text=True)
+    if out.returncode != 0:
+        return {"error": out.stderr.strip()}
+    return json.loads(out.stdout)
+
+
+def _overlap(a, b, circle: bool) -> float:
+    """Length of the overlap of intervals a and b (on the circle modulo 2π)."""
+    best = 0.0
+    shifts = (-2 * math.pi, 0.0, 2 * math.pi) if circle else (0.0,)
+    for s in shifts:
+        best = max(best, min(a[1], b[1] + s) - max(a[0], b[0] + s))
+    return best
+
+
+def check(case: Case, method: str = "quadrature") -> Outcome:
+    """Compares one cell with the reference."""
+    case = resolve(case)
+    outcome = Outcome(case)
+    levels = critical_levels(case.alpha, case.beta, case.nu, case.eta, case.kappa)
+    # Within rounding of a critical level the component count is not defined in double
+    # precision (the L1 size of V there times a few eps).
+    for theta, value in levels:
+        size = abs(value) + (case.kappa**2 / (2 * math.sin(theta) ** 2) if case.kappa else 0.0) + 2.0
+        if abs(case.energy - value) <= 64 * EPS * size:
+            outcome.ambiguous = True
+    truth = reference(case.alpha, case.beta, case.nu, case.eta, case.kappa, case.energy)
+    result = run_cell(case, method)
+    if "error" in result:
+        outcome.problems.append(f"refused: {result['error']}")
+        return outcome
+    comps = result["components"]
+    outcome.components = len(comps)
+    circle = case.kappa == 0
+    if not outcome.ambiguous and len(comps) != len(truth):
+        outcome.problems.append(f"{len(comps)} components, the reference has {len(truth)}")
+    for ref in truth:
+        matches = [c for c in comps if _overlap((c["theta_min"], c["theta_max"]), (ref.theta_min, ref.theta_max), circle) >= 0]
+        if not matches:
+            if not outcome.ambiguous:
+                outcome.problems.append(f"missed component [{ref.theta_min:.6g}, {ref.theta_max:.6g}]")
+            continue
+        comp = max(matches, key=lambda c: _overlap((c["theta_min"], c["theta_max"]), (ref.theta_min, ref.theta_max), circle))
+        status = comp["status"]
+        errors = comp["errors"]
+        if status in ("ok", "tolerance_not_reached", "fixed_point"):
+            outcome.ok_components += status == "ok"
+            for name, value, truth_value, truth_error, estimate in (
+                ("T", comp["period"], ref.period, ref.period_error, errors["period"]),
+                ("N", comp["rotation_number"], ref.rotation_number, ref.rotation_error, errors["rotation_number"]),
+            ):
+                if value is None or not math.isfinite(value) or estimate is None:
+                    outcome.problems.append(f"{status} component has {name} = {value} ± {estimate}")
+                    continue
+                error = abs(value - truth_value)
+                allowed = estimate + 4 * truth_error
+                if status == "ok":
+                    ratio = error / allowed if allowed > 0 else (math.inf if error > 0 else 0.0)
+                    outcome.worst_ratio = max(outcome.worst_ratio, ratio)
+                if error > allowed:
+                    outcome.problems.append(
+                        f"{status}: {name} = {value!r}, reference {truth_value!r}: error {error:.3g} > estimate {estimate:.3g}"
+                    )
+                if status == "ok" and estimate > 1e-10 * (abs(truth_value) if name == "T" else 1.0) * 1.0000001:
+                    outcome.problems.append(f"ok but {name}'s estimate {estimate:.3g} is above the tolerance")
+        elif status == "separatrix":
+            if not outcome.ambiguous:
+                outcome.problems.append(f"separatrix status {math.fabs(case.energy):.17g} off any critical level")
+        else:
+            outcome.problems.append(f"component status {status}")
+    return outcome
+
+
+def check_all(cases: list[Case], method: str = "quadrature", processes: int | None = None) -> list[Outcome]:
+    processes = processes or os.cpu_count() or 1
+    with multiprocessing.Pool(processes) as pool:
+        return pool.starmap(check, [(c, method) for c in cases], chunksize=1)
+
+
+def summary(outcomes: list[Outcome]) -> str:
+    bad = [o for o in outcomes if o.problems]
+    oks = sum(o.ok_components for o in outcomes)
+    worst = max((o.worst_ratio for o in outcomes), default=0.0)
+    lines = [f"{len(outcomes)} cells, {sum(o.components for o in outcomes)} components, {oks} with status ok; "
+             f"worst error/estimate among ok values {worst:.3g}; {len(bad)} cells with problems"]
+    for o in bad:
+        lines.append(f"  {o.case.origin}: {asdict(o.case)}")
+        lines.extend(f"    {p}" for p in o.problems)
+    return "\n".join(lines)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--cells", type=int, default=300)
+    parser.add_argument("--seed", type=int, default=12)
+    parser.add_argument("--method", default="quadrature")
+    parser.add_argument("--out", type=Path)
+    args = parser.parse_args()
+    cases = reproductions() + sample(args.seed, args.cells)
+    outcomes = check_all(cases, args.method)
+    print(summary(outcomes))
+    if args.out:
+        with args.out.open("w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(list(asdict(cases[0]).keys()) + ["components", "ok_components", "worst_ratio", "problems"])
+            for o in outcomes:
+                w.writerow(list(asdict(o.case).values()) + [o.components, o.ok_components, o.worst_ratio, " | ".join(o.problems)])
+    return 1 if any(o.problems for o in outcomes) else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
