@@ -1,8 +1,8 @@
 """The reduced model of SPEC §1 in plain Python, for scripts that check or race rubber-atlas.
 
 Three layers share the formulas of SPEC §1.2–1.3 (Z, U, B, J, V, ψ̇):
-- `HighPrecision`: T and Δψ (N = −Δψ/2π) of one component by mpmath's tanh-sinh quadrature at
-  40 significant digits, split at the critical points of V — an independent reference for the
+- `HighPrecision`: T and N = −Δψ/2π of the component nearest a given θ, from the mpmath
+  reference of `reference.py` at 40 significant digits — an independent reference for the
   hard cells (near a separatrix, a pole or a minimum), where an ODE run is least reliable.
 - `midpoint_rotation_numbers`: what a researcher vectorises by hand with NumPy — N alone by
   the periodic midpoint rule after θ = c − (L/2) cos φ.
@@ -16,6 +16,8 @@ import math
 
 import mpmath
 import numpy as np
+
+from reference import Cell
 
 
 class Body:
@@ -58,22 +60,6 @@ class Body:
         return -kappa * c / (self.integral_factor(theta, lib) * s * s)
 
 
-def _bisect(f, a, b):
-    """A root of f between a and b (f changes sign) by bisection to the working precision."""
-    fa = f(a)
-    eps = mpmath.mpf(2) ** (-mpmath.mp.prec)
-    while abs(b - a) > 4 * eps * max(abs(a), abs(b)):
-        m = (a + b) / 2
-        fm = f(m)
-        if fm == 0:
-            return m
-        if (fm > 0) == (fa > 0):
-            a, fa = m, fm
-        else:
-            b = m
-    return (a + b) / 2
-
-
 class _Mp:
     """mpmath under the names the formulas use."""
 
@@ -81,10 +67,12 @@ class _Mp:
 
 
 class HighPrecision:
-    """T and N of the component of {V ≤ ε} around a given θ, at `digits` significant digits."""
+    """T and N of the component of {V ≤ ε} around a given θ, at `digits` significant digits:
+    the component nearest θ among those `reference.Cell` finds."""
 
     def __init__(self, body: Body, kappa: float, digits: int = 40):
         self.body, self.kappa, self.digits = body, mpmath.mpf(kappa), digits
+        self.cell = Cell(body.alpha, body.beta, body.nu, body.eta, kappa, digits)
 
     def _v(self, theta):
         return self.body.potential(theta, self.kappa, _Mp)
@@ -92,58 +80,16 @@ class HighPrecision:
     def _dv(self, theta):
         return self.body.slope(theta, self.kappa, _Mp)
 
-    def critical_points(self, cells: int = 4000):
-        """Roots of V′ in (0, π) (κ ≠ 0), by a scan of sin³θ V′ and findroot."""
+    def critical_points(self):
+        """θ of every critical point of V in (0, π) (κ ≠ 0), increasing."""
         with mpmath.workdps(self.digits):
-            g = lambda t: self._dv(t) * mpmath.sin(t) ** 3  # noqa: E731
-            grid = [mpmath.pi * (i + 0.5) / cells for i in range(cells)]
-            values = [g(t) for t in grid]
-            roots = []
-            for a, b, fa, fb in zip(grid, grid[1:], values, values[1:]):
-                if fa == 0 or fa * fb < 0:
-                    roots.append(_bisect(g, a, b))
-            return roots
-
-    def component(self, energy: float, near: float, critical=None):
-        """The turning points [θ_min, θ_max] of the component containing or nearest `near`,
-        and the critical points strictly inside."""
-        with mpmath.workdps(self.digits):
-            e = mpmath.mpf(energy)
-            crit = self.critical_points() if critical is None else critical
-            nodes = [mpmath.mpf(0)] + list(crit) + [mpmath.pi]
-            level = lambda t: self._v(t) - e  # noqa: E731
-            # Walk the monotone pieces between nodes; each sign change holds one turning point.
-            ends = []
-            for a, b in zip(nodes, nodes[1:]):
-                la = mpmath.inf if a == 0 else level(a)
-                lb = mpmath.inf if b == mpmath.pi else level(b)
-                if (la > 0) != (lb > 0):
-                    lo = a if a > 0 else mpmath.mpf(10) ** (-self.digits // 2)
-                    hi = b if b < mpmath.pi else mpmath.pi - mpmath.mpf(10) ** (-self.digits // 2)
-                    ends.append(_bisect(level, lo, hi))
-            pairs = list(zip(ends[0::2], ends[1::2]))
-            lo, hi = min(pairs, key=lambda p: 0 if p[0] <= near <= p[1] else min(abs(p[0] - near), abs(p[1] - near)))
-            interior = [c for c in crit if lo < c < hi]
-            return lo, hi, interior
+            return [p.theta for p in self.cell.critical_points()]
 
     def integrals(self, energy: float, near: float):
         """(θ_min, θ_max, T, N) of the component nearest `near`, as floats."""
-        with mpmath.workdps(self.digits):
-            e = mpmath.mpf(energy)
-            lo, hi, interior = self.component(energy, near)
-            points = [lo] + interior + [hi]
-
-            def dt(t):
-                gap = e - self._v(t)
-                # Nodes within the last digits of a turning point may round to gap ≤ 0; their
-                # weight (√ of the distance) is far below the working precision.
-                if gap <= 0:
-                    return mpmath.mpf(0)
-                return mpmath.sqrt(self.body.inertia(t, _Mp) / (2 * gap))
-
-            period = 2 * mpmath.quad(dt, points)
-            advance = 2 * mpmath.quad(lambda t: self.body.psi_rate(t, self.kappa, _Mp) * dt(t), points)
-            return float(lo), float(hi), float(period), float(-advance / (2 * mpmath.pi))
+        comps = self.cell.components(energy)
+        best = min(comps, key=lambda c: max(c.theta_min - near, near - c.theta_max, 0.0))
+        return best.theta_min, best.theta_max, best.period, best.rotation_number
 
 
 def midpoint_rotation_numbers(body: Body, kappas, energies, nodes: int = 64, grid: int = 128):

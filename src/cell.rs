@@ -334,7 +334,7 @@ fn level_offset_error<S: Shape>(
     let scale = component
         .interior
         .iter()
-        .map(|p| potential.value_scale(p.site.angle()))
+        .map(|p| p.scale)
         .fold(0.0, f64::max);
     // The rounding of ε − V(c) and of each turning point (one ulp of θ in its chart).
     let ends = [component.lower, component.upper];

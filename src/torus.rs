@@ -15,7 +15,6 @@
 use crate::body::{Angle, Body, Reduction, Shape};
 use crate::error::{AtlasError, Result};
 use crate::quadrature::{spectral_antiderivative, IntervalNode, TanhSinhLevel, FINEST_LEVEL};
-use crate::reduced::ReducedSystem;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 mod cosine;
@@ -272,11 +271,6 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         }
     }
 
-    /// V″ at θ (away from the poles).
-    pub fn curvature(&self, theta: f64) -> f64 {
-        ReducedSystem::new(self.body, self.kappa).effective_potential_second(theta)
-    }
-
     /// V″ at an angle: (κ/sinθ)² (sin²θ + 3 cos²θ) / sin²θ + U″.
     pub fn curvature_at(&self, a: Angle) -> f64 {
         let upp = self.body.shape.potential_second_at(a);
@@ -287,14 +281,20 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         w * w * (1.0 + 3.0 * (a.cos / a.sin) * (a.cos / a.sin)) + upp
     }
 
-    /// Where to look for critical points of V (κ ≠ 0), in increasing θ: [`SCAN_CELLS`]
+    /// Where to look for critical points of V, in increasing θ over [0, π] (κ = 0: the
+    /// uniform cells alone): [`SCAN_CELLS`]
     /// uniform cells, each pole's end cell again on a logarithmic scale (8 points a decade)
     /// down to 10⁻³ √|κ|, below which V′ < 0 near θ = 0 (> 0 near π) whatever U (the wall
     /// κ²/sin³θ beats any U′ there), so that a small well at a pole is not lost inside the
     /// first cell. Sites beyond π/2 are held as π − θ.
     fn scan_sites(&self) -> Vec<Site> {
         let cell = PI / SCAN_CELLS as f64;
-        let innermost = (1e-3 * self.kappa.abs().sqrt()).max(f64::MIN_POSITIVE.sqrt());
+        // κ = 0: the poles are critical points themselves, no well hides at them.
+        let innermost = if self.kappa == 0.0 {
+            cell
+        } else {
+            (1e-3 * self.kappa.abs().sqrt()).max(f64::MIN_POSITIVE.sqrt())
+        };
         let mut logs = Vec::new();
         let mut x = innermost;
         while x < cell {
@@ -307,6 +307,26 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         sites.extend((half + 1..SCAN_CELLS).map(|i| Site::from_pi(cell * (SCAN_CELLS - i) as f64)));
         sites.extend(logs.iter().rev().map(|&x| Site::from_pi(x)));
         sites
+    }
+
+    /// The zeros of `f` on a sequence of sites, one per neighbouring pair with a sign change
+    /// (bisected) or an exact zero at a site.
+    fn sign_changes(&self, f: &impl Fn(Angle) -> f64, sites: &[Site]) -> Vec<Site> {
+        let mut zeros = Vec::new();
+        for w in sites.windows(2) {
+            let (fa, fb) = (f(w[0].angle()), f(w[1].angle()));
+            if fa == 0.0 {
+                zeros.push(w[0]);
+            } else if fb != 0.0 && (fa < 0.0) != (fb < 0.0) {
+                zeros.push(self.bisect_sites(f, w[0], w[1]));
+            }
+        }
+        if let Some(&last) = sites.last() {
+            if f(last.angle()) == 0.0 {
+                zeros.push(last);
+            }
+        }
+        zeros
     }
 
     /// A sign change of `f` between two neighbouring scan sites, bisected to the last bit in
@@ -349,57 +369,42 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
 
     fn find_critical_points(&self) -> Vec<CriticalPoint> {
         let shape = &self.body.shape;
+        // Roots of g = sin³θ V′ = −κ² cosθ + sin³θ U′ (no pole; U′'s roots in (0, π) for
+        // κ = 0), bracketed between the roots of g′ = κ² sinθ + 3 sin²θ cosθ U′ + sin³θ U″
+        // so that close pairs (near the cusp, tangencies) are not lost between scan nodes.
+        // Both are evaluated divided by a power of sinθ (V′ = g/sin³θ, g′/sin²θ), which
+        // keeps their signs and keeps κ² from underflowing.
+        let g = |a: Angle| self.slope(a);
+        let dg = |a: Angle| {
+            let w = self.kappa / a.sin;
+            w * w * a.sin
+                + 3.0 * a.cos * shape.potential_prime_at(a)
+                + a.sin * shape.potential_second_at(a)
+        };
+        let scan = self.scan_sites();
+        // A flat U at κ = 0 (the homogeneous sphere) has no isolated critical points: every
+        // energy above U is uniform rolling; only θ = 0 and π are kept as reference points.
+        let flat = self.kappa == 0.0 && scan.iter().all(|s| g(s.angle()) == 0.0);
+        let mut cuts = vec![scan[0]];
+        cuts.extend(self.sign_changes(&dg, &scan));
+        cuts.push(scan[scan.len() - 1]);
+        cuts.dedup();
+        let mut roots = if flat {
+            Vec::new()
+        } else {
+            self.sign_changes(&g, &cuts)
+        };
+        roots.dedup();
         let sites: Vec<Site> = if self.kappa != 0.0 {
-            // Roots of g = sin³θ V′ = −κ² cosθ + sin³θ U′ (no pole), bracketed between the
-            // roots of g′ = κ² sinθ + 3 sin²θ cosθ U′ + sin³θ U″ so that close pairs
-            // (near the cusp, tangencies) are not lost between scan nodes. Both are
-            // evaluated divided by a power of sinθ (V′ = g/sin³θ, g′/sin²θ), which keeps their
-            // signs and keeps κ² from underflowing.
-            let g = |a: Angle| self.slope(a);
-            let dg = |a: Angle| {
-                let w = self.kappa / a.sin;
-                w * w * a.sin
-                    + 3.0 * a.cos * shape.potential_prime_at(a)
-                    + a.sin * shape.potential_second_at(a)
-            };
-            let scan = self.scan_sites();
-            let mut cuts = vec![scan[0]];
-            for w in scan.windows(2) {
-                let (da, db) = (dg(w[0].angle()), dg(w[1].angle()));
-                if db == 0.0 {
-                    cuts.push(w[1]);
-                } else if da != 0.0 && (da < 0.0) != (db < 0.0) {
-                    cuts.push(self.bisect_sites(&dg, w[0], w[1]));
-                }
-            }
-            cuts.push(scan[scan.len() - 1]);
-            cuts.dedup();
-            let mut roots = Vec::new();
-            for w in cuts.windows(2) {
-                let (ga, gb) = (g(w[0].angle()), g(w[1].angle()));
-                if ga == 0.0 {
-                    roots.push(w[0]);
-                } else if gb != 0.0 && (ga < 0.0) != (gb < 0.0) {
-                    roots.push(self.bisect_sites(&g, w[0], w[1]));
-                }
-            }
-            roots.dedup();
             roots
         } else {
-            // On the circle: roots of U′ on [0, 2π), with θ = 0 and π always among them.
-            let g = |t: f64| shape.potential_prime(t);
-            let dg = |t: f64| shape.potential_second(t);
-            // A flat U (the homogeneous sphere) has no isolated critical points: every energy
-            // above U is uniform rolling; only θ = 0 and π are kept as reference points.
-            let flat = (0..=SCAN_CELLS).all(|i| g(PI * i as f64 / SCAN_CELLS as f64) == 0.0);
-            let mut t: Vec<f64> = if flat {
-                Vec::new()
-            } else {
-                roots_between_extrema(g, dg, PI)
-                    .into_iter()
-                    .filter(|&t| t > 1e-9 && t < PI - 1e-9)
-                    .collect()
-            };
+            // On the circle [0, 2π): θ = 0 and π always, the roots and their mirror images,
+            // every site holding θ itself.
+            let mut t: Vec<f64> = roots
+                .iter()
+                .map(|s| s.theta)
+                .filter(|&t| t > 1e-9 && t < PI - 1e-9)
+                .collect();
             let mirrored: Vec<f64> = t.iter().rev().map(|x| TAU - x).collect();
             t.insert(0, 0.0);
             t.push(PI);
@@ -412,11 +417,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 site,
                 value: self.value(site.angle()),
                 scale: self.value_scale(site.angle()),
-                curvature: if self.kappa == 0.0 {
-                    self.curvature(site.theta)
-                } else {
-                    self.curvature_at(site.angle())
-                },
+                curvature: self.curvature_at(site.angle()),
                 kind: CriticalKind::Inflection,
             })
             .collect();
@@ -1323,52 +1324,6 @@ fn safe_newton(
         x = next;
     }
     x
-}
-
-/// Roots of a smooth g on [0, end]: the roots of g′ (scan plus bisection) cut the interval
-/// into pieces where g is monotone, and each piece with a sign change has one root, found by
-/// bisection to the last bit; g = 0 at a cut (a double root) is kept.
-fn roots_between_extrema(g: impl Fn(f64) -> f64, dg: impl Fn(f64) -> f64, end: f64) -> Vec<f64> {
-    let mut cuts = vec![0.0];
-    cuts.extend(roots_by_scan(&dg, 0.0, end, SCAN_CELLS));
-    cuts.push(end);
-    cuts.dedup();
-    let mut roots = Vec::new();
-    for w in cuts.windows(2) {
-        let (ga, gb) = (g(w[0]), g(w[1]));
-        if ga == 0.0 {
-            roots.push(w[0]);
-        } else if gb != 0.0 && (ga < 0.0) != (gb < 0.0) {
-            roots.push(bisect(&g, w[0], w[1], ga < 0.0));
-        }
-    }
-    if g(end) == 0.0 {
-        roots.push(end);
-    }
-    roots.dedup();
-    roots
-}
-
-/// All roots of a continuous `f` on [a, b] where it changes sign between `n` scan cells, each
-/// refined by bisection to the last bit; exact zeros at scan nodes are kept.
-pub fn roots_by_scan(f: impl Fn(f64) -> f64, a: f64, b: f64, n: usize) -> Vec<f64> {
-    let mut roots = Vec::new();
-    let x = |i: usize| a + (b - a) * i as f64 / n as f64;
-    let mut f_prev = f(a);
-    if f_prev == 0.0 {
-        roots.push(a);
-    }
-    for i in 1..=n {
-        let (lo, hi) = (x(i - 1), x(i));
-        let f_hi = f(hi);
-        if f_hi == 0.0 {
-            roots.push(hi);
-        } else if f_prev != 0.0 && (f_prev < 0.0) != (f_hi < 0.0) {
-            roots.push(bisect(&f, lo, hi, f_prev < 0.0));
-        }
-        f_prev = f_hi;
-    }
-    roots
 }
 
 /// Bisection to the last representable bit on [lo, hi], where `f(lo) < 0` iff `lo_negative`.
