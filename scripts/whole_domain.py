@@ -136,8 +136,12 @@ def _is_maximum(levels, i, kappa):
     return levels[i][1] > left and levels[i][1] > right
 
 
+# Their numbers in the issue.
+LABELS = ["1", "2", "2 (sphere)", "3", "4", "5", "6", "7", "8", "9 (kappa 1e-160)", "9 (kappa 1e-200)"]
+
+
 def reproductions() -> list[Case]:
-    return [Case(*r, origin=f"reproduction {i + 1}") for i, r in enumerate(REPRODUCTIONS)]
+    return [Case(*r, origin=f"issue 12 #{label}") for label, r in zip(LABELS, REPRODUCTIONS)]
 
 
 def run_cell(case: Case, method: str = "quadrature") -> dict:

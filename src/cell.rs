@@ -275,7 +275,15 @@ pub fn solve_component<S: Shape>(
     if let Some(saddle) = separatrix(component, energy) {
         return Ok(on_separatrix(potential, component, &saddle, options));
     }
-    let mut raw = integrate(potential, energy, component, options)?;
+    let mut raw = match integrate(potential, energy, component, options) {
+        Ok(raw) => raw,
+        // DOP853 can give up in a stiff corner (step size underflow near a pole at large β
+        // and η): the component is marked, not the whole cell refused.
+        Err(AtlasError::Integration { .. }) if options.method == Method::Ode => {
+            return Ok(unresolved(component));
+        }
+        Err(e) => return Err(e),
+    };
     let offset = level_offset_error(potential, energy, component, &raw, options);
     raw.period_error += offset.period;
     raw.psi_advance_error += offset.psi_advance;
@@ -501,6 +509,36 @@ fn finish(component: &Component, raw: PeriodIntegrals, options: &CellOptions) ->
     }
 }
 
+/// A component whose integrals could not be computed: no values (NaN), unbounded errors,
+/// status `tolerance_not_reached`.
+fn unresolved(component: &Component) -> ComponentResult {
+    let unknown = ErrorEstimates {
+        period: f64::INFINITY,
+        omega_theta: f64::INFINITY,
+        omega_psi: f64::INFINITY,
+        rotation_number: f64::INFINITY,
+        drift: f64::INFINITY,
+        drift_radius: f64::INFINITY,
+    };
+    ComponentResult {
+        theta_min: component.theta_min(),
+        theta_max: component.theta_max(),
+        period: f64::NAN,
+        omega_theta: f64::NAN,
+        omega_psi: f64::NAN,
+        rotation_number: f64::NAN,
+        drift: f64::NAN,
+        drift_radius: f64::NAN,
+        bounded: None,
+        motion: component.kind,
+        status: Status::ToleranceNotReached,
+        error_estimate: f64::INFINITY,
+        errors: unknown,
+        drift_vector: [f64::NAN; 2],
+        work: 0,
+    }
+}
+
 /// R = |Δζ| / (2 |sin πN|) and its error; R = 0 when Δζ = 0 exactly (κ = 0 librations).
 fn drift_radius(drift: f64, drift_error: f64, n: f64, n_error: f64) -> (f64, f64) {
     if drift.is_nan() {
@@ -518,17 +556,30 @@ fn drift_radius(drift: f64, drift_error: f64, n: f64, n_error: f64) -> (f64, f64
     (r, r * rel)
 }
 
-/// A maximum inside the component or at one of its ends whose level is ε to rounding.
+/// A maximum inside the component or at one of its ends whose computed level is ε itself.
+/// A level a few ulps off is integrated like any other: its orbit is real, and the saddle's
+/// conditioning (ulp(V_s)/(λ |ε − V_s|) per passage) says how little its values are worth.
 fn separatrix(component: &Component, energy: f64) -> Option<CriticalPoint> {
     component
         .interior
         .iter()
         .chain(component.neighbours.iter().flatten())
-        .find(|p| {
+        .find(|p| p.kind != CriticalKind::Minimum && energy == p.value)
+        .copied()
+}
+
+/// Whether a maximum inside the component or at one of its ends lies within 4 ulps (of its
+/// L1 size) of ε: the values are then real but only as good as that distance allows (the
+/// saddle's conditioning), too poor to trace a curve by.
+pub fn within_rounding_of_separatrix(component: &Component, energy: f64) -> bool {
+    component
+        .interior
+        .iter()
+        .chain(component.neighbours.iter().flatten())
+        .any(|p| {
             p.kind != CriticalKind::Minimum
                 && (energy - p.value).abs() <= 4.0 * f64::EPSILON * p.scale
         })
-        .copied()
 }
 
 fn on_separatrix<S: Shape>(

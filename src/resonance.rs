@@ -5,7 +5,7 @@
 //! hypothesis (SPEC §4; paper §5).
 
 use crate::body::Shape;
-use crate::cell::{solve_component, CellOptions, Status};
+use crate::cell::{solve_component, within_rounding_of_separatrix, CellOptions, Status};
 use crate::error::{AtlasError, Result};
 use crate::torus::{CriticalKind, EffectivePotential, MotionKind};
 use crate::Body;
@@ -89,7 +89,7 @@ pub(crate) fn evaluate<S: Shape>(
         .iter()
         .enumerate()
         .find(|(_, c)| c.theta_min() <= minimum && minimum <= c.theta_max())?;
-    if component.kind != MotionKind::Libration {
+    if component.kind != MotionKind::Libration || within_rounding_of_separatrix(component, energy) {
         return None;
     }
     let r = solve_component(potential, energy, component, options).ok()?;

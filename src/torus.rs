@@ -1238,8 +1238,9 @@ fn weighted<S: Shape>(
     let (dpsi, along) = if v.kappa == 0.0 {
         (0.0, 0.0)
     } else {
-        // ω3 dt / sin θ = κ dt / (J sin θ), with one division.
-        let w3_dt = v.kappa * dt / (red.integral_factor * a.sin);
+        // ω3 dt / sin θ = (κ / sin θ) dt / J: κ/sinθ first, as κ dt may underflow where both
+        // are 1e-170 (a turning point that close to a pole).
+        let w3_dt = (v.kappa / a.sin) * dt / red.integral_factor;
         (-w3_dt * a.cos / a.sin, red.potential * w3_dt)
     };
     NodeSample {

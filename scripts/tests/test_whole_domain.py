@@ -46,7 +46,7 @@ def test_reference_finds_the_tiny_well_at_a_pole():
     assert [round(c.theta_min, 7) for c in comps] == [0.0001903, 0.0022367]
 
 
-@pytest.mark.parametrize("case", whole_domain.reproductions(), ids=lambda c: c.origin.replace(" ", "-"))
+@pytest.mark.parametrize("case", whole_domain.reproductions(), ids=lambda c: c.origin.split("#")[1])
 def test_reproductions_are_right_or_honest(case):
     outcome = whole_domain.check(case)
     assert not outcome.problems, outcome.problems
@@ -59,3 +59,26 @@ def test_whole_domain_is_honest():
     print(report)
     assert sum(o.ok_components for o in outcomes) > CELLS // 2, report
     assert not any(o.problems for o in outcomes), report
+
+
+def test_ode_method_marks_a_component_it_cannot_integrate():
+    """Reproduction 7: DOP853 gives up (step size underflow) at β = 930, η = 640 near a pole.
+    The cell is not refused: the component has no values, unbounded errors and says so."""
+    case = next(c for c in whole_domain.reproductions() if c.origin == "issue 12 #7")
+    result = whole_domain.run_cell(case, method="ode")
+    assert "error" not in result, result
+    (comp,) = result["components"]
+    assert comp["status"] == "tolerance_not_reached"
+    assert comp["rotation_number"] is None and comp["errors"]["rotation_number"] is None
+
+
+def test_tiny_kappa_is_right_or_says_it_is_not():
+    """|κ| from 1e-60 to 1e-300 at a pole (the turning point as close to it): T is right to
+    its estimate, and N = ±½ lies within N's estimate whatever the status."""
+    for kappa in (1e-60, 1e-160, 1e-200, 1e-300):
+        truth = reference(0.5, 3.0, 0.5, 0.5, kappa, 2.0)
+        result = whole_domain.run_cell(whole_domain.Case(0.5, 3.0, 0.5, 0.5, kappa, 2.0, "tiny kappa"))
+        assert len(result["components"]) == len(truth) == 2
+        for comp, ref in zip(result["components"], truth):
+            assert abs(comp["period"] - ref.period) <= comp["errors"]["period"] + 4 * ref.period_error, kappa
+            assert abs(comp["rotation_number"] - ref.rotation_number) <= comp["errors"]["rotation_number"], kappa

@@ -7,7 +7,7 @@
 
 use super::{
     interleave, level_error, sample, weighted, Component, DriftEstimate, EffectivePotential,
-    NodeSample, PeriodIntegrals, Piece, EPS,
+    NodeSample, PeriodIntegrals, Piece, EPS, HIDDEN_PEAK,
 };
 use crate::body::{Angle, Shape};
 use crate::error::Result;
@@ -91,7 +91,26 @@ fn integrate_on<S: Shape>(
             d.error += phase * d.scale;
             d
         });
-        if done {
+        let hopeless = samples.intervals >= LAST_INTERVALS
+            || !reaches(samples.intervals, t_sums, 0.5 * tol * period)
+            || !reaches(samples.intervals, psi_sums, 0.5 * tol * TAU);
+        // With a turning point beyond the tanh-sinh rule's last node (which would hide the ψ̇
+        // peak there, an error of up to π in Δψ), the values reached here are kept with
+        // their estimates even where they have not converged: the status then says so.
+        let beyond_tanh_sinh =
+            piece.left.site.theta.min(piece.right.site.from_pi) < HIDDEN_PEAK * piece.length;
+        // Only sums already in their geometric regime (each level ten times closer), whose
+        // last difference bounds the error.
+        let settled = |s: [f64; 3]| (s[0] - s[1]).abs() <= 0.1 * (s[1] - s[2]).abs();
+        if done || (hopeless && beyond_tanh_sinh && settled(t_sums) && settled(psi_sums)) {
+            let drift = match drift {
+                None if with_drift => {
+                    let mut d = samples.drift();
+                    d.error += phase * d.scale;
+                    Some(d)
+                }
+                d => d,
+            };
             let psi_advance = 2.0 * psi_sums[0];
             return Ok(Some(PeriodIntegrals {
                 period,
@@ -103,9 +122,6 @@ fn integrate_on<S: Shape>(
                 converged: period_error <= tol * period && psi_advance_error / TAU <= tol,
             }));
         }
-        let hopeless = samples.intervals >= LAST_INTERVALS
-            || !reaches(samples.intervals, t_sums, 0.5 * tol * period)
-            || !reaches(samples.intervals, psi_sums, 0.5 * tol * TAU);
         if hopeless {
             return Ok(None);
         }
@@ -246,12 +262,11 @@ enum Map {
     /// turning point to a pole, where in θ the pole at distance θ_min narrows the strip of
     /// convergence to ~√(θ_min/L).
     Mercator {
-        /// tan(θ/2) at the two ends.
+        /// tan(θ/2) at the left end and tan((π − θ)/2) at the right one: each end seen from
+        /// its own pole (s ↦ −s mirrors the map), so neither overflows nor rounds away.
         tan_half: [f64; 2],
         /// s_max − s_min.
         length: f64,
-        /// θ_max − θ_min.
-        theta_length: f64,
     },
 }
 
@@ -285,11 +300,18 @@ impl Map {
                 (1.0 - a.cos) / a.sin
             }
         };
-        let tan_half = [tan_half(piece.left.angle), tan_half(piece.right.angle)];
+        let mirror = |a: Angle| Angle {
+            sin: a.sin,
+            cos: -a.cos,
+        };
+        let tan_half = [
+            tan_half(piece.left.angle),
+            tan_half(mirror(piece.right.angle)),
+        ];
         Map::Mercator {
             tan_half,
-            length: (tan_half[1] / tan_half[0]).ln(),
-            theta_length: piece.length,
+            // s_max − s_min = ln tan(θ_max/2) − ln tan(θ_min/2).
+            length: -(tan_half[0].ln() + tan_half[1].ln()),
         }
     }
 
@@ -297,40 +319,33 @@ impl Map {
     fn node(&self, intervals: usize, j: usize) -> IntervalNode {
         match *self {
             Map::Plain { length } => IntervalNode::cosine_tabulated(intervals, j, length),
-            Map::Mercator {
-                tan_half,
-                length,
-                theta_length,
-            } => {
+            Map::Mercator { tan_half, length } => {
                 let unit = IntervalNode::cosine_tabulated(intervals, j, 1.0);
-                let left = unit.from_left <= unit.from_right;
-                // s − s_end = ±L_s sin²(φ/2) or ∓L_s cos²(φ/2); with q = e^{s − s_end} and
-                // t = tan(θ_end/2): |θ − θ_end| = 2 atan(t |q − 1| / (1 + t² q)) and
-                // sin θ = 2 t q / (1 + t² q²).
-                let (t, ds) = if left {
-                    (tan_half[0], length * unit.from_left)
-                } else {
-                    (tan_half[1], -length * unit.from_right)
+                // From each end, in its own pole's coordinate: s − s_end = L_s u with u the
+                // unit distance to that end; with q = e^{L_s u} and t = tan(θ_end/2) (for the
+                // right end, of π − θ_end): |θ − θ_end| = 2 atan(t (q − 1) / (1 + t² q)) and
+                // sin θ = 2 t q / (1 + t² q²). Both distances are computed from their own end:
+                // most of the s-range may lie within rounding of one end in θ.
+                let from = |t: f64, u: f64| {
+                    let q_minus_1 = (length * u).exp_m1();
+                    let q = 1.0 + q_minus_1;
+                    // t q first: t alone may be 1e-300, whose square underflows.
+                    let tq = t * q;
+                    let distance = 2.0 * (t * q_minus_1 / (1.0 + t * tq)).atan();
+                    (distance, 2.0 * tq / (1.0 + tq * tq))
                 };
-                let q_minus_1 = ds.exp_m1();
-                let q = 1.0 + q_minus_1;
-                let near = 2.0 * (t * q_minus_1.abs() / (1.0 + t * t * q)).atan();
-                let sin_theta = 2.0 * t * q / (1.0 + t * t * q * q);
-                // dθ/dφ = sin θ ds/dφ = sin θ L_s sin(φ/2) cos(φ/2).
-                let jacobian = sin_theta * length * unit.jacobian;
-                let far = theta_length - near;
-                if left {
-                    IntervalNode {
-                        from_left: near,
-                        from_right: far,
-                        jacobian,
-                    }
+                let (from_left, sin_left) = from(tan_half[0], unit.from_left);
+                let (from_right, sin_right) = from(tan_half[1], unit.from_right);
+                let sin_theta = if unit.from_left <= unit.from_right {
+                    sin_left
                 } else {
-                    IntervalNode {
-                        from_left: far,
-                        from_right: near,
-                        jacobian,
-                    }
+                    sin_right
+                };
+                // dθ/dφ = sin θ ds/dφ = sin θ L_s sin(φ/2) cos(φ/2).
+                IntervalNode {
+                    from_left,
+                    from_right,
+                    jacobian: sin_theta * length * unit.jacobian,
                 }
             }
         }
