@@ -844,12 +844,16 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         };
         let turning = component.kind == MotionKind::Libration;
         let mut ends = vec![end(component.lower, turning)];
-        // Minima are harmless inside a piece; maxima and tangencies are near-singular points.
+        // Maxima and tangencies are near-singular points. Minima are harmless inside a piece
+        // unless U is sharply curved (an angular feature scale below 0.1, e.g. a prolate
+        // ellipsoid with β < 0.1 round θ = π/2), where the feature sits at the minimum and
+        // the sparse middle nodes of a long piece would step over it.
+        let sharp = self.body.shape.angular_feature_scale() < 0.1;
         ends.extend(
             component
                 .interior
                 .iter()
-                .filter(|p| cut && p.kind != CriticalKind::Minimum)
+                .filter(|p| cut && (p.kind != CriticalKind::Minimum || sharp))
                 .map(|p| end(p.site, false)),
         );
         ends.push(end(component.upper, turning));
