@@ -344,50 +344,46 @@ fn level_offset_error<S: Shape>(
         .iter()
         .map(|p| p.scale)
         .fold(0.0, f64::max);
-    // The rounding of ε − V(c) and of each turning point (one ulp of θ in its chart).
-    let ends = [component.lower, component.upper];
+    // V′, ψ̇ and dψ̇/dθ at the two turning points and the bottom, one evaluation each.
     let chart = |site: &crate::torus::Site| site.theta.min(site.from_pi).abs();
+    let sites = [component.lower, component.upper, bottom.site];
+    let rates: Vec<(f64, (f64, f64, f64))> = sites
+        .iter()
+        .map(|s| (chart(s), potential.slope_and_psi_rates(s.angle())))
+        .collect();
+    // The rounding of ε − V(c) and of each turning point (an ulp of θ in its chart).
     let delta = 4.0 * eps * (scale + energy.abs())
-        + ends
+        + sites[..2]
             .iter()
-            .map(|e| 2.0 * eps * chart(e) * potential.slope(e.angle()).abs())
+            .zip(&rates)
+            .map(|(end, (_, (slope, _, _)))| 2.0 * eps * end.ulp_scale() * slope.abs())
             .sum::<f64>();
     let depth = (energy - bottom.value).max(delta);
-    // ∫|ψ̇| dt, bounded by T max|ψ̇| over the bottom and the ends away from the poles (at an
-    // end near a pole ψ̇ peaks in a sliver of time whose share the relative bounds cover).
-    let far_from_pole = |site: &&crate::torus::Site| chart(site) > 0.1;
+    // Away from the poles (at an end near a pole ψ̇ peaks in a sliver of time whose share
+    // the relative bounds cover): ∫|ψ̇| dt ≤ T max|ψ̇|, and the shift of the orbit by the
+    // rounding of each turning point to a double (an ulp in its chart) moves Δψ by
+    // δθ ∫ |dψ̇/dθ| dt (large against Δψ itself where ψ̇ changes sign inside, round π/2).
+    let far = rates.iter().zip(&sites).filter(|((x, _), _)| *x > 0.1);
     let psi_scale = raw.psi_advance.abs()
-        + 2.0
-            * raw.period
-            * ends
-                .iter()
-                .chain(std::iter::once(&bottom.site))
-                .filter(far_from_pole)
-                .map(|e| potential.psi_rate(e.angle()).abs())
-                .fold(0.0, f64::max);
-    let drift_scale = raw.drift.map_or(0.0, |d| d.scale);
-    // Each turning point is a double, up to an ulp off (in its chart): besides the energy
-    // they shift the orbit, which moves Δψ by δθ ∫ |dψ̇/dθ| dt (large against Δψ itself where
-    // ψ̇ changes sign inside, as round θ = π/2).
+        + 2.0 * raw.period * far.clone().map(|((_, r), _)| r.1.abs()).fold(0.0, f64::max);
     let psi_shift = 2.0
         * eps
         * raw.period
-        * ends
-            .iter()
-            .chain(std::iter::once(&bottom.site))
-            .filter(far_from_pole)
-            .map(|e| chart(e) * potential.psi_rate_slope(e.angle()).abs())
+        * far
+            .map(|((_, r), s)| s.ulp_scale() * r.2.abs())
             .fold(0.0, f64::max);
+    let drift_scale = raw.drift.map_or(0.0, |d| d.scale);
     let crude = EnergyErrors {
         period: 2.0 * delta / depth * raw.period,
         psi_advance: 2.0 * delta / depth * psi_scale + psi_shift,
         drift: 2.0 * delta / depth * drift_scale,
     };
-    let k2 = potential.kappa * potential.kappa;
-    let near_pole = k2 > 0.0
-        && ends.iter().any(|e| {
+    // The wall κ²/(2 sin²θ) a small part of V at an end near a pole: ε and U nearly cancel.
+    let near_pole = potential.kappa != 0.0
+        && sites[..2].iter().any(|e| {
             let a = e.angle();
-            chart(e) < 0.1 && 0.5 * k2 / (a.sin * a.sin) < 1e-3 * potential.value_scale(a)
+            let w = potential.kappa / a.sin;
+            chart(e) < 0.1 && 0.5 * w * w < 1e-3 * potential.value_scale(a)
         });
     let small = |error: f64, allowed: f64| error <= 0.05 * options.tol * allowed;
     if !near_pole

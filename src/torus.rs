@@ -54,6 +54,16 @@ impl Site {
         }
     }
 
+    /// The size the site's rounding is relative to: |θ| where θ is held exactly, else π − θ.
+    #[inline]
+    pub fn ulp_scale(&self) -> f64 {
+        if self.theta_exact {
+            self.theta.abs()
+        } else {
+            self.from_pi
+        }
+    }
+
     /// sin θ and cos θ, from whichever of θ and π − θ is held exactly (PI − θ is off π − θ
     /// by π − PI = 1.2e-16, a 1e-12 relative error of a libration 1e-4 wide beyond π/2).
     #[inline]
@@ -352,19 +362,23 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         -self.kappa * a.cos / (j * a.sin * a.sin)
     }
 
-    /// dψ̇/dθ = κ (sin²θ + 2 cos²θ) / (J sin³θ) + κ cosθ J′ / (J² sin²θ), with
-    /// J′ = ((ν − 1) sinθ cosθ / η + U U′) / J (0 for κ = 0).
-    pub fn psi_rate_slope(&self, a: Angle) -> f64 {
+    /// (V′, ψ̇, dψ̇/dθ) at an angle from one evaluation of the body, with
+    /// dψ̇/dθ = κ (sin²θ + 2 cos²θ) / (J sin³θ) + κ cosθ J′ / (J² sin²θ) and
+    /// J′ = ((ν − 1) sinθ cosθ / η + U U′) / J (ψ̇ and its slope 0 for κ = 0).
+    pub fn slope_and_psi_rates(&self, a: Angle) -> (f64, f64, f64) {
+        let up = self.body.shape.potential_prime_at(a);
         if self.kappa == 0.0 {
-            return 0.0;
+            return (up, 0.0, 0.0);
         }
         let red = self.body.reduction_at(a);
         let j = red.integral_factor;
-        let up = self.body.shape.potential_prime_at(a);
         let jp = ((self.body.nu - 1.0) * a.sin * a.cos / self.body.eta + red.potential * up) / j;
-        let s2 = a.sin * a.sin;
-        self.kappa * (s2 + 2.0 * a.cos * a.cos) / (j * s2 * a.sin)
-            + self.kappa * a.cos * jp / (j * j * s2)
+        let w = self.kappa / a.sin;
+        let cot = a.cos / a.sin;
+        let slope = -w * w * cot + up;
+        let psi = -w * cot / j;
+        let psi_slope = w * (1.0 + 2.0 * cot * cot) / j + w * cot * jp / (j * j);
+        (slope, psi, psi_slope)
     }
 
     fn find_critical_points(&self) -> Vec<CriticalPoint> {
@@ -910,7 +924,7 @@ fn drift_estimate(
         known.push((key, value));
         value
     };
-    DriftEstimate::from_levels(level(0), level(1), level(2))
+    DriftEstimate::from_levels(level(0), level(1), level(2), Convergence::Unknown)
 }
 
 /// Drift sums already made (Δζ and its path scale), by the pieces' levels.
@@ -966,14 +980,19 @@ pub struct DriftEstimate {
 impl DriftEstimate {
     /// The finest of three successive (Δζ, path scale) values, with its error from their
     /// differences by [`cautious_error`].
-    fn from_levels(fine: ([f64; 2], f64), mid: ([f64; 2], f64), coarse: ([f64; 2], f64)) -> Self {
+    fn from_levels(
+        fine: ([f64; 2], f64),
+        mid: ([f64; 2], f64),
+        coarse: ([f64; 2], f64),
+        rate: Convergence,
+    ) -> Self {
         let (d1, d2) = (
             (fine.0[0] - mid.0[0]).hypot(fine.0[1] - mid.0[1]),
             (mid.0[0] - coarse.0[0]).hypot(mid.0[1] - coarse.0[1]),
         );
         Self {
             value: fine.0,
-            error: cautious_error(d1, d2).max(8.0 * EPS * fine.1),
+            error: cautious_error(d1, d2, rate).max(8.0 * EPS * fine.1),
             scale: fine.1,
         }
     }
@@ -1101,7 +1120,10 @@ impl PieceSamples {
     /// Error of the sum of `f`: see [`level_error`], plus the tail beyond |τ| = TAU_MAX.
     fn error(&self, f: impl Fn(&NodeSample) -> f64) -> f64 {
         let tail = self.step() * (f(&self.nodes[0]).abs() + f(self.nodes.last().unwrap()).abs());
-        level_error([self.sum(0, &f), self.sum(1, &f), self.sum(2, &f)]) + tail
+        level_error(
+            [self.sum(0, &f), self.sum(1, &f), self.sum(2, &f)],
+            Convergence::Unknown,
+        ) + tail
     }
 
     /// Σ ½ (relative gap error) |f| step: the gap enters t′ as (ε − V)^{−1/2}.
@@ -1145,26 +1167,39 @@ fn interleave(
 }
 
 /// The error of the finest of three successive sums of a nested rule (finest first), from
-/// the level differences d₁ = |I₀ − I₁| and d₂ = |I₁ − I₂| by [`cautious_error`], for the
-/// tanh-sinh rule (whose errors square from level to level once converging, but not in the
-/// first levels near a separatrix: d₁²/d₂ was 7× short at tol 1e-6 there) and the trapezoid
-/// rule (E(n) = C ρⁿ would allow d₁²/d₂, but not with singularities at several distances).
-fn level_error(sums: [f64; 3]) -> f64 {
+/// the level differences d₁ = |I₀ − I₁| and d₂ = |I₁ − I₂| by [`cautious_error`].
+fn level_error(sums: [f64; 3], rate: Convergence) -> f64 {
     let (d1, d2) = ((sums[0] - sums[1]).abs(), (sums[1] - sums[2]).abs());
-    cautious_error(d1, d2).max(8.0 * EPS * sums[0].abs())
+    cautious_error(d1, d2, rate).max(8.0 * EPS * sums[0].abs())
+}
+
+/// What a rule's level differences may be trusted to say about the next level.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Convergence {
+    /// One geometric rate once past the first levels: the trapezoid rule in the plain cosine
+    /// map, whose integrand's nearest singularities (the poles, the shape's, complex turning
+    /// points) set a single strip. Over the whole domain against 50-digit values (issue 12,
+    /// 431 cells) it never fell short of d₁ max(√r, 1/10).
+    Geometric,
+    /// Possibly several rates: the tanh-sinh rule (its first levels near a separatrix are
+    /// pre-asymptotic: d₁²/d₂ was 7× short at tol 1e-6) and the Mercator map, which spreads a
+    /// pole over a long s-range (E₀/d₁ = 0.54 after r = 5e-7, κ = −2.5e-5 at high energy).
+    Unknown,
 }
 
 /// The error of the finest of three successive sums of a nested rule from the level
-/// differences d₁ ≈ E₁ and d₂ ≈ E₂ of the two coarser ones. With r = d₁/d₂, E₀ = d₁ r²
-/// under E(n) = C ρⁿ, but an integrand with singularities at several distances converges
-/// fast at first and slower later, and the first levels may not be in the asymptotic regime
-/// at all (seen on random cells: r = 9e-4 followed by E₀/E₁ = 2e-3 for T, r = 2e-5 followed
-/// by 1e-2 for the drift, and over the whole domain against 50-digit values E₀/d₁ up to 0.54
-/// at small κ and high energy after r ≤ 0.01). So no extrapolation is trusted: the estimate
-/// is the last level difference d₁ itself, which bounds E₀ whenever the levels improve.
-/// Used for T, Δψ and Δζ by either rule.
-fn cautious_error(d1: f64, _d2: f64) -> f64 {
-    d1
+/// differences d₁ ≈ E₁ and d₂ ≈ E₂ of the two coarser ones, r = d₁/d₂. Under E(n) = C ρⁿ,
+/// E₀ = d₁ r², but the first levels may not be in the asymptotic regime (seen on random
+/// cells: r = 9e-4 followed by E₀/E₁ = 2e-3 for T, r = 2e-5 followed by 1e-2 for the
+/// drift), so a [`Convergence::Geometric`] rule gets d₁ max(√r, 1/10) — never more than one
+/// digit beyond the last difference — and d₁ itself until r ≤ 0.01. Any other rule gets d₁,
+/// which bounds E₀ whenever the levels improve. Used for T, Δψ and Δζ by either rule.
+fn cautious_error(d1: f64, d2: f64, rate: Convergence) -> f64 {
+    if rate == Convergence::Geometric && d2 > 0.0 && d1 <= 0.01 * d2 {
+        d1 * (d1 / d2).sqrt().max(0.1)
+    } else {
+        d1
+    }
 }
 
 /// The integrands at one tanh-sinh node of a piece.
@@ -1242,10 +1277,12 @@ fn weighted<S: Shape>(
     let (dpsi, along) = if v.kappa == 0.0 {
         (0.0, 0.0)
     } else {
-        // ω3 dt / sin θ = (κ / sin θ) dt / J: κ/sinθ first, as κ dt may underflow where both
-        // are 1e-170 (a turning point that close to a pole).
-        let w3_dt = (v.kappa / a.sin) * dt / red.integral_factor;
-        (-w3_dt * a.cos / a.sin, red.potential * w3_dt)
+        // ω3 dt / sin θ = κ dt / (J sin θ), with one division, κ times 1/(J sin θ) first:
+        // κ dt may underflow where both are 1e-170 (a turning point that close to a pole).
+        let inv_j_sin = 1.0 / (red.integral_factor * a.sin);
+        let w3_dt = (v.kappa * inv_j_sin) * dt;
+        let cot = a.cos * (inv_j_sin * red.integral_factor);
+        (-w3_dt * cot, red.potential * w3_dt)
     };
     NodeSample {
         dt,
@@ -1274,10 +1311,15 @@ fn divided_difference<S: Shape>(
     let dk = if v.kappa == 0.0 {
         0.0
     } else {
-        // −½ (κ/sin e)(κ/sin t) (sin(t + e)/sin e) / sin t: no under- or overflow for
-        // angles near a pole at the tiniest κ.
         let sin_sum = t.sin * e.cos + t.cos * e.sin;
-        -0.5 * (v.kappa / e.sin) * (v.kappa / t.sin) * (sin_sum / e.sin) / t.sin
+        let sines = e.sin * t.sin;
+        if sines > 1e-100 && v.kappa.abs() > 1e-100 {
+            -v.kappa * v.kappa * sin_sum / (2.0 * sines * sines)
+        } else {
+            // −½ (κ/sin e)(κ/sin t)(sin(t + e)/sin e)/sin t: no under- or overflow for angles
+            // near a pole at the tiniest κ.
+            -0.5 * (v.kappa / e.sin) * (v.kappa / t.sin) * (sin_sum / e.sin) / t.sin
+        }
     };
     (dk + du, dk.abs() + du_scale)
 }

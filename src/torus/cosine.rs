@@ -6,8 +6,8 @@
 //! at small κ) it stops early and the tanh-sinh path of the parent module takes over.
 
 use super::{
-    interleave, level_error, sample, weighted, Component, DriftEstimate, EffectivePotential,
-    NodeSample, PeriodIntegrals, Piece, EPS, HIDDEN_PEAK,
+    interleave, level_error, sample, weighted, Component, Convergence, DriftEstimate,
+    EffectivePotential, NodeSample, PeriodIntegrals, Piece, EPS, HIDDEN_PEAK,
 };
 use crate::body::{Angle, Shape};
 use crate::error::Result;
@@ -69,8 +69,9 @@ fn integrate_on<S: Shape>(
         let sums = samples.level_sums();
         let (t_sums, psi_sums) = (sums.t, sums.psi);
         let period = 2.0 * t_sums[0];
-        let t_error = 2.0 * level_error(t_sums);
-        let psi_error = 2.0 * level_error(psi_sums);
+        let rate = map.convergence();
+        let t_error = 2.0 * level_error(t_sums, rate);
+        let psi_error = 2.0 * level_error(psi_sums, rate);
         // The quadrature gets what the tolerance leaves of the whole error estimate after the
         // rounding of the gap and the conditioning near a saddle, which refining cannot
         // reduce (when those alone exceed it, a tenth of them: the status then says so).
@@ -85,7 +86,7 @@ fn integrate_on<S: Shape>(
         // Rounding in T and Δψ enters the drift through the phases and the weights.
         let phase = (extra_t - saddle_t) / period + extra_psi;
         // The drift (the costly part) only once T and Δψ have converged.
-        let drift = (done && with_drift).then(|| samples.drift());
+        let drift = (done && with_drift).then(|| samples.drift(rate));
         done &= drift.is_none_or(|d| d.error <= budget(tol * d.scale, phase * d.scale));
         let drift = drift.map(|mut d| {
             d.error += phase * d.scale;
@@ -105,7 +106,7 @@ fn integrate_on<S: Shape>(
         if done || (hopeless && beyond_tanh_sinh && settled(t_sums) && settled(psi_sums)) {
             let drift = match drift {
                 None if with_drift => {
-                    let mut d = samples.drift();
+                    let mut d = samples.drift(rate);
                     d.error += phase * d.scale;
                     Some(d)
                 }
@@ -214,10 +215,10 @@ impl Samples {
     /// Δζ on this level, with its error from the two levels below, each computed from
     /// scratch (its own ψ̃ and phases: reusing this level's would hide ψ̃'s aliasing, which
     /// Δψ's estimate does not bound, ĥ₀ converging faster than the higher coefficients).
-    fn drift(&mut self) -> DriftEstimate {
+    fn drift(&mut self, rate: Convergence) -> DriftEstimate {
         let fine = self.level_drift(1);
         let mid = self.level_drift(2);
-        DriftEstimate::from_levels(fine, mid, self.level_drift(4))
+        DriftEstimate::from_levels(fine, mid, self.level_drift(4), rate)
     }
 }
 
@@ -271,6 +272,14 @@ enum Map {
 }
 
 impl Map {
+    /// How far the map's level differences may be trusted ([`Convergence`]).
+    fn convergence(&self) -> Convergence {
+        match self {
+            Map::Plain { .. } => Convergence::Geometric,
+            Map::Mercator { .. } => Convergence::Unknown,
+        }
+    }
+
     /// The maps to try in turn: the plain one, then (κ ≠ 0 and a turning point closer to
     /// its pole than the libration is long) Mercator's. Mercator's coarsens the middle of a
     /// long libration, where the shape's own singularities may lie close to the real axis
