@@ -198,19 +198,23 @@ impl Ellipsoid {
     }
 
     /// (U, w) = (Z + α cosθ, cosθ + αZ) at an angle, with Z = `z`, to full relative precision
-    /// also where they cancel (cosθ < 0 and α → 1, near θ = π): there Z + α cosθ =
-    /// β² sin²θ / (Z + |cosθ|) + (1 − α)|cosθ| and cosθ + αZ = β² sin²θ / (Z + |cosθ|) −
-    /// (1 − α) Z, from Z² − cos²θ = β² sin²θ (1 − α is exact for α ≥ ½).
+    /// also where they cancel (α cosθ < 0 and |α| → 1: near θ = π for α → 1, near θ = 0 for
+    /// α → −1): with L = β² sin²θ / (Z + |cosθ|) = Z − |cosθ| (from Z² − cos²θ = β² sin²θ),
+    /// Z + α cosθ = L + (1 − |α|)|cosθ| and cosθ + αZ = sgn α (L − (1 − |α|) Z) (1 − |α| is
+    /// exact for |α| ≥ ½).
     #[inline]
     pub fn height_and_offset_at(&self, a: Angle, z: f64) -> (f64, f64) {
-        // For α ≤ ½, Z + α cosθ ≥ Z/2 (Z ≥ |cosθ|): no cancellation, and a symmetric
+        // For |α| ≤ ½, Z + α cosθ ≥ Z/2 (Z ≥ |cosθ|): no cancellation, and a symmetric
         // body (α = 0) keeps U(π − θ) = U(θ) exactly.
-        if a.cos >= 0.0 || self.alpha <= 0.5 {
+        if self.alpha * a.cos >= 0.0 || self.alpha.abs() <= 0.5 {
             return (z + self.alpha * a.cos, a.cos + self.alpha * z);
         }
-        let lift = self.beta * self.beta * a.sin * a.sin / (z - a.cos);
-        let rest = 1.0 - self.alpha;
-        (lift - rest * a.cos, lift - rest * z)
+        let lift = self.beta * self.beta * a.sin * a.sin / (z + a.cos.abs());
+        let rest = 1.0 - self.alpha.abs();
+        (
+            lift + rest * a.cos.abs(),
+            self.alpha.signum() * (lift - rest * z),
+        )
     }
 
     /// Z at an angle given by its sine and cosine.
@@ -451,5 +455,42 @@ mod tests {
         assert!(Body::new(Ellipsoid::new(0.5, 3.0).unwrap(), 2.5, 1.0).is_err());
         assert!(Body::new(Ellipsoid::new(0.5, 3.0).unwrap(), 0.5, -1.0).is_err());
         assert!(EllipsoidBody::ellipsoid(0.5, 3.0, 2.0, 0.5).is_ok());
+    }
+
+    /// U = Z + α cosθ and w = cosθ + αZ where they cancel (|α| → 1 at the pole where α cosθ
+    /// < 0: θ = π for α > 0, θ = 0 for α < 0), against their Taylor series in the distance x
+    /// to that pole (truncated at x⁸, far below 1e-15 of U for x ≤ 1e-3).
+    #[test]
+    fn height_keeps_full_precision_where_z_and_alpha_cos_cancel() {
+        for alpha in [0.999999, -0.999999, 0.75, -0.6] {
+            for beta in [0.44, 1.0, 1.4142132] {
+                let shape = Ellipsoid::new(alpha, beta).unwrap();
+                let a = f64::abs(alpha);
+                for x in [1e-3, 1e-5, 1e-8, 0.0] {
+                    let angle = if alpha > 0.0 {
+                        Angle::from_pi(x)
+                    } else {
+                        Angle::new(x)
+                    };
+                    let q = (beta * beta - 1.0) * x.sin().powi(2);
+                    let z_minus_1 = q / 2.0 - q * q / 8.0 + q * q * q / 16.0;
+                    let one_minus_cos = x * x / 2.0 - x.powi(4) / 24.0 + x.powi(6) / 720.0;
+                    // U = (1 − |α|) + (Z − 1) + |α| (1 − cos x).
+                    let u = (1.0 - a) + z_minus_1 + a * one_minus_cos;
+                    // w = sgn α (|α| Z − cos x) = sgn α (−(1 − |α|) + |α| (Z − 1) + (1 − cos x)).
+                    let w = alpha.signum() * (-(1.0 - a) + a * z_minus_1 + one_minus_cos);
+                    // Full precision: a few ulps of the L1 size of the series' terms.
+                    let size = (1.0 - a) + z_minus_1.abs() + one_minus_cos;
+                    let z = shape.centre_height_at(angle);
+                    let (u_got, w_got) = shape.height_and_offset_at(angle, z);
+                    for (got, want, name) in [(u_got, u, "U"), (w_got, w, "w")] {
+                        assert!(
+                            (got - want).abs() <= 4.0 * f64::EPSILON * size,
+                            "{name} at α = {alpha}, β = {beta}, x = {x}: {got} vs {want}"
+                        );
+                    }
+                }
+            }
+        }
     }
 }

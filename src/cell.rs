@@ -315,6 +315,16 @@ struct EnergyErrors {
     drift: f64,
 }
 
+impl EnergyErrors {
+    fn plus(self, other: Self) -> Self {
+        Self {
+            period: self.period + other.period,
+            psi_advance: self.psi_advance + other.psi_advance,
+            drift: self.drift + other.drift,
+        }
+    }
+}
+
 /// The error of a libration's integrals from the level of its turning points: they are the
 /// roots of V − ε measured from a critical point c inside, ε − V(c) − (V(θ) − V(c)), whose
 /// constant term carries the rounding of V(c) (a few ulps of its L1 size, whatever the gap)
@@ -359,6 +369,25 @@ fn level_offset_error<S: Shape>(
             .map(|(end, (_, (slope, _, _)))| 2.0 * eps * end.ulp_scale() * slope.abs())
             .sum::<f64>();
     let depth = (energy - bottom.value).max(delta);
+    // The two ends' levels V(e) differ from ε by their own rounding, so the integrals are
+    // taken against a level tilted across the libration by m ≤ δε / L. Their response,
+    // dX/dm = −d(X ⟨θ − θ_mid⟩)/dε (⟨⟩ the time average), is at most (L/2)|dX/dε| (in the
+    // level term) plus ‖X‖ |d⟨θ⟩/dε|, and the average moves no faster than the faster end,
+    // |dθ_end/dε| = 1/|V′|: an error δε ‖X‖ max(1/|V′|) / L. (Against 30-digit quadrature
+    // of a tilted cubic well the two terms were 1.03–27× the true dT/dm, tightest next to
+    // the saddle, where the level term carries it; the level term below is 4× that.)
+    let length = potential
+        .separation(&component.lower, &component.upper)
+        .abs();
+    let tilt = if length > 0.0 {
+        delta / length
+            * rates[..2]
+                .iter()
+                .map(|(_, r)| 1.0 / r.0.abs())
+                .fold(0.0, f64::max)
+    } else {
+        0.0
+    };
     // Away from the poles (at an end near a pole ψ̇ peaks in a sliver of time whose share
     // the relative bounds cover): ∫|ψ̇| dt ≤ T max|ψ̇|, and the shift of the orbit by the
     // rounding of each turning point to a double (an ulp in its chart) moves Δψ by
@@ -373,6 +402,11 @@ fn level_offset_error<S: Shape>(
             .map(|((_, r), s)| s.ulp_scale() * r.2.abs())
             .fold(0.0, f64::max);
     let drift_scale = raw.drift.map_or(0.0, |d| d.scale);
+    let tilted = EnergyErrors {
+        period: tilt * raw.period,
+        psi_advance: tilt * psi_scale,
+        drift: tilt * drift_scale,
+    };
     let crude = EnergyErrors {
         period: 2.0 * delta / depth * raw.period,
         psi_advance: 2.0 * delta / depth * psi_scale + psi_shift,
@@ -391,7 +425,7 @@ fn level_offset_error<S: Shape>(
         && small(crude.psi_advance, TAU)
         && small(crude.drift, drift_scale)
     {
-        return crude;
+        return crude.plus(tilted);
     }
     // The step stays well inside the family: below a quarter of the depth and of the
     // distance to every saddle at or next to the component.
@@ -404,7 +438,7 @@ fn level_offset_error<S: Shape>(
         .fold(f64::INFINITY, f64::min);
     let h = (256.0 * delta).min(0.25 * depth).min(0.25 * saddles);
     if h < 16.0 * delta {
-        return crude;
+        return crude.plus(tilted);
     }
     let at = |e: f64| -> Option<PeriodIntegrals> {
         integrate(
@@ -416,7 +450,7 @@ fn level_offset_error<S: Shape>(
         .ok()
     };
     let (Some(up), Some(down)) = (at(energy + h), at(energy - h)) else {
-        return crude;
+        return crude.plus(tilted);
     };
     // |dX/dε| from the larger one-sided difference, twice over, plus the differences'
     // own errors.
@@ -446,6 +480,7 @@ fn level_offset_error<S: Shape>(
         ) + psi_shift,
         drift,
     }
+    .plus(tilted)
 }
 
 fn finish(component: &Component, raw: PeriodIntegrals, options: &CellOptions) -> ComponentResult {
@@ -455,7 +490,12 @@ fn finish(component: &Component, raw: PeriodIntegrals, options: &CellOptions) ->
     let n = -raw.psi_advance / TAU;
     let rel_t = raw.period_error / t;
     let n_err = raw.psi_advance_error / TAU;
+    // A libration with ψ ≡ 0 (κ = 0) retraces its way out on the way back: Δζ = 0 exactly.
+    let planar = component.kind == MotionKind::Libration
+        && raw.psi_advance == 0.0
+        && raw.psi_advance_error == 0.0;
     let (drift, drift_error, drift_vector) = match raw.drift {
+        Some(d) if planar && d.value == [0.0, 0.0] => (0.0, 0.0, d.value),
         Some(d) => (d.value[0].hypot(d.value[1]), d.error, d.value),
         None => (f64::NAN, f64::NAN, [f64::NAN; 2]),
     };
@@ -535,15 +575,22 @@ fn unresolved(component: &Component) -> ComponentResult {
     }
 }
 
-/// R = |Δζ| / (2 |sin πN|) and its error; R = 0 when Δζ = 0 exactly (κ = 0 librations).
+/// R = |Δζ| / (2 |sin πN|) and its error; R = 0 when Δζ = 0 exactly (κ = 0 librations),
+/// with the error |δΔζ| / (2 |sin πN|): unbounded (∞) at N = 0, where any drift the
+/// rounding hides would be a straight line.
 fn drift_radius(drift: f64, drift_error: f64, n: f64, n_error: f64) -> (f64, f64) {
     if drift.is_nan() {
         return (f64::NAN, f64::NAN);
     }
     if drift == 0.0 {
+        let s = (PI * n).sin().abs();
         return (
             0.0,
-            drift_error / (2.0 * (PI * n).sin().abs()).max(f64::MIN_POSITIVE),
+            if drift_error == 0.0 {
+                0.0
+            } else {
+                drift_error / (2.0 * s)
+            },
         );
     }
     let s = (PI * n).sin().abs();

@@ -54,13 +54,14 @@ impl Site {
         }
     }
 
-    /// The size the site's rounding is relative to: |θ| where θ is held exactly, else π − θ.
+    /// The size the site's rounding is relative to: |θ| where θ is held exactly, else
+    /// |π − θ| (negative beyond π on the κ = 0 circle).
     #[inline]
     pub fn ulp_scale(&self) -> f64 {
         if self.theta_exact {
             self.theta.abs()
         } else {
-            self.from_pi
+            self.from_pi.abs()
         }
     }
 
@@ -248,23 +249,21 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         }
     }
 
-    /// θ_b − θ_a to one rounding, whatever chart each site is held in: for κ ≠ 0 a site
-    /// beyond π/2 holds π − θ exactly and its θ only rounded (an ulp of π, which against a
-    /// libration 1e-8 wide round π/2 is a 2e-8 relative error of its length); on the κ = 0
-    /// circle every site holds θ.
+    /// θ_b − θ_a to one rounding, whatever chart each site is held in: a site held as π − θ
+    /// has its θ only rounded (an ulp of π, which against a libration 1e-8 wide round π/2 is
+    /// a 2e-8 relative error of its length, and against one 1e-3 wide round π at κ = 0 and
+    /// α → 1 was a 3e-14 error of T), so the difference is taken in the chart both sites are
+    /// exact in, or across π/2 with π split into two doubles.
     pub fn separation(&self, a: &Site, b: &Site) -> f64 {
         // π = PI + PI_LOW to 2⁻¹⁰⁶.
         const PI_LOW: f64 = 1.2246467991473532e-16;
-        if self.kappa == 0.0 {
-            return b.theta - a.theta;
-        }
-        match (a.theta > FRAC_PI_2, b.theta > FRAC_PI_2) {
-            (true, true) => a.from_pi - b.from_pi,
-            (false, false) => b.theta - a.theta,
-            // PI − θ is exact for θ in [1, π/2] (both multiples of 2⁻⁵² below 2) and the
-            // second difference by Sterbenz's lemma when the sites are close.
-            (false, true) => ((PI - a.theta) - b.from_pi) + PI_LOW,
-            (true, false) => -(((PI - b.theta) - a.from_pi) + PI_LOW),
+        match (a.theta_exact, b.theta_exact) {
+            (true, true) => b.theta - a.theta,
+            (false, false) => a.from_pi - b.from_pi,
+            // PI − θ is exact for θ in [π/2, 2π] and the second difference when the sites
+            // are close (Sterbenz's lemma); elsewhere one rounding.
+            (true, false) => ((PI - a.theta) - b.from_pi) + PI_LOW,
+            (false, true) => -(((PI - b.theta) - a.from_pi) + PI_LOW),
         }
     }
 
@@ -339,18 +338,34 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         zeros
     }
 
-    /// A sign change of `f` between two neighbouring scan sites, bisected to the last bit in
-    /// the chart of the site nearer its pole (π/2 belongs to both).
+    /// A sign change of `f` between two sites, bisected to the last bit in θ on (0, π/2] and
+    /// in π − θ on [π/2, π), so that a zero keeps its relative precision at either pole; a
+    /// bracket across π/2 is first cut there. (Bisected in the chart of the bracket's right
+    /// end, a critical point 4e-4 from θ = 0 was held only to an ulp of π, which put the
+    /// turning points beside it 5e-14 off at α → −1.)
     fn bisect_sites(&self, f: &impl Fn(Angle) -> f64, a: Site, b: Site) -> Site {
-        let right = b.theta > FRAC_PI_2;
-        let (lo, hi) = if right {
-            (b.from_pi, a.from_pi)
-        } else {
-            (a.theta, b.theta)
+        let in_theta = |lo: f64, hi: f64| {
+            let f_lo = f(Site::at(lo).angle());
+            Site::at(bisect(&|x| f(Site::at(x).angle()), lo, hi, f_lo < 0.0))
         };
-        let site = |x: f64| if right { Site::from_pi(x) } else { Site::at(x) };
-        let f_lo = f(site(lo).angle());
-        site(bisect(&|x| f(site(x).angle()), lo, hi, f_lo < 0.0))
+        let in_phi = |lo: f64, hi: f64| {
+            let f_lo = f(Site::from_pi(lo).angle());
+            Site::from_pi(bisect(&|x| f(Site::from_pi(x).angle()), lo, hi, f_lo < 0.0))
+        };
+        if b.theta <= FRAC_PI_2 {
+            return in_theta(a.theta, b.theta);
+        }
+        if a.theta >= FRAC_PI_2 {
+            return in_phi(b.from_pi, a.from_pi);
+        }
+        let middle = f(Site::at(FRAC_PI_2).angle());
+        if middle == 0.0 {
+            Site::at(FRAC_PI_2)
+        } else if (middle < 0.0) != (f(a.angle()) < 0.0) {
+            in_theta(a.theta, FRAC_PI_2)
+        } else {
+            in_phi(b.from_pi, FRAC_PI_2)
+        }
     }
 
     /// ψ̇ = −κ cosθ / (J sin²θ) at an angle (0 for κ = 0).
@@ -413,7 +428,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             roots
         } else {
             // On the circle [0, 2π): θ = 0 and π always, the roots and their mirror images,
-            // every site holding θ itself.
+            // θ itself held but for π.
             let mut t: Vec<f64> = roots
                 .iter()
                 .map(|s| s.theta)
@@ -423,7 +438,16 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             t.insert(0, 0.0);
             t.push(PI);
             t.extend(mirrored);
-            t.into_iter().map(Site::at).collect()
+            // θ = π held as π − θ = 0: exactly the pole, where PI is 1.2e-16 short of it.
+            t.into_iter()
+                .map(|x| {
+                    if x == PI {
+                        Site::from_pi(0.0)
+                    } else {
+                        Site::at(x)
+                    }
+                })
+                .collect()
         };
         let mut points: Vec<CriticalPoint> = sites
             .into_iter()
@@ -493,7 +517,11 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 .max_by(|a, b| a.1.value.total_cmp(&b.1.value))
                 .expect("θ = 0 and π are always critical on the circle");
             let lift = |p: &CriticalPoint, by: f64| CriticalPoint {
-                site: Site::at(p.site.theta + by),
+                site: if by == 0.0 {
+                    p.site
+                } else {
+                    Site::at(p.site.theta + by)
+                },
                 ..*p
             };
             // Keep lifted angles near [−π, π] so that components around θ = 0 straddle it.
@@ -652,7 +680,11 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         let f_left = |x: f64| level(Site::at(x));
         // The sign of V − ε at a node is known (a pole is +∞): no evaluation needed there.
         let below = |n: &Option<CriticalPoint>| n.is_some_and(|p| p.value < energy);
-        if self.kappa == 0.0 || hi <= FRAC_PI_2 {
+        // Beyond π/2 the root is sought in π − θ, for κ = 0 too (where the circle's lifted
+        // θ ≤ 2π keeps PI − θ exact): a libration round θ = π at κ = 0 may be as narrow as
+        // one at a pole for κ ≠ 0 (1e-3 wide as α → 1), and an ulp of π in each turning
+        // point would be a 3e-13 relative uncertainty of its length.
+        if hi <= FRAC_PI_2 {
             return Site::at(safe_newton(f_left, lo, hi, below(a), start_theta));
         }
         let f_right = |phi: f64| {
@@ -841,20 +873,20 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
     /// The pieces of a component: cut at the ends and, if `cut`, at every interior maximum or
     /// tangency.
     fn pieces(&self, energy: f64, component: &Component, cut: bool) -> Vec<Piece> {
-        let end = |site: Site, turning: bool| PieceEnd {
-            site,
-            angle: site.angle(),
-            excess: if turning {
-                0.0
-            } else {
-                energy - self.value(site.angle())
-            },
-            // ε − V(e) carries the rounding of V(e) and of the subtraction.
-            excess_error: if turning {
-                0.0
-            } else {
-                4.0 * EPS * (self.value_scale(site.angle()) + energy.abs())
-            },
+        let end = |site: Site, turning: bool| {
+            let value = self.value(site.angle());
+            PieceEnd {
+                site,
+                angle: site.angle(),
+                excess: if turning { 0.0 } else { energy - value },
+                level: if turning { value } else { energy },
+                // ε − V(e) carries the rounding of V(e) and of the subtraction.
+                excess_error: if turning {
+                    0.0
+                } else {
+                    4.0 * EPS * (self.value_scale(site.angle()) + energy.abs())
+                },
+            }
         };
         let turning = component.kind == MotionKind::Libration;
         let mut ends = vec![end(component.lower, turning)];
@@ -1033,6 +1065,10 @@ struct PieceEnd {
     angle: Angle,
     /// ε − V at the end: 0 at a turning point (by definition of the end), > 0 at a saddle.
     excess: f64,
+    /// The level V + `excess` the gap is measured against at the end: V(e) at a turning
+    /// point (ε to within the rounding of the root), ε at a saddle. Between the ends the
+    /// level runs linearly (see `Piece::tilt`), in both of `sample`'s forms of the gap.
+    level: f64,
     /// Bound on the rounding error of `excess` (0 at a turning point, whose level is the
     /// gap's zero by construction; the offset of that level from ε is bounded in
     /// [`crate::cell`]).
@@ -1229,11 +1265,13 @@ fn sample<S: Shape>(
         let w = v.kappa / a.sin;
         0.5 * w * w + red.potential
     };
-    let direct = energy - v_t;
-    let direct_err = 4.0 * EPS * (energy.abs() + v_t.abs());
-    let (gap, abs_err) = if 16.0 * direct > energy.abs() + v_t.abs() || cx <= -0.4 {
-        // Far from the ends and from saddles the plain difference loses at most 4 bits.
-        (direct, direct_err)
+    let (gap, abs_err) = if 16.0 * (energy - v_t) > energy.abs() + v_t.abs() || cx <= -0.4 {
+        // Far from the ends and from saddles the plain difference loses at most 4 bits. It
+        // is taken against the same tilted level as the form below: against ε itself the
+        // gap would jump where the forms meet by the ends' offsets from ε (a 4e-13 relative
+        // jump, a 3e-14 error of T, in a libration 1e-3 wide round θ = π at κ = 0).
+        let level = end.level + piece.tilt * signed / piece.length;
+        (level - v_t, 4.0 * EPS * (level.abs() + v_t.abs()))
     } else {
         // ε − V(t) = excess − sin(t − e) D(t, e) + tilt, with D the divided difference of V
         // and the tilt m·(t − e)/L that makes the two ends' levels meet (see `Piece::tilt`).

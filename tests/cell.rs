@@ -269,7 +269,11 @@ fn kappa_zero_librates_below_the_top_and_rolls_away_above() {
                 for c in &r.components {
                     assert_eq!(c.rotation_number, 0.0);
                     assert_eq!(c.bounded, Some(true));
+                    // The way back retraces the way out: no drift, and none hidden by
+                    // rounding, so R = 0 exactly too (not 0 ± ∞ at N = 0).
                     assert_eq!(c.drift, 0.0);
+                    assert_eq!(c.errors.drift, 0.0);
+                    assert_eq!((c.drift_radius, c.errors.drift_radius), (0.0, 0.0));
                 }
             }
         }

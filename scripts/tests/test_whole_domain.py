@@ -46,7 +46,7 @@ def test_reference_finds_the_tiny_well_at_a_pole():
     assert [round(c.theta_min, 7) for c in comps] == [0.0001903, 0.0022367]
 
 
-@pytest.mark.parametrize("case", whole_domain.reproductions(), ids=lambda c: c.origin.split("#")[1])
+@pytest.mark.parametrize("case", whole_domain.reproductions(), ids=lambda c: c.origin.removeprefix("issue 12 #"))
 def test_reproductions_are_right_or_honest(case):
     outcome = whole_domain.check(case)
     assert not outcome.problems, outcome.problems

@@ -98,8 +98,8 @@ fn integrate_on<S: Shape>(
         // With a turning point beyond the tanh-sinh rule's last node (which would hide the ψ̇
         // peak there, an error of up to π in Δψ), the values reached here are kept with
         // their estimates even where they have not converged: the status then says so.
-        let beyond_tanh_sinh =
-            piece.left.site.theta.min(piece.right.site.from_pi) < HIDDEN_PEAK * piece.length;
+        let beyond_tanh_sinh = v.kappa != 0.0
+            && piece.left.site.theta.min(piece.right.site.from_pi) < HIDDEN_PEAK * piece.length;
         // Only sums already in their geometric regime (each level ten times closer), whose
         // last difference bounds the error.
         let settled = |s: [f64; 3]| (s[0] - s[1]).abs() <= 0.1 * (s[1] - s[2]).abs();
