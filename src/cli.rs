@@ -164,6 +164,18 @@ pub struct RunArgs {
     /// Overwrite an existing output and discard an interrupted run.
     #[arg(long)]
     pub force: bool,
+    /// Bring the output up to date (as a Slurm task does): keep it if it was made from this
+    /// scene by this build for this shard, continue an interrupted run of the same, and
+    /// compute afresh (replacing) whatever is stale.
+    #[arg(long, conflicts_with_all = ["force", "resume"])]
+    pub update: bool,
+    /// Print the output path the run would write (the default from the scene's name and
+    /// --shard, or --out) and exit.
+    #[arg(long)]
+    pub print_out: bool,
+    /// Run even where the estimated memory or disk exceeds what this machine has free.
+    #[arg(long)]
+    pub allow_large: bool,
     /// Compute part I of N of the grid (1 <= I <= N) into its own file.
     #[arg(long, value_name = "I/N")]
     pub shard: Option<String>,
@@ -306,6 +318,9 @@ pub struct DiagramArgs {
     /// Samples of θ0 per half (θ0 < π/2, θ0 > π/2) of the fixed-point curves.
     #[arg(long, default_value_t = 2000)]
     pub samples: usize,
+    /// Run even where the estimated memory or disk exceeds what this machine has free.
+    #[arg(long)]
+    pub allow_large: bool,
     /// Truncate the sampled curves at this κ.
     #[arg(long, default_value_t = 3.0, allow_hyphen_values = true)]
     pub kappa_max: f64,
@@ -339,6 +354,9 @@ pub struct TrajectoryArgs {
     /// Number of output intervals (the file has SAMPLES + 1 rows).
     #[arg(long, default_value_t = 2000)]
     pub samples: usize,
+    /// Run even where the estimated memory or disk exceeds what this machine has free.
+    #[arg(long)]
+    pub allow_large: bool,
     /// Relative and absolute tolerance of the DOP853 integrator.
     #[arg(long, default_value_t = 1e-12, allow_hyphen_values = true)]
     pub tol: f64,
@@ -754,10 +772,14 @@ fn run_scene(args: RunArgs) -> Result<()> {
             ))
         }
     });
+    if args.print_out {
+        println!("{}", out.display());
+        return Ok(());
+    }
     // Before any work: never a directory, device, symlink or the scene itself.
     check_output(
         &out,
-        args.force || args.resume,
+        args.force || args.resume || args.update,
         &[&args.scene],
         &ATLAS_EXTENSIONS,
     )?;
@@ -782,6 +804,10 @@ fn run_scene(args: RunArgs) -> Result<()> {
         Some(n) => n.min(std::thread::available_parallelism().map_or(1, |c| c.get())),
         None => std::thread::available_parallelism().map_or(1, |n| n.get()),
     };
+    // Before anything is allocated: a grid the machine cannot hold is refused in one line.
+    if !args.allow_large {
+        check_footprint(&sweep::footprint(&scene, shard, threads), &out)?;
+    }
     // The global pool, so that the run's serial parts (file creation, writing) stay on the
     // main thread: on a pool thread glibc grows that thread's heap a page at a time, and
     // creating the HDF5 file took 7 ms of mprotect calls instead of 1.
@@ -793,16 +819,137 @@ fn run_scene(args: RunArgs) -> Result<()> {
         out: out.clone(),
         resume: args.resume,
         force: args.force,
+        update: args.update,
         shard,
         attributes: invocation_attributes(),
     };
+    crate::stop::install().context("cannot install the SIGINT and SIGTERM handlers")?;
     let reporter = Reporter::new(args.quiet, &scene.name);
-    let summary = sweep::run(&scene, &request, &reporter)?;
+    let summary = match sweep::run(&scene, &request, &reporter) {
+        Err(AtlasError::Interrupted { done, total, .. }) => {
+            reporter.finish();
+            let (signal, status) = crate::stop::received();
+            let shard_arg = match &args.shard {
+                Some(text) => format!(" --shard {text}"),
+                None => String::new(),
+            };
+            eprintln!(
+                "rubber-atlas: stopped by {signal} with {done} of {total} cells computed and kept in {}; continue with: rubber-atlas run {}{shard_arg} --out {} --resume",
+                rubber_atlas::store::journal::Journal::dir_for(&out).display(),
+                args.scene.display(),
+                out.display(),
+            );
+            std::process::exit(i32::from(status));
+        }
+        result => result?,
+    };
     reporter.finish();
+    if summary.up_to_date {
+        if !args.quiet {
+            println!(
+                "{} is complete and current (this scene, this build); nothing to do",
+                out.display()
+            );
+        }
+        return Ok(());
+    }
     if !args.quiet {
         print_summary(&summary, &out, threads);
     }
     Ok(())
+}
+
+/// Bytes as a person reads them: 1.5 GB, 310 MB.
+fn show_bytes(bytes: f64) -> String {
+    let units = [("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("kB", 1e3)];
+    match units.iter().find(|(_, size)| bytes >= *size) {
+        Some((name, size)) => format!("{:.3} {name}", bytes / size)
+            .replace(".000 ", " ")
+            .to_string(),
+        None => format!("{bytes:.0} B"),
+    }
+}
+
+/// Memory the kernel could give this process now (MemAvailable), if it says.
+fn available_memory() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024.0)
+}
+
+/// Free space for an unprivileged user in the folder that will hold `out`.
+fn free_disk(out: &std::path::Path) -> Option<f64> {
+    use std::os::unix::ffi::OsStrExt;
+    let dir = match out.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => std::path::Path::new("."),
+    };
+    let c_path = std::ffi::CString::new(dir.as_os_str().as_bytes()).ok()?;
+    // SAFETY: statvfs fills the zeroed struct from a valid NUL-terminated path.
+    let mut stat: libc::statvfs = unsafe { std::mem::zeroed() };
+    if unsafe { libc::statvfs(c_path.as_ptr(), &mut stat) } != 0 {
+        return None;
+    }
+    Some(stat.f_bavail as f64 * stat.f_frsize as f64)
+}
+
+/// Refuses work whose estimated peak `memory` (over 80 % of what is available) or `disk`
+/// for `out` (over what is free there) exceeds the machine, in one line with both figures,
+/// the `remedy` and --allow-large.
+fn check_resources(
+    memory: f64,
+    disk: Option<f64>,
+    out: Option<&std::path::Path>,
+    remedy: &str,
+) -> Result<()> {
+    let mut short = Vec::new();
+    if let Some(free) = available_memory().filter(|&free| memory > 0.8 * free) {
+        short.push(format!(
+            "about {} of memory ({} available)",
+            show_bytes(memory),
+            show_bytes(free)
+        ));
+    }
+    if let (Some(disk), Some(out)) = (disk, out) {
+        if let Some(free) = free_disk(out).filter(|&free| disk > free) {
+            short.push(format!(
+                "up to {} of disk ({} free there)",
+                show_bytes(disk),
+                show_bytes(free)
+            ));
+        }
+    }
+    if short.is_empty() {
+        return Ok(());
+    }
+    Err(AtlasError::Atlas {
+        path: out.map_or("the request".into(), |o| o.display().to_string()),
+        reason: format!(
+            "needs {}; {remedy}; --allow-large runs it anyway",
+            short.join(" and ")
+        ),
+    }
+    .into())
+}
+
+/// [`check_resources`] for a run, suggesting how many shards would fit in memory.
+fn check_footprint(need: &sweep::Footprint, out: &std::path::Path) -> Result<()> {
+    let shards = available_memory().map_or(1.0, |free| (need.memory_bytes / (0.5 * free)).ceil());
+    let split = if shards > 1.0 {
+        format!("split it with --shard I/N (N >= {shards:.0}) across machines, or ")
+    } else {
+        String::new()
+    };
+    check_resources(
+        need.memory_bytes,
+        Some(need.disk_bytes),
+        Some(out),
+        &format!(
+            "the run has {:.3e} cells: {split}use fewer kappa or energy points",
+            need.cells
+        ),
+    )
 }
 
 fn merge(args: MergeArgs) -> Result<()> {
@@ -990,6 +1137,13 @@ fn diagram(args: DiagramArgs) -> Result<()> {
     if let Some(out) = &args.out {
         check_output(out, args.force, &[], &TABLE_EXTENSIONS)?;
     }
+    if !args.allow_large {
+        // Measured: 245 bytes of memory per sample at the peak, 2 points per sample of
+        // about 150 bytes each in a CSV file.
+        let memory = 300.0 * args.samples as f64;
+        let disk = args.out.as_ref().map(|_| 300.0 * args.samples as f64);
+        check_resources(memory, disk, args.out.as_deref(), "use fewer --samples")?;
+    }
     let body = EllipsoidBody::ellipsoid(args.shape.alpha, args.shape.beta, args.nu, args.eta)?;
     let set = CriticalSet::of(&body, args.samples, args.kappa_max)?;
     if args.json {
@@ -1173,6 +1327,17 @@ fn trajectory(args: TrajectoryArgs) -> Result<()> {
             reason: "must be >= 1",
         }
         .into());
+    }
+    if !args.allow_large {
+        // Measured: 135 bytes of memory per sample at the peak; a CSV row of 10 columns
+        // is under 250 bytes.
+        let rows = args.samples as f64 + 1.0;
+        check_resources(
+            160.0 * rows,
+            Some(250.0 * rows),
+            Some(&args.out),
+            "use fewer --samples",
+        )?;
     }
     let start = match (args.start.energy, args.start.theta0) {
         (Some(e), None) => {

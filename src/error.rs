@@ -42,6 +42,13 @@ pub enum AtlasError {
     /// An atlas file, a shard or a resume journal that cannot be used as asked.
     #[error("{path}: {reason}")]
     Atlas { path: String, reason: String },
+    /// Another process is writing the same output.
+    #[error("{path}: {reason}")]
+    Busy { path: String, reason: String },
+    /// A run was asked to stop (SIGINT, SIGTERM): the units computed so far are in the
+    /// journal and a resumed run continues from them.
+    #[error("{path}: interrupted with {done} of {total} cells computed and kept")]
+    Interrupted { path: String, done: u64, total: u64 },
 }
 
 impl AtlasError {

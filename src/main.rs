@@ -1,9 +1,11 @@
 //! The `rubber-atlas` command: parses the command line (see [`cli`]), runs it, and maps the
 //! outcome to an exit code: 0 success, 2 bad input (one line naming the bad value), 1 a
-//! computation that failed.
+//! computation that failed, 75 an output another process is writing, 130 / 143 a run
+//! stopped by SIGINT / SIGTERM (its journal kept for --resume).
 
 mod cli;
 mod progress;
+mod stop;
 
 use clap::Parser;
 use std::process::ExitCode;
@@ -44,7 +46,16 @@ fn main() -> ExitCode {
     match cli::run(args) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", one_line(&format!("{e:#}")));
+            if e.chain().any(|c| {
+                matches!(
+                    c.downcast_ref::<rubber_atlas::AtlasError>(),
+                    Some(rubber_atlas::AtlasError::Busy { .. })
+                )
+            }) {
+                // EX_TEMPFAIL: try again once the other process is done.
+                return ExitCode::from(75);
+            }
             let bad_input = e.chain().any(|c| {
                 matches!(
                     c.downcast_ref::<rubber_atlas::AtlasError>(),
@@ -61,5 +72,40 @@ fn main() -> ExitCode {
             });
             ExitCode::from(if bad_input { 2 } else { 1 })
         }
+    }
+}
+
+/// An error message on one line. HDF5's failed-write message carries a ctime() stamp (with
+/// its newline) and a dump of the write call around the system's own message, which is what
+/// a user needs: "… file write failed: No space left on device".
+fn one_line(text: &str) -> String {
+    let mut text = text.replace('\n', " ");
+    let start = text.find("file write failed: time = ");
+    let message = text.find("error message = '").and_then(|at| {
+        let rest = &text[at + "error message = '".len()..];
+        rest.find('\'').map(|end| rest[..end].to_string())
+    });
+    if let (Some(start), Some(message)) = (start, message) {
+        text = format!("{}file write failed: {message}", &text[..start]);
+    }
+    text.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::one_line;
+
+    #[test]
+    fn an_hdf5_write_error_becomes_one_line_with_the_system_message() {
+        let hdf5 = "cannot write t.h5: H5Dwrite(): can't write data: file write failed: time = \
+                    Sun Nov 22 21:51:04 2026\n, filename = 't.h5.partial-1', file descriptor = 3, \
+                    errno = 28, error message = 'No space left on device', buf = 0x7f, total \
+                    write size = 783624, bytes this sub-write = 783624, bytes actually written = \
+                    18446744073709551615, offset = 0";
+        assert_eq!(
+            one_line(hdf5),
+            "cannot write t.h5: H5Dwrite(): can't write data: file write failed: No space left on device"
+        );
+        assert_eq!(one_line("a\n  b"), "a b");
     }
 }

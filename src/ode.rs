@@ -28,6 +28,8 @@ pub struct SampledSolution<const N: usize> {
 
 /// Runs DOP853 on `system` from (t0, y0) towards t1 (it may stop earlier when the system's
 /// `solout` asks to) at relative and absolute tolerance `tol`, first step `h0` (0: automatic).
+/// With `max_steps` below `u32::MAX` it also stops after that many accepted steps, short of
+/// t1 (the solver keeps every step it takes: bounding them bounds its memory).
 /// Returns the last time and state and the number of accepted steps.
 pub fn run_dop853<const N: usize, F: System<f64, SVector<f64, N>>>(
     system: F,
@@ -36,6 +38,7 @@ pub fn run_dop853<const N: usize, F: System<f64, SVector<f64, N>>>(
     y0: SVector<f64, N>,
     tol: f64,
     h0: f64,
+    max_steps: u32,
 ) -> Result<(f64, SVector<f64, N>, usize)> {
     let mut solver = Dop853::from_param(
         system,
@@ -51,14 +54,23 @@ pub fn run_dop853<const N: usize, F: System<f64, SVector<f64, N>>>(
         6.0,
         t1 - t0,
         h0,
-        u32::MAX,
+        max_steps,
         1000,
         OutputType::Sparse,
     );
-    let stats = solver.integrate().map_err(|e| AtlasError::Integration {
-        time: t0,
-        reason: e.to_string(),
-    })?;
+    let steps =
+        match solver.integrate() {
+            Ok(stats) => stats.accepted_steps as usize,
+            Err(ode_solvers::dop_shared::IntegrationError::MaxNumStepReached {
+                n_step, ..
+            }) if max_steps != u32::MAX => n_step as usize,
+            Err(e) => {
+                return Err(AtlasError::Integration {
+                    time: t0,
+                    reason: e.to_string(),
+                })
+            }
+        };
     let (ts, ys) = (solver.x_out(), solver.y_out());
     let (Some(&t_last), Some(y_last)) = (ts.last(), ys.last()) else {
         return Err(AtlasError::Integration {
@@ -66,8 +78,13 @@ pub fn run_dop853<const N: usize, F: System<f64, SVector<f64, N>>>(
             reason: "the integrator returned no step".into(),
         });
     };
-    Ok((t_last, *y_last, stats.accepted_steps as usize))
+    Ok((t_last, *y_last, steps))
 }
+
+/// Accepted steps per solver run in [`integrate_sampled`]: a run stores every step
+/// (`OutputType::Sparse`), so a long output interval (`--t-end 1e12` with 2000 samples) is
+/// covered by runs of at most this many steps, each starting where the last stopped.
+const STEPS_PER_RUN: u32 = 100_000;
 
 /// Integrates ẏ = f(y) from y(0) = `y0` to `t_end` with DOP853 at relative and absolute
 /// tolerance `tol`, returning the solution at `samples + 1` equally spaced times.
@@ -95,15 +112,25 @@ pub fn integrate_sampled<const N: usize, R: Rate<N>>(
             t_end * i as f64 / samples as f64,
         );
         // The previous interval's typical step seeds this one (0 = automatic choice).
-        let (t_last, y_last, steps) = run_dop853(Adapter(rate), t0, t1, y, tol, h_last)?;
-        if (t_last - t1).abs() > 1e-12 * t1.abs().max(1.0) {
-            return Err(AtlasError::Integration {
-                time: t_last,
-                reason: format!("stopped before t = {t1}"),
-            });
+        let (mut t, mut steps) = (t0, 0);
+        loop {
+            let (t_last, y_last, run_steps) =
+                run_dop853(Adapter(rate), t, t1, y, tol, h_last, STEPS_PER_RUN)?;
+            steps += run_steps;
+            let stalled = t_last <= t;
+            (t, y) = (t_last, y_last);
+            if (t - t1).abs() <= 1e-12 * t1.abs().max(1.0) {
+                break;
+            }
+            if run_steps < STEPS_PER_RUN as usize || stalled {
+                return Err(AtlasError::Integration {
+                    time: t,
+                    reason: format!("stopped before t = {t1}"),
+                });
+            }
+            h_last = (t - t0) / steps.max(1) as f64;
         }
         h_last = (t1 - t0) / steps.max(1) as f64;
-        y = y_last;
         times.push(t1);
         states.push(y);
     }

@@ -101,7 +101,7 @@ fn run<S: Shape>(
     t1: f64,
     tol: f64,
 ) -> Result<(State, usize)> {
-    let (_, y, steps) = run_dop853(system, t0, t1, y0, tol, 0.0)?;
+    let (_, y, steps) = run_dop853(system, t0, t1, y0, tol, 0.0, u32::MAX)?;
     Ok((y, steps))
 }
 

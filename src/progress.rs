@@ -106,6 +106,10 @@ impl Reporter {
 }
 
 impl Progress for Reporter {
+    fn interrupted(&self) -> bool {
+        crate::stop::requested()
+    }
+
     fn begin(&self, total: u64, done: u64) {
         *self.started.lock().unwrap() = Instant::now();
         self.total.store(total, Ordering::Relaxed);

@@ -118,6 +118,84 @@ pub fn check_output(path: &Path, force: bool, inputs: &[&Path], extensions: &[&s
     Ok(())
 }
 
+/// An exclusive claim on an output: held from before the first check of the output and its
+/// journal until the finished file is in place, so that a second run (or merge) on the same
+/// output is refused at once instead of writing the same temporary file. It is an advisory
+/// `flock` on `<out>.lock`, which the kernel releases when the process ends however it ends
+/// (a SIGKILL leaves the file but never a held lock); the file holds the holder's PID for
+/// the message, and is removed when the claim is dropped.
+#[derive(Debug)]
+pub struct OutputLock {
+    file: std::fs::File,
+    path: PathBuf,
+}
+
+impl OutputLock {
+    /// Claims `out`, or says which process holds it.
+    pub fn acquire(out: &Path) -> Result<OutputLock> {
+        use std::os::unix::fs::MetadataExt;
+        let path = with_suffix(out, ".lock");
+        let fail = |reason: String| AtlasError::Busy {
+            path: out.display().to_string(),
+            reason,
+        };
+        // A claim on a lock file that the previous holder unlinked meanwhile would be no
+        // claim at all: lock, then check that the path still names the locked file.
+        for _ in 0..100 {
+            let file = std::fs::OpenOptions::new()
+                .read(true)
+                .write(true)
+                .create(true)
+                .truncate(false)
+                .open(&path)
+                .map_err(|e| output_error(&path, e))?;
+            match file.try_lock() {
+                Ok(()) => {}
+                Err(std::fs::TryLockError::WouldBlock) => {
+                    let holder = std::fs::read_to_string(&path).unwrap_or_default();
+                    let holder = holder.trim();
+                    return Err(fail(if holder.is_empty() {
+                        "another rubber-atlas process is writing it; wait for it to end or choose another --out".into()
+                    } else {
+                        format!("another rubber-atlas process ({holder}) is writing it; wait for it to end or choose another --out")
+                    }));
+                }
+                Err(std::fs::TryLockError::Error(e)) => return Err(output_error(&path, e)),
+            }
+            let same = match (file.metadata(), std::fs::metadata(&path)) {
+                (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+                _ => false,
+            };
+            if !same {
+                continue;
+            }
+            let mut file = file;
+            let holder = format!(
+                "pid {} on {}",
+                std::process::id(),
+                std::fs::read_to_string("/proc/sys/kernel/hostname")
+                    .map(|h| h.trim().to_string())
+                    .unwrap_or_default()
+            );
+            let _ = file.set_len(0);
+            let _ = file.write_all(holder.as_bytes());
+            return Ok(OutputLock { file, path });
+        }
+        Err(fail(
+            "its lock file keeps changing under this process".into(),
+        ))
+    }
+}
+
+impl Drop for OutputLock {
+    fn drop(&mut self) {
+        // Unlinked while still held: a process that opened the old file finds it unlinked
+        // (above) and tries again with a fresh one.
+        let _ = std::fs::remove_file(&self.path);
+        let _ = self.file.unlock();
+    }
+}
+
 /// `path` with `suffix` appended to its file name (`x.h5` → `x.h5<suffix>`), in the same
 /// directory: where an output is written before it is renamed into place.
 pub(crate) fn with_suffix(path: &Path, suffix: &str) -> PathBuf {

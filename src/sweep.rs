@@ -23,6 +23,11 @@ pub trait Progress: Sync {
     fn advance(&self, _cells: u64) {}
     /// Every unit is computed; the HDF5 file is being written.
     fn writing(&self) {}
+    /// Whether the run should stop (the caller got SIGINT or SIGTERM): units in flight are
+    /// finished and kept in the journal, no new one is started.
+    fn interrupted(&self) -> bool {
+        false
+    }
 }
 
 /// A progress sink that says nothing.
@@ -48,6 +53,8 @@ pub struct Summary {
     pub cells_computed: u64,
     /// Wall time, seconds.
     pub seconds: f64,
+    /// The output was already complete and current (`RunRequest::update`): nothing done.
+    pub up_to_date: bool,
 }
 
 impl Summary {
@@ -119,6 +126,10 @@ pub struct RunRequest {
     pub resume: bool,
     /// Replace an existing output, and discard an interrupted run's journal.
     pub force: bool,
+    /// Bring the output up to date (a Slurm task's mode): keep it if it was made from this
+    /// scene by this build for this shard, continue an interrupted run of the same, and
+    /// compute everything else afresh, replacing what is stale.
+    pub update: bool,
     pub shard: Shard,
     /// Attributes the caller adds to the file's root (command line, creation time).
     pub attributes: Vec<(String, AttrValue)>,
@@ -173,29 +184,100 @@ fn borrowed(attributes: &[(String, AttrValue)]) -> Vec<(&str, AttrValue)> {
         .collect()
 }
 
+/// What a run of a scene (or of one shard of it) needs, estimated from the grid alone
+/// before anything is allocated: the caller compares it with the machine.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Footprint {
+    /// Cells this run computes.
+    pub cells: f64,
+    /// Disk at the peak: the journal and the file side by side, uncompressed (an upper
+    /// bound: the file's chunks are deflated).
+    pub disk_bytes: f64,
+    /// Memory at the peak: the list of work units, and the largest run of units of one
+    /// (α, β) slice, computed and encoded before it is written, plus one unit per thread.
+    pub memory_bytes: f64,
+}
+
+/// The [`Footprint`] of running `shard` of `scene` on `threads` threads.
+pub fn footprint(scene: &Scene, shard: Shard, threads: usize) -> Footprint {
+    let shape = scene.shape();
+    let [na, nb, nk, ne] = shape.map(|n| n as f64);
+    let rows = atlas::rows_per_unit(shape) as f64;
+    let per_slice = (nk / rows).ceil();
+    let total = na * nb * per_slice;
+    // This shard's share of the units, as `Shard::units` splits them.
+    let share = (total / shard.count as f64).ceil();
+    let unit_cells = rows * ne;
+    let bytes_per_cell: f64 = atlas::scene_variables(scene)
+        .iter()
+        .map(|v| match v.kind {
+            atlas::Kind::Value => (8 * atlas::COMPONENT_SLOTS) as f64,
+            atlas::Kind::Flag => atlas::COMPONENT_SLOTS as f64,
+            atlas::Kind::CellFlag => 1.0,
+            atlas::Kind::CellValue => 8.0,
+        })
+        .sum();
+    let cells = share * unit_cells;
+    let slice_run = share.min(per_slice) * unit_cells;
+    Footprint {
+        cells,
+        disk_bytes: 2.0 * cells * bytes_per_cell,
+        memory_bytes: total * std::mem::size_of::<atlas::Unit>() as f64
+            + (2.0 * slice_run + threads as f64 * unit_cells) * bytes_per_cell,
+    }
+}
+
+/// Whether `out` is an atlas made from a scene with this fingerprint (its text and this
+/// build) for this shard.
+fn output_is_current(out: &Path, fingerprint: u64, shard: Shard) -> bool {
+    let Ok(file) = hdf5::File::open(out) else {
+        return false;
+    };
+    let text = |name: &str| {
+        file.attr(name)
+            .and_then(|a| a.read_scalar::<hdf5::types::VarLenUnicode>())
+            .map(|s| s.as_str().to_string())
+            .ok()
+    };
+    let integer = |name: &str| file.attr(name).and_then(|a| a.read_scalar::<i64>()).ok();
+    text("scene_fingerprint").as_deref() == Some(format!("{fingerprint:016x}").as_str())
+        && integer("shard_index") == Some(shard.index as i64)
+        && integer("shard_count") == Some(shard.count as i64)
+}
+
 /// Runs `scene` as `request` says; returns the summary.
 pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Result<Summary> {
     let started = Instant::now();
     let out = &request.out;
-    if out.exists() && !request.force {
+    // Before anything is written: the shard must have work units of its own.
+    request
+        .shard
+        .check_against(atlas::units(scene.shape()).len())?;
+    // Held until the file is in place and the journal gone.
+    let _claim = crate::store::OutputLock::acquire(out)?;
+    let fingerprint = scene.fingerprint();
+    if out.exists() && request.update && output_is_current(out, fingerprint, request.shard) {
+        return Ok(Summary {
+            up_to_date: true,
+            seconds: started.elapsed().as_secs_f64(),
+            ..Summary::default()
+        });
+    }
+    if out.exists() && !request.force && !request.update {
         return Err(AtlasError::atlas(
             out,
             "exists; use --force to overwrite it (a finished run has nothing to resume)",
         ));
     }
-    // Before anything is written: the shard must have work units of its own.
-    request
-        .shard
-        .check_against(atlas::units(scene.shape()).len())?;
-    let fingerprint = scene.fingerprint();
     let journal_dir = Journal::dir_for(out);
     let journal = if journal_dir.exists() {
-        if request.force {
+        let matching = || Journal::open(&journal_dir, fingerprint);
+        if request.force || (request.update && matching().is_err()) {
             std::fs::remove_dir_all(&journal_dir)
                 .map_err(|e| AtlasError::atlas(&journal_dir, e))?;
             Journal::create(&journal_dir, fingerprint, &scene.text)?
-        } else if request.resume {
-            Journal::open(&journal_dir, fingerprint)?
+        } else if request.resume || request.update {
+            matching()?
         } else {
             return Err(AtlasError::atlas(
                 &journal_dir,
@@ -249,7 +331,7 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
             let encoded = run
                 .par_iter()
                 .zip(run_done)
-                .map(|(u, &was_done)| -> Result<(EncodedUnit, Summary)> {
+                .map(|(u, &was_done)| -> Result<Option<(EncodedUnit, Summary)>> {
                     // A unit of the journal is taken as it was stored; a damaged one (torn by
                     // a power loss) is computed again.
                     if was_done {
@@ -258,8 +340,12 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
                         {
                             let mut part = Summary::from_words(&words);
                             part.units_resumed = 1;
-                            return Ok((chunks, part));
+                            return Ok(Some((chunks, part)));
                         }
+                    }
+                    // Asked to stop: no new unit (those in flight finish into the journal).
+                    if progress.interrupted() {
+                        return Ok(None);
                     }
                     let rows: Vec<usize> = u.rows.clone().collect();
                     let block = compute_rows(
@@ -275,10 +361,17 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
                     let chunks = encode_unit(&variables, &block, shape);
                     journal.write(u.index, &chunks, &part.words())?;
                     part.cells_computed = block.cells as u64;
-                    Ok((chunks, part))
+                    Ok(Some((chunks, part)))
                 })
                 .collect::<Result<Vec<_>>>()?;
-            for (u, (chunks, part)) in run.iter().zip(encoded) {
+            if encoded.iter().any(Option::is_none) || progress.interrupted() {
+                return Err(AtlasError::Interrupted {
+                    path: out.display().to_string(),
+                    done: 0,
+                    total,
+                });
+            }
+            for (u, (chunks, part)) in run.iter().zip(encoded.into_iter().flatten()) {
                 file.write_encoded(u, &chunks)?;
                 summary.add(&part);
             }
@@ -288,6 +381,16 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
     })();
     if let Err(e) = written {
         let _ = std::fs::remove_file(&tmp);
+        if let AtlasError::Interrupted { path, total, .. } = e {
+            // What a resumed run will find: the units the journal holds now.
+            let kept = journal.listed_units().unwrap_or_default();
+            let done = mine
+                .iter()
+                .filter(|u| kept.contains(&u.index))
+                .map(|u| cells_of(u) as u64)
+                .sum();
+            return Err(AtlasError::Interrupted { path, done, total });
+        }
         return Err(e);
     }
     std::fs::rename(&tmp, out).map_err(|e| AtlasError::atlas(out, e))?;
@@ -306,6 +409,7 @@ pub fn merge(
     extra_attributes: &[(String, AttrValue)],
 ) -> Result<Summary> {
     let started = Instant::now();
+    let _claim = crate::store::OutputLock::acquire(out)?;
     if out.exists() && !force {
         return Err(AtlasError::atlas(
             out,

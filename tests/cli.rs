@@ -643,3 +643,60 @@ impl CharDevice for std::fs::FileType {
         self.is_char_device()
     }
 }
+
+#[test]
+fn requests_beyond_any_machine_are_refused_within_a_second() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // 10¹² cells in one (α, β) slice (about 700 TB at the peak), 10¹³ diagram and trajectory
+    // samples (petabytes): each refused in one line that names the need and the remedy,
+    // before anything is allocated or written.
+    let scene = d.join("huge.toml");
+    std::fs::write(
+        &scene,
+        "name = \"huge\"\n[body]\nnu = 0.5\neta = 0.5\n[axes]\nalpha = [0.5]\nbeta = [3.0]\n\
+         kappa = { start = 0.0, stop = 2.0, num = 1000000 }\n\
+         energy = { start = 0.5, stop = 4.5, num = 1000000 }\n",
+    )
+    .unwrap();
+    let out = d.join("out");
+    std::fs::create_dir(&out).unwrap();
+    let atlas = out.join("huge.h5");
+    let table = out.join("t.csv");
+    let mut diagram: Vec<&str> = vec!["diagram"];
+    diagram.extend(BODY);
+    diagram.extend([
+        "--samples",
+        "10000000000000",
+        "--out",
+        table.to_str().unwrap(),
+    ]);
+    let trajectory = trajectory_args(&[
+        "--periods",
+        "1",
+        "--samples",
+        "10000000000000",
+        "--out",
+        table.to_str().unwrap(),
+    ]);
+    let run_scene = [
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        atlas.to_str().unwrap(),
+    ];
+    for (args, needle) in [
+        (&run_scene[..], "--shard I/N"),
+        (&diagram[..], "fewer --samples"),
+        (&trajectory[..], "fewer --samples"),
+    ] {
+        let start = std::time::Instant::now();
+        assert_refused(args, "--allow-large", Some(&out.join("none")));
+        assert!(stderr(&run(args)).contains(needle));
+        assert!(
+            start.elapsed() < std::time::Duration::from_secs(2),
+            "{args:?} took {:?}",
+            start.elapsed()
+        );
+    }
+}

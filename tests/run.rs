@@ -524,3 +524,133 @@ fn a_shard_opened_alone_marks_the_cells_it_did_not_compute() {
     }
     assert!(computed > 0 && not > 0);
 }
+
+/// Runs `scene` into `out` (quietly; it must succeed) and returns `out`.
+fn run_quietly(scene: &str, out: &Path) -> PathBuf {
+    ok(&run(&[
+        "run",
+        scene,
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]));
+    out.to_path_buf()
+}
+
+/// Waits until the run writing `journal` has `units` unit files there (or has ended).
+fn wait_for_units(child: &mut std::process::Child, journal: &Path, units: usize) {
+    let start = Instant::now();
+    while unit_files(journal) < units
+        && start.elapsed() < Duration::from_secs(60)
+        && child.try_wait().unwrap().is_none()
+    {
+        std::thread::sleep(Duration::from_millis(2));
+    }
+}
+
+#[test]
+fn two_runs_on_one_output_never_leave_a_wrong_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = slow_scene(dir.path());
+    let s = scene.to_str().unwrap();
+    let reference = run_quietly(s, &dir.path().join("reference.h5"));
+    // The second run starts at different moments of the first (before its first unit, part
+    // of the way, about when it ends), with --resume or --force.
+    for (round, delay_ms) in [0u64, 20, 150, 400, 900, 0, 60, 300]
+        .into_iter()
+        .enumerate()
+    {
+        let out = dir.path().join(format!("o{round}.h5"));
+        let o = out.to_str().unwrap();
+        let first = Command::new(BIN)
+            .args(["run", s, "--out", o, "--quiet"])
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(Duration::from_millis(delay_ms));
+        let mode = if round % 2 == 0 {
+            "--resume"
+        } else {
+            "--force"
+        };
+        let second = run(&["run", s, "--out", o, mode, "--quiet"]);
+        let first = first.wait_with_output().unwrap();
+        let mut succeeded = 0;
+        for output in [&first, &second] {
+            let text = String::from_utf8_lossy(&output.stderr);
+            match output.status.code() {
+                Some(0) => succeeded += 1,
+                // Refused at once while the other holds the output (at delay 0 either may
+                // be first).
+                Some(75) => assert!(text.contains("another rubber-atlas process"), "{text}"),
+                // Started after the other had finished: the output exists (--resume).
+                Some(2) => assert!(text.contains("exists"), "{text}"),
+                code => panic!("round {round}: a run exited {code:?}: {text}"),
+            }
+        }
+        assert!(succeeded >= 1, "round {round}: neither run finished");
+        assert_same_arrays(&reference, &out);
+        for leftover in [".partial.d", ".partial.h5", ".lock"] {
+            let path = dir.path().join(format!("o{round}.h5{leftover}"));
+            assert!(!path.exists(), "round {round}: {path:?} left behind");
+        }
+    }
+}
+
+#[test]
+fn sigint_and_sigterm_stop_a_run_after_its_units_in_flight_and_it_resumes() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = slow_scene(dir.path());
+    let s = scene.to_str().unwrap();
+    let reference = run_quietly(s, &dir.path().join("reference.h5"));
+    let out = dir.path().join("o.h5");
+    let o = out.to_str().unwrap();
+    let journal = dir.path().join("o.h5.partial.d");
+    // SIGINT, SIGTERM, and two SIGINTs at once (the second ends the process without
+    // waiting); each stop is resumed by the next round, the last one to the end.
+    let rounds: [(&[i32], i32, &str); 3] = [
+        (&[libc::SIGINT], 130, "SIGINT"),
+        (&[libc::SIGTERM], 143, "SIGTERM"),
+        (&[libc::SIGINT, libc::SIGINT], 130, "SIGINT"),
+    ];
+    let mut stopped = 0;
+    for (round, (signals, code, name)) in rounds.into_iter().enumerate() {
+        let mut args = vec!["run", s, "--out", o, "--quiet"];
+        if round > 0 {
+            args.push("--resume");
+        }
+        let mut child = Command::new(BIN)
+            .args(&args)
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        wait_for_units(&mut child, &journal, unit_files(&journal) + 1);
+        for &signal in signals {
+            // SAFETY: a signal to our own child process.
+            unsafe { libc::kill(child.id() as i32, signal) };
+        }
+        let output = child.wait_with_output().unwrap();
+        let text = String::from_utf8_lossy(&output.stderr);
+        if output.status.success() {
+            // Finished before the signal landed.
+            break;
+        }
+        stopped += 1;
+        assert_eq!(output.status.code(), Some(code), "{name}: {text}");
+        if signals.len() == 1 {
+            assert!(text.contains(&format!("stopped by {name}")), "{text}");
+            assert!(
+                text.contains(&format!("rubber-atlas run {s} --out {o} --resume")),
+                "{text}"
+            );
+            assert_eq!(text.lines().count(), 1, "{text}");
+        }
+        assert!(!out.exists() && journal.exists());
+    }
+    assert!(stopped >= 2, "the signals landed after the run had ended");
+    if !out.exists() {
+        ok(&run(&["run", s, "--out", o, "--resume", "--quiet"]));
+    }
+    assert_same_arrays(&reference, &out);
+    assert!(!journal.exists());
+}

@@ -51,3 +51,74 @@ def test_array_tasks_then_merge_equal_a_single_run(tmp_path):
             a, b = merged[name][()], one[name][()]
             assert a.tobytes() == b.tobytes(), name
         assert np.isfinite(one["rotation_number"][()]).any()
+
+
+def _single(tmp_path: Path, scene: Path) -> Path:
+    single = tmp_path / "single.h5"
+    subprocess.run([BIN, "run", str(scene), "--out", str(single), "--quiet", "--force"], check=True)
+    return single
+
+
+def _same_arrays(a: Path, b: Path) -> bool:
+    with h5py.File(a) as x, h5py.File(b) as y:
+        return sorted(x) == sorted(y) and all(x[n][()].tobytes() == y[n][()].tobytes() for n in y)
+
+
+def test_resubmission_after_a_scene_edit_recomputes_and_merges_again(tmp_path):
+    """Issue 13 #3: after an edit of the scene (its tolerance), a resubmitted array task
+    recomputes its shard instead of saying "nothing to do", and the merge job replaces the
+    old merged atlas. A scene name in single quotes (valid TOML) names the files."""
+    (tmp_path / "atlas").mkdir()
+    scene = tmp_path / "atlas" / "tiny.toml"
+    scene.write_text(SCENE.replace('name = "tiny"', "name = 'sq'"))
+    for task in (1, 2, 3):
+        sbatch(tmp_path, "atlas/tiny.toml", task=task)
+    sbatch(tmp_path, "--merge", "atlas/tiny.toml", "3")
+    merged = tmp_path / "atlas" / "sq.h5"
+    assert _same_arrays(merged, _single(tmp_path, scene))
+    scene.write_text(scene.read_text().replace("tolerance = 1e-9", "tolerance = 1e-6"))
+    for task in (1, 2, 3):
+        assert "nothing to do" not in sbatch(tmp_path, "atlas/tiny.toml", task=task)
+    # Now current: a requeue does nothing.
+    assert "nothing to do" in sbatch(tmp_path, "atlas/tiny.toml", task=1)
+    sbatch(tmp_path, "--merge", "atlas/tiny.toml", "3")
+    assert _same_arrays(merged, _single(tmp_path, scene))
+    with h5py.File(merged) as f:
+        assert f.attrs["tolerance"] == 1e-6
+
+
+def test_a_shard_left_by_another_build_is_recomputed(tmp_path):
+    """A shard whose fingerprint is not this build's (here: altered by hand) is stale."""
+    (tmp_path / "atlas").mkdir()
+    (tmp_path / "atlas" / "tiny.toml").write_text(SCENE)
+    sbatch(tmp_path, "atlas/tiny.toml", task=1)
+    shard = tmp_path / "atlas" / "tiny.shard-1-of-3.h5"
+    with h5py.File(shard, "r+") as f:
+        f.attrs["scene_fingerprint"] = "0123456789abcdef"
+    assert "nothing to do" not in sbatch(tmp_path, "atlas/tiny.toml", task=1)
+    assert "nothing to do" in sbatch(tmp_path, "atlas/tiny.toml", task=1)
+
+
+def test_submit_passes_options_and_names_logs(tmp_path):
+    """submit.sh with a stand-in sbatch on PATH: the array and the merge job get the extra
+    options (partition, account), logs go to atlas/logs/ (created), the merge job's log is
+    named by its own job id, and a requeue appends to a task's log."""
+    bindir = tmp_path / "bin"
+    bindir.mkdir()
+    calls = tmp_path / "calls.txt"
+    fake = bindir / "sbatch"
+    fake.write_text(f'#!/usr/bin/env bash\nprintf "%s\\n" "$*" >> {calls}\necho 4242\n')
+    fake.chmod(0o755)
+    env = dict(os.environ, PATH=f"{bindir}:{os.environ['PATH']}")
+    subprocess.run(["bash", str(ROOT / "scripts" / "slurm" / "submit.sh"), "atlas/tiny.toml", "3",
+                    "--partition=short", "--account=proj"], cwd=tmp_path, env=env, check=True,
+                   capture_output=True)
+    array, merge = calls.read_text().splitlines()
+    assert "--array=1-3" in array and "--partition=short" in array and "--account=proj" in array
+    assert "--dependency=afterok:4242" in merge and "--partition=short" in merge and "--account=proj" in merge
+    assert "--output=atlas/logs/%x-%j.out" in merge
+    assert (tmp_path / "atlas" / "logs").is_dir()
+    text = SBATCH.read_text()
+    assert "#SBATCH --output=atlas/logs/%x-%A_%a.out" in text and "#SBATCH --open-mode=append" in text
+    ignored = subprocess.run(["git", "check-ignore", "-q", "atlas/logs/rubber-atlas-1_1.out"], cwd=ROOT)
+    assert ignored.returncode == 0
