@@ -165,6 +165,20 @@ FOUND = [
     ("seed 7: kappa = 0, a libration held beyond pi (theta = 3 pi / 2)",
      (0.7650758463547191, 0.0015646726019297385, 1.8888576081043287, 8.69343237802934, 0.0,
       0.0010111258569451501)),
+    # T 1.2e-11 off (estimate 2.4e-12): on a needle (β = 0.0068) with α → 1, Z and α cosθ
+    # cancel in U′ and in the divided differences of U beyond π/2, which put both turning
+    # points 240 ulps off.
+    ("seed 2026: alpha -> 1, beta = 0.0068, a libration beyond pi/2",
+     (0.999999, 0.006814032939965051, 1.6671348784155802, 5.039999969587748, 0.0029902596634845432,
+      0.0002776485304124647)),
+    ("mirror of seed 2026: alpha -> -1, beta = 0.0068",
+     (-0.999999, 0.006814032939965051, 1.6671348784155802, 5.039999969587748, 0.0029902596634845432,
+      0.0002776485304124647)),
+    # N 1.3e-14 off (estimate 9.3e-15): Δψ = 2e-11 is the difference of two sweeps of
+    # about π past the poles, whose rounding the estimate did not count.
+    ("seed 77: alpha -> 1, kappa = -4e-8 at energy 3e4, two pole passages",
+     (0.999999, 0.09480813466638069, 0.8245627609674903, 0.04229013032789601, -4.017720738079887e-08,
+      29320.520807416226)),
     ("mirror of issue 12 #6: alpha -> -1, a well 2e-6 wide at theta = 0.067",
      (-0.999999, 0.0015267025376685998, 0.576404134748566, 0.07763191150403917, 5.235375405830439e-06,
       1.0060490242139052e-06)),

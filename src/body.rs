@@ -217,6 +217,14 @@ impl Ellipsoid {
         )
     }
 
+    /// Whether Z and α cosθ cancel where U′ and the divided differences of U are formed:
+    /// a prolate body (β < 1, so Z ≈ |cosθ| away from θ = π/2) with |α| > ½, on the side
+    /// where α cosθ < 0 (beyond π/2 for α > 0, before it for α < 0).
+    #[inline]
+    fn cancels(&self, a: Angle) -> bool {
+        self.beta < 1.0 && self.alpha.abs() > 0.5 && self.alpha * a.cos < 0.0
+    }
+
     /// Z at an angle given by its sine and cosine.
     #[inline]
     pub fn centre_height_at(&self, a: Angle) -> f64 {
@@ -299,13 +307,28 @@ impl Shape for Ellipsoid {
 
     #[inline]
     fn potential_prime_at(&self, a: Angle) -> f64 {
-        a.sin * ((self.beta * self.beta - 1.0) * a.cos / self.centre_height_at(a) - self.alpha)
+        a.sin * self.potential_prime_over_sin_at(a)
     }
 
-    /// U″ = −α cosθ + (β² − 1) [(cos²θ − sin²θ) / Z − sinθ cosθ Z′ / Z²].
+    /// U″ = −α cosθ + (β² − 1) [(cos²θ − sin²θ) / Z − sinθ cosθ Z′ / Z²]. Where Z and
+    /// α cosθ cancel ([`Ellipsoid::cancels`]), U = L + (1 − |α|) c with c = |cosθ| and
+    /// L = Z − c, and U″ = L″ − (1 − |α|) c with
+    /// L″ = Z″ + c = [c L (Z² + Z c + c²) + β² cos⁴θ + β² (1 − β²) sin⁴θ] / Z³, every term
+    /// positive (from Z″ = (β² − 1)(cos²θ − sin²θ + (1 − β²) sin⁴θ) / Z³); the plain form
+    /// was 1e-12 off at the bottom of the well at α = 0.999999, β = 0.0068.
     #[inline]
     fn potential_second_at(&self, a: Angle) -> f64 {
         let z = self.centre_height_at(a);
+        if self.cancels(a) {
+            let b2 = self.beta * self.beta;
+            let c = a.cos.abs();
+            let lift = b2 * a.sin * a.sin / (z + c);
+            let (c2, s2) = (c * c, a.sin * a.sin);
+            let lift_second =
+                (c * lift * (z * z + z * c + c2) + b2 * c2 * c2 + b2 * (1.0 - b2) * s2 * s2)
+                    / (z * z * z);
+            return lift_second - (1.0 - self.alpha.abs()) * c;
+        }
         let b = self.beta * self.beta - 1.0;
         let zp = b * a.sin * a.cos / z;
         -self.alpha * a.cos
@@ -318,10 +341,19 @@ impl Shape for Ellipsoid {
         self.beta.min(1.0 / self.beta)
     }
 
-    /// U′/sinθ = (β² − 1) cosθ / Z − α.
+    /// U′/sinθ = (β² − 1) cosθ / Z − α; where its two terms cancel ([`Ellipsoid::cancels`]),
+    /// with c = |cosθ| and L = Z − c = β² sin²θ / (Z + c), the same as
+    /// sgn α ((1 − |α|) − (L + β² c) / Z), whose terms are all small.
     #[inline]
     fn potential_prime_over_sin_at(&self, a: Angle) -> f64 {
-        (self.beta * self.beta - 1.0) * a.cos / self.centre_height_at(a) - self.alpha
+        let z = self.centre_height_at(a);
+        let b2 = self.beta * self.beta;
+        if self.cancels(a) {
+            let c = a.cos.abs();
+            let lift = b2 * a.sin * a.sin / (z + c);
+            return self.alpha.signum() * ((1.0 - self.alpha.abs()) - (lift + b2 * c) / z);
+        }
+        (b2 - 1.0) * a.cos / z - self.alpha
     }
 
     #[inline]
@@ -332,6 +364,15 @@ impl Shape for Ellipsoid {
     /// (U(x) − U(y)) / sin(x − y) without cancellation, from Z(x)² − Z(y)² = (β² − 1)
     /// sin(x − y) sin(x + y) and cos x − cos y = −sin(x − y) (sin x + sin y) / (1 + cos(x − y)):
     /// (β² − 1) sin(x + y) / (Z(x) + Z(y)) − α (sin x + sin y) / (1 + cos(x − y)).
+    ///
+    /// Where U cancels at both points ([`Ellipsoid::cancels`]), those two terms are each of
+    /// order 1 against a difference of order U, so U = L + (1 − |α|) c is differenced
+    /// instead (c = |cosθ|, L = β² sin²θ / D, D = Z + c): with E = (D(x) − D(y)) / sin(x − y)
+    /// = (β² − 1) sin(x + y) / (Z(x) + Z(y)) + sgn α (sin x + sin y) / (1 + cos(x − y)),
+    /// (L(x) − L(y)) / sin(x − y) = (β² sin(x + y) − L(y) E) / D(x), and
+    /// (c(x) − c(y)) / sin(x − y) = sgn α (sin x + sin y) / (1 + cos(x − y)). For β < 1 the
+    /// two parts of E, and the two of the numerator, have one sign (issue 12: at α = 0.999999,
+    /// β = 0.0068 the plain form put a turning point 240 ulps off).
     #[inline]
     fn potential_divided_difference(
         &self,
@@ -340,9 +381,20 @@ impl Shape for Ellipsoid {
         _sin_diff: f64,
         cos_diff: f64,
     ) -> (f64, f64) {
+        let b2 = self.beta * self.beta;
         let sin_sum = x.sin * y.cos + x.cos * y.sin;
-        let shape = (self.beta * self.beta - 1.0) * sin_sum
-            / (self.centre_height_at(x) + self.centre_height_at(y));
+        let (zx, zy) = (self.centre_height_at(x), self.centre_height_at(y));
+        let shape = (b2 - 1.0) * sin_sum / (zx + zy);
+        if self.cancels(x) && self.cancels(y) {
+            let (cx, cy) = (x.cos.abs(), y.cos.abs());
+            let (dx, dy) = (zx + cx, zy + cy);
+            let cdd = self.alpha.signum() * (x.sin + y.sin) / (1.0 + cos_diff);
+            let e = shape + cdd;
+            let lift_y = b2 * y.sin * y.sin / dy;
+            let lift_dd = (b2 * sin_sum - lift_y * e) / dx;
+            let rest = (1.0 - self.alpha.abs()) * cdd;
+            return (lift_dd + rest, lift_dd.abs() + rest.abs());
+        }
         let offset = self.alpha * (x.sin + y.sin) / (1.0 + cos_diff);
         (shape - offset, shape.abs() + offset.abs())
     }
@@ -445,6 +497,7 @@ impl<S: Shape> Body<S> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::PI;
 
     #[test]
     fn ellipsoid_rejects_out_of_range_parameters() {
@@ -455,6 +508,65 @@ mod tests {
         assert!(Body::new(Ellipsoid::new(0.5, 3.0).unwrap(), 2.5, 1.0).is_err());
         assert!(Body::new(Ellipsoid::new(0.5, 3.0).unwrap(), 0.5, -1.0).is_err());
         assert!(EllipsoidBody::ellipsoid(0.5, 3.0, 2.0, 0.5).is_ok());
+    }
+
+    /// The divided difference (U(x) − U(y)) / sin(x − y) where Z and α cosθ cancel, against
+    /// the difference of U's own values (full relative precision, tested above) over pairs
+    /// far enough apart that their difference loses little: within a few ulps of
+    /// (|U(x)| + |U(y)|) / |sin(x − y)|. The plain form was 1e-12 off here.
+    #[test]
+    fn divided_differences_of_u_keep_full_precision_where_z_and_alpha_cos_cancel() {
+        for alpha in [0.999999, -0.999999, 0.9] {
+            for beta in [0.0068, 0.05, 0.6] {
+                let shape = Ellipsoid::new(alpha, beta).unwrap();
+                // Points on the cancelling side: θ beyond π/2 for α > 0, before it for α < 0.
+                let side = |t: f64| if alpha > 0.0 { t } else { PI - t };
+                for (x, y) in [(1.655, 2.506), (1.6, 1.7), (2.0, 3.0), (1.58, 3.1)] {
+                    let (ax, ay) = (Angle::new(side(x)), Angle::new(side(y)));
+                    let (s, c) = (side(x) - side(y)).sin_cos();
+                    let (dd, _) = shape.potential_divided_difference(ax, ay, s, c);
+                    let (ux, uy) = (shape.potential_at(ax), shape.potential_at(ay));
+                    let want = (ux - uy) / s;
+                    let allowed = 8.0 * f64::EPSILON * (ux.abs() + uy.abs()) / s.abs();
+                    assert!(
+                        (dd - want).abs() <= allowed,
+                        "α = {alpha}, β = {beta}, ({x}, {y}): {dd} vs {want} ± {allowed:e}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// U′ and U″ where Z and α cosθ cancel, against their Taylor series about the bottom of
+    /// U (θ = π for α > 0, U = (1 − α) + (β² − 1 + α) x²/2 + … in x = θ − π): U′ = U″ x and
+    /// U″ = β² − 1 + α to O(x²).
+    #[test]
+    fn slope_and_curvature_of_u_keep_full_precision_where_z_and_alpha_cos_cancel() {
+        for alpha in [0.999999f64, -0.999999] {
+            for beta in [0.0068f64, 0.3] {
+                let shape = Ellipsoid::new(alpha, beta).unwrap();
+                let x = 1e-9;
+                let angle = if alpha > 0.0 {
+                    Angle::from_pi(x)
+                } else {
+                    Angle::new(x)
+                };
+                // β² − (1 − |α|): 1 − |α| is exact, β² − 1 + |α| would cancel.
+                let curvature = beta * beta - (1.0 - alpha.abs());
+                let second = shape.potential_second_at(angle);
+                assert!(
+                    (second - curvature).abs() <= 8.0 * f64::EPSILON * curvature.abs(),
+                    "U″ at α = {alpha}, β = {beta}: {second} vs {curvature}"
+                );
+                // U′ = U″ x, signed: U grows away from the bottom.
+                let slope = shape.potential_prime_at(angle) * if alpha > 0.0 { -1.0 } else { 1.0 };
+                assert!(
+                    (slope - curvature * x).abs() <= 8.0 * f64::EPSILON * curvature.abs() * x,
+                    "U′ at α = {alpha}, β = {beta}: {slope} vs {}",
+                    curvature * x
+                );
+            }
+        }
     }
 
     /// U = Z + α cosθ and w = cosθ + αZ where they cancel (|α| → 1 at the pole where α cosθ

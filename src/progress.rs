@@ -99,7 +99,9 @@ impl Reporter {
     pub fn finish(&self) {
         match &self.mode {
             Mode::Bar(bar) => bar.finish_and_clear(),
-            Mode::Lines { .. } => self.line(),
+            // Nothing begun (an output already up to date): nothing to report.
+            Mode::Lines { .. } if self.total.load(Ordering::Relaxed) > 0 => self.line(),
+            Mode::Lines { .. } => {}
             Mode::Quiet => {}
         }
     }
