@@ -921,7 +921,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                     left: l,
                     right: r,
                     length,
-                    tilt: rise + r.excess - l.excess,
+                    tilt_rate: (rise + r.excess - l.excess) / length,
                 }
             })
             .collect()
@@ -1067,7 +1067,7 @@ struct PieceEnd {
     excess: f64,
     /// The level V + `excess` the gap is measured against at the end: V(e) at a turning
     /// point (ε to within the rounding of the root), ε at a saddle. Between the ends the
-    /// level runs linearly (see `Piece::tilt`), in both of `sample`'s forms of the gap.
+    /// level runs linearly (see `Piece::tilt_rate`), in both of `sample`'s forms of the gap.
     level: f64,
     /// Bound on the rounding error of `excess` (0 at a turning point, whose level is the
     /// gap's zero by construction; the offset of that level from ε is bounded in
@@ -1080,10 +1080,10 @@ struct Piece {
     left: PieceEnd,
     right: PieceEnd,
     length: f64,
-    /// m = (V + excess)(right) − (V + excess)(left): the gap is taken against the level that
-    /// runs linearly from one end's to the other's, so it vanishes at both turning points
-    /// and is continuous in between.
-    tilt: f64,
+    /// m / L with m = (V + excess)(right) − (V + excess)(left): the gap is taken against the
+    /// level that runs linearly from one end's to the other's, so it vanishes at both
+    /// turning points and is continuous in between.
+    tilt_rate: f64,
 }
 
 /// What one node contributes, already multiplied by dθ/dτ (not by the τ-step).
@@ -1270,20 +1270,18 @@ fn sample<S: Shape>(
         // is taken against the same tilted level as the form below: against ε itself the
         // gap would jump where the forms meet by the ends' offsets from ε (a 4e-13 relative
         // jump, a 3e-14 error of T, in a libration 1e-3 wide round θ = π at κ = 0).
-        let level = end.level + piece.tilt * signed / piece.length;
+        let level = end.level + piece.tilt_rate * signed;
         (level - v_t, 4.0 * EPS * (level.abs() + v_t.abs()))
     } else {
         // ε − V(t) = excess − sin(t − e) D(t, e) + tilt, with D the divided difference of V
-        // and the tilt m·(t − e)/L that makes the two ends' levels meet (see `Piece::tilt`).
+        // and the tilt m·(t − e)/L that makes the two ends' levels meet (see `Piece::tilt_rate`).
         let (d, scale) = divided_difference(v, a, e, sx, cx);
         (
-            end.excess - sx * d + piece.tilt * signed / piece.length,
+            end.excess - sx * d + piece.tilt_rate * signed,
             end.excess_error
                 + 4.0
                     * EPS
-                    * (end.excess.abs()
-                        + sx.abs() * scale
-                        + (piece.tilt * signed / piece.length).abs()),
+                    * (end.excess.abs() + sx.abs() * scale + (piece.tilt_rate * signed).abs()),
         )
     };
     if gap <= 0.0 || !gap.is_finite() {

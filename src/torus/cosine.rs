@@ -389,7 +389,7 @@ fn end_sample<S: Shape>(
     }
     let a = end.angle;
     let red = v.body.reduction_at(a);
-    let tilt = piece.tilt / piece.length;
+    let tilt = piece.tilt_rate;
     let slope = v.slope(a);
     let g = if left { tilt - slope } else { slope - tilt };
     let w = v.kappa / a.sin;
