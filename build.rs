@@ -1,5 +1,6 @@
 //! Build script: links the HDF5 high-level library (dimension scales, `H5DS*`) next to the
-//! HDF5 library that the `hdf5` crate links, and records the git commit for provenance.
+//! HDF5 library that the `hdf5` crate links, and records the git commit for provenance
+//! (marked `-dirty` when tracked files differ from it).
 
 use std::process::Command;
 
@@ -37,8 +38,17 @@ fn main() {
         .filter(|o| o.status.success())
         .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
         .unwrap_or_default();
+    // Sources that differ from the commit (tracked files modified) mark it `-dirty`.
+    let dirty = Command::new("git")
+        .args(["status", "--porcelain", "--untracked-files=no"])
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .is_some_and(|o| !o.stdout.is_empty());
     let commit = if commit.is_empty() {
         "unknown".to_string()
+    } else if dirty {
+        format!("{commit}-dirty")
     } else {
         commit
     };
@@ -47,4 +57,8 @@ fn main() {
     println!("cargo:rerun-if-changed=.git/index");
     println!("cargo:rerun-if-changed=.git/refs/heads");
     println!("cargo:rerun-if-changed=build.rs");
+    // Any edit of the sources may make the build dirty (or clean again).
+    for path in ["src", "Cargo.toml", "Cargo.lock", "benches", "tests"] {
+        println!("cargo:rerun-if-changed={path}");
+    }
 }

@@ -26,13 +26,15 @@ DIMENSIONS = ("alpha", "beta", "kappa", "energy", "component")
 
 
 def open_atlas(path: str | Path, **kwargs) -> xr.Dataset:
-    """The atlas at `path` as an xarray Dataset (engine h5netcdf). Refuses files that are not
+    """The atlas at `path` as an xarray Dataset (engine h5netcdf unless `engine=` says
+    otherwise; other keywords go to `xarray.open_dataset`). Refuses files that are not
     complete rubber-atlas atlases (a run in progress writes `<out>.partial.h5` and renames it
     only when done, so an existing atlas path is always complete)."""
     path = Path(path)
     if path.name.endswith(".partial.h5"):
         raise ValueError(f"{path}: an unfinished run's file; resume the run with --resume")
-    ds = xr.open_dataset(path, engine="h5netcdf", **kwargs)
+    kwargs.setdefault("engine", "h5netcdf")
+    ds = xr.open_dataset(path, **kwargs)
     if ds.attrs.get("program") != "rubber-atlas":
         ds.close()
         raise ValueError(f"{path}: not a rubber-atlas atlas (no program attribute)")

@@ -263,7 +263,7 @@ FIGURES = {"ab": fig_ab, "wvth": fig_wvth, "bif": fig_bif, "phase": fig_phase, "
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0].replace("\n", " "))
     parser.add_argument("figure", choices=[*FIGURES, "all"])
     parser.add_argument("--out", required=True, help="folder for the PNG files")
     args = parser.parse_args()

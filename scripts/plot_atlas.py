@@ -30,8 +30,14 @@ def plot(path: str | Path, out: str | Path, alpha_index: int = 0, beta_index: in
     ds = open_atlas(path)
     cut = ds.isel(alpha=alpha_index, beta=beta_index)
     kappa, energy = cut.kappa.values, cut.energy.values
-    slots = [s for s in range(ds.sizes["component"]) if np.isfinite(cut.rotation_number.isel(component=s)).any()]
+    slots = []
+    if "rotation_number" in ds:
+        slots = [s for s in range(ds.sizes["component"]) if np.isfinite(cut.rotation_number.isel(component=s)).any()]
     panels = len(slots) + ("drift_radius" in ds)
+    if panels == 0:
+        ds.close()
+        raise SystemExit(f"plot_atlas.py: {path} has no finite rotation_number and no drift_radius to draw "
+                         "(the scene's [outputs] fields left them out)")
     fig, axes = plt.subplots(1, panels, figsize=(5.2 * panels, 4.4), squeeze=False)
     for ax, slot in zip(axes[0], slots):
         n = cut.rotation_number.isel(component=slot).values.T
@@ -62,7 +68,7 @@ def plot(path: str | Path, out: str | Path, alpha_index: int = 0, beta_index: in
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0].replace("\n", " "))
     parser.add_argument("atlas")
     parser.add_argument("--out", required=True)
     parser.add_argument("--alpha-index", type=int, default=0)

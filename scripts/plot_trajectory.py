@@ -44,7 +44,7 @@ def plot(path: str | Path, out: str | Path) -> Path:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0].replace("\n", " "))
     parser.add_argument("trajectory")
     parser.add_argument("--out", required=True)
     args = parser.parse_args(argv)

@@ -78,10 +78,16 @@ def plot(csv_path: Path, png_path: Path) -> None:
 
 
 def main(argv: list[str]) -> None:
-    csv_path = Path(argv[1]) if len(argv) > 1 else ROOT / "docs" / "work-precision.csv"
-    png_path = Path(argv[2]) if len(argv) > 2 else ROOT / "docs" / "work-precision.png"
-    plot(csv_path, png_path)
-    print(f"wrote {png_path}")
+    import argparse
+
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0].replace("\n", " "))
+    parser.add_argument("csv", nargs="?", default=ROOT / "docs" / "work-precision.csv", type=Path,
+                        help="the bench's table [default: docs/work-precision.csv]")
+    parser.add_argument("png", nargs="?", default=ROOT / "docs" / "work-precision.png", type=Path,
+                        help="the figure to write [default: docs/work-precision.png]")
+    args = parser.parse_args(argv[1:])
+    plot(args.csv, args.png)
+    print(f"wrote {args.png}")
 
 
 if __name__ == "__main__":

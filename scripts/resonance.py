@@ -198,7 +198,7 @@ def load(path: str | Path) -> dict[str, np.ndarray]:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0].replace("\n", " "))
     parser.add_argument("atlas")
     group = parser.add_mutually_exclusive_group(required=True)
     group.add_argument("--pq", help="one rotation number P/Q, e.g. 0, 1, -1/7")

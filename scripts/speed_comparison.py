@@ -110,7 +110,7 @@ def rubber_atlas_n(kappa: float, energy: float) -> float:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0].replace("\n", " "))
     parser.add_argument("--scipy-cells", type=int, default=400)
     parser.add_argument("--accuracy-cells", type=int, default=300)
     args = parser.parse_args()

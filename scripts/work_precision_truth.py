@@ -42,6 +42,9 @@ def cells():
 
 
 def main():
+    import argparse
+
+    argparse.ArgumentParser(description=__doc__.split("\n\n")[0].replace("\n", " ")).parse_args()
     body = Body(ALPHA, BETA)
     rows = []
     for kind, kappa, energy, near in cells():

@@ -18,11 +18,20 @@ use rubber_atlas::verdict::{self, VerdictOptions};
 use rubber_atlas::EllipsoidBody;
 use std::path::PathBuf;
 
+/// `--version`: the package version and the git commit it was built from, marked `-dirty`
+/// when the sources differed from that commit.
+const VERSION: &str = concat!(
+    env!("CARGO_PKG_VERSION"),
+    " (",
+    env!("RUBBER_ATLAS_GIT_COMMIT"),
+    ")"
+);
+
 /// Atlases of the dynamics of a "rubber" ellipsoid of revolution rolling on a plane.
 #[derive(Debug, Parser)]
 #[command(
     name = "rubber-atlas",
-    version,
+    version = VERSION,
     about,
     long_about = None,
     arg_required_else_help = true
@@ -55,6 +64,16 @@ pub enum Command {
     /// whether it holds, κ_max, counterexamples on integer resonances and the high-energy
     /// limit N∞(λ); with --boundaries, the β at which the verdict changes for one α.
     Verdict(VerdictArgs),
+    /// Prints a completion script for a shell, e.g. `rubber-atlas completions bash >
+    /// /etc/bash_completion.d/rubber-atlas`.
+    Completions {
+        /// The shell.
+        #[arg(value_enum)]
+        shell: clap_complete::Shell,
+    },
+    /// Prints the manual page (roff), e.g. `rubber-atlas man > rubber-atlas.1; man
+    /// ./rubber-atlas.1`.
+    Man,
 }
 
 #[derive(Debug, Args)]
@@ -155,7 +174,7 @@ pub struct RunArgs {
     /// Output file [default: atlas/<name>.h5; with --shard I/N atlas/<name>.shard-I-of-N.h5].
     #[arg(long, value_name = "PATH")]
     pub out: Option<PathBuf>,
-    /// Worker threads [default: every core].
+    /// Worker threads [default: RAYON_NUM_THREADS if set, else every core].
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
     /// Continue an interrupted run of the same scene and output (finished units are kept).
@@ -381,6 +400,18 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Merge(args) => merge(args),
         Command::Resonance(args) => resonance(args),
         Command::Verdict(args) => verdict(args),
+        Command::Completions { shell } => {
+            let mut command = <Cli as clap::CommandFactory>::command();
+            clap_complete::generate(shell, &mut command, "rubber-atlas", &mut std::io::stdout());
+            Ok(())
+        }
+        Command::Man => {
+            let command = <Cli as clap::CommandFactory>::command();
+            clap_mangen::Man::new(command)
+                .render(&mut std::io::stdout())
+                .context("cannot write the manual page")?;
+            Ok(())
+        }
     }
 }
 
@@ -792,7 +823,12 @@ fn run_scene(args: RunArgs) -> Result<()> {
             .into());
         }
     }
-    let threads = match args.threads {
+    // --threads, else RAYON_NUM_THREADS (as rayon itself reads it), else every core.
+    let from_env = std::env::var("RAYON_NUM_THREADS")
+        .ok()
+        .and_then(|v| v.trim().parse::<usize>().ok())
+        .filter(|&n| n > 0);
+    let threads = match args.threads.or(from_env) {
         Some(0) => {
             return Err(AtlasError::Atlas {
                 path: "--threads 0".into(),
@@ -1068,14 +1104,14 @@ fn cell(args: CellArgs) -> Result<()> {
         return Ok(());
     }
     println!(
-        "cell alpha={} beta={} nu={} eta={} kappa={} energy={} ({:?}, tol {:e}): {}",
+        "cell alpha={} beta={} nu={} eta={} kappa={} energy={} ({}, tol {:e}): {}",
         args.level.shape.alpha,
         args.level.shape.beta,
         args.level.nu,
         args.level.eta,
         args.level.kappa,
         energy,
-        options.method,
+        json_name(&options.method),
         args.tol,
         if result.components.is_empty() {
             "no motion (energy below the minimum of V)".to_string()
@@ -1085,8 +1121,11 @@ fn cell(args: CellArgs) -> Result<()> {
     );
     for (i, c) in result.components.iter().enumerate() {
         println!(
-            "[{i}] {:?} on [{:.12}, {:.12}], status {:?}",
-            c.motion, c.theta_min, c.theta_max, c.status
+            "[{i}] {} on [{:.12}, {:.12}], status {}",
+            json_name(&c.motion),
+            c.theta_min,
+            c.theta_max,
+            json_name(&c.status)
         );
         let rows = [
             ("period T", c.period, c.errors.period),
@@ -1109,6 +1148,16 @@ fn cell(args: CellArgs) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// The name a value has in the JSON output (`ok`, `libration`, `quadrature`), so that the
+/// text output uses the same words.
+fn json_name<T: serde::Serialize>(value: &T) -> String {
+    match serde_json::to_value(value) {
+        Ok(serde_json::Value::String(name)) => name,
+        Ok(other) => other.to_string(),
+        Err(_) => String::from("?"),
+    }
 }
 
 fn command_line() -> String {

@@ -700,3 +700,74 @@ fn requests_beyond_any_machine_are_refused_within_a_second() {
         );
     }
 }
+
+#[test]
+fn version_completions_manual_threads_and_names_follow_the_conventions() {
+    // --version: the package version and the commit, marked -dirty for modified sources.
+    let v = run(&["--version"]);
+    let text = String::from_utf8_lossy(&v.stdout);
+    let commit = text
+        .split_once('(')
+        .and_then(|(_, rest)| rest.split_once(')'))
+        .map(|(c, _)| c.trim_end_matches("-dirty").to_string())
+        .unwrap_or_default();
+    assert!(
+        text.starts_with(&format!("rubber-atlas {}", env!("CARGO_PKG_VERSION"))),
+        "{text}"
+    );
+    assert!(
+        commit == "unknown"
+            || (commit.len() == 40 && commit.chars().all(|c| c.is_ascii_hexdigit())),
+        "{text}"
+    );
+    // Completions for every shell clap_complete knows, and the manual page.
+    for shell in ["bash", "zsh", "fish", "elvish", "powershell"] {
+        let o = run(&["completions", shell]);
+        assert!(o.status.success(), "{shell}");
+        let script = String::from_utf8_lossy(&o.stdout);
+        assert!(
+            script.contains("rubber-atlas") && script.contains("verdict"),
+            "{shell}"
+        );
+    }
+    let man = run(&["man"]);
+    let page = String::from_utf8_lossy(&man.stdout);
+    assert!(
+        man.status.success() && page.contains(".TH rubber-atlas") && page.contains("completions")
+    );
+    // The text output uses the JSON's words.
+    let mut cell = vec!["cell"];
+    cell.extend(BODY);
+    cell.extend(["--kappa", "1", "--energy", "3"]);
+    let text = String::from_utf8_lossy(&run(&cell).stdout).into_owned();
+    assert!(
+        text.contains("(quadrature, tol") && text.contains("status ok"),
+        "{text}"
+    );
+    assert!(
+        !text.contains("Quadrature") && !text.contains("status Ok"),
+        "{text}"
+    );
+    // RAYON_NUM_THREADS is honoured by `run` when --threads is absent.
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("s.toml");
+    std::fs::write(
+        &scene,
+        "name = \"s\"\n[body]\nnu = 0.5\neta = 0.5\n[axes]\nalpha = [0.5]\nbeta = [3.0]\n\
+         kappa = { start = 0.0, stop = 1.0, num = 8 }\nenergy = { start = 1.0, stop = 3.0, num = 8 }\n",
+    )
+    .unwrap();
+    let out = dir.path().join("s.h5");
+    let o = Command::new(env!("CARGO_BIN_EXE_rubber-atlas"))
+        .args([
+            "run",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .env("RAYON_NUM_THREADS", "1")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("on 1 thread(s)"));
+}

@@ -114,6 +114,43 @@ def test_the_plot_script_draws_the_atlas(demo, tmp_path):
     assert png.stat().st_size > 20_000
 
 
+def test_open_atlas_takes_an_engine_and_other_keywords(demo):
+    with open_atlas(demo, engine="h5netcdf", decode_times=False) as ds:
+        assert "rotation_number" in ds
+
+
+STATUS_ONLY = """name = "status-only"
+[body]
+nu = 0.5
+eta = 0.5
+[axes]
+alpha = [0.5]
+beta = [3.0]
+kappa = { start = 0.0, stop = 1.0, num = 5 }
+energy = { start = 1.0, stop = 3.0, num = 5 }
+[outputs]
+fields = ["status", "period"]
+"""
+
+
+def test_the_plot_script_says_what_is_missing_instead_of_a_traceback(make_atlas, tmp_path):
+    atlas = make_atlas("status-only", STATUS_ONLY)
+    out = subprocess.run([sys.executable, str(ROOT / "scripts" / "plot_atlas.py"), str(atlas), "--out",
+                          str(tmp_path / "x.png")], capture_output=True, text=True)
+    assert out.returncode != 0
+    assert "no finite rotation_number" in out.stderr and "Traceback" not in out.stderr
+
+
+@pytest.mark.parametrize("script", ["figures", "hypothesis", "plot_atlas", "plot_trajectory", "plot_work_precision",
+                                    "resonance", "speed_comparison", "whole_domain", "work_precision_truth"])
+def test_every_script_help_is_whole_sentences(script):
+    out = subprocess.run([sys.executable, str(ROOT / "scripts" / f"{script}.py"), "--help"],
+                         capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    description = out.stdout.split("\n\n")[1].strip()
+    assert description.endswith((".", ":", ")")), description
+
+
 def test_a_partial_file_is_not_opened_as_an_atlas(tmp_path):
     partial = tmp_path / "x.h5.partial.h5"
     partial.write_bytes(b"")
