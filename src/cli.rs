@@ -859,21 +859,25 @@ fn run_scene(args: RunArgs) -> Result<()> {
         shard,
         attributes: invocation_attributes(),
     };
-    crate::stop::install().context("cannot install the SIGINT and SIGTERM handlers")?;
+    // The command that continues this run, quoted for a POSIX shell.
+    let shard_arg = match &args.shard {
+        Some(text) => format!(" --shard {}", shell_quote(text)),
+        None => String::new(),
+    };
+    let resume = format!(
+        "rubber-atlas run {}{shard_arg} --out {} --resume",
+        shell_quote(&args.scene.display().to_string()),
+        shell_quote(&out.display().to_string()),
+    );
+    crate::stop::install(&resume).context("cannot install the SIGINT and SIGTERM handlers")?;
     let reporter = Reporter::new(args.quiet, &scene.name);
     let summary = match sweep::run(&scene, &request, &reporter) {
         Err(AtlasError::Interrupted { done, total, .. }) => {
             reporter.finish();
             let (signal, status) = crate::stop::received();
-            let shard_arg = match &args.shard {
-                Some(text) => format!(" --shard {text}"),
-                None => String::new(),
-            };
             eprintln!(
-                "rubber-atlas: stopped by {signal} with {done} of {total} cells computed and kept in {}; continue with: rubber-atlas run {}{shard_arg} --out {} --resume",
+                "rubber-atlas: stopped by {signal} with {done} of {total} cells computed and kept in {}; continue with: {resume}",
                 rubber_atlas::store::journal::Journal::dir_for(&out).display(),
-                args.scene.display(),
-                out.display(),
             );
             std::process::exit(i32::from(status));
         }
@@ -1148,6 +1152,17 @@ fn cell(args: CellArgs) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// `text` as one word for a POSIX shell: as it is when it needs no quoting, else in single
+/// quotes (a quote inside as '\'').
+fn shell_quote(text: &str) -> String {
+    let plain = |c: char| c.is_ascii_alphanumeric() || "_-./=:,+@%".contains(c);
+    if !text.is_empty() && text.chars().all(plain) {
+        text.to_string()
+    } else {
+        format!("'{}'", text.replace('\'', "'\\''"))
+    }
 }
 
 /// The name a value has in the JSON output (`ok`, `libration`, `quadrature`), so that the

@@ -367,12 +367,25 @@ fn parameter_error(reader: &Reader<'_>, key: &str, e: AtlasError) -> AtlasError 
 impl Scene {
     /// Reads and checks the scene file at `path`.
     pub fn from_file(path: &Path) -> Result<Scene> {
+        /// Far above any scene (a few kB): a device or a huge file is not read to the end.
+        const MAX_SCENE_BYTES: u64 = 1 << 20;
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| AtlasError::Scene {
+        let fail = |reason: String| AtlasError::Scene {
             file: file.clone(),
             key: "(file)".into(),
-            reason: e.to_string(),
-        })?;
+            reason,
+        };
+        let meta = std::fs::metadata(path).map_err(|e| fail(e.to_string()))?;
+        if !meta.is_file() {
+            return Err(fail("not a regular file (a scene is a TOML file)".into()));
+        }
+        if meta.len() > MAX_SCENE_BYTES {
+            return Err(fail(format!(
+                "{} bytes: too large for a scene (at most {MAX_SCENE_BYTES})",
+                meta.len()
+            )));
+        }
+        let text = std::fs::read_to_string(path).map_err(|e| fail(e.to_string()))?;
         Scene::parse(&text, &file)
     }
 

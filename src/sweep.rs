@@ -227,12 +227,32 @@ pub fn footprint(scene: &Scene, shard: Shard, threads: usize) -> Footprint {
     }
 }
 
-/// Whether `out` is an atlas made from a scene with this fingerprint (its text and this
-/// build) for this shard.
-fn output_is_current(out: &Path, fingerprint: u64, shard: Shard) -> bool {
+/// Whether `out` is an atlas made from `scene` (its text and this build: the fingerprint)
+/// for this shard, whole: every variable present with the grid's shape and readable to the
+/// last chunk (a damaged chunk fails its filter when read).
+fn output_is_current(out: &Path, scene: &Scene, shard: Shard) -> bool {
+    let fingerprint = scene.fingerprint();
     let Ok(file) = hdf5::File::open(out) else {
         return false;
     };
+    let grid = scene.shape();
+    let whole = atlas::scene_variables(scene).iter().all(|v| {
+        let Ok(d) = file.dataset(v.name) else {
+            return false;
+        };
+        let mut shape = grid.to_vec();
+        if !v.kind.per_cell() {
+            shape.push(atlas::COMPONENT_SLOTS);
+        }
+        d.shape() == shape
+            && match v.kind {
+                atlas::Kind::Value | atlas::Kind::CellValue => d.read_raw::<f64>().is_ok(),
+                atlas::Kind::Flag | atlas::Kind::CellFlag => d.read_raw::<u8>().is_ok(),
+            }
+    });
+    if !whole {
+        return false;
+    }
     let text = |name: &str| {
         file.attr(name)
             .and_then(|a| a.read_scalar::<hdf5::types::VarLenUnicode>())
@@ -256,7 +276,7 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
     // Held until the file is in place and the journal gone.
     let _claim = crate::store::OutputLock::acquire(out)?;
     let fingerprint = scene.fingerprint();
-    if out.exists() && request.update && output_is_current(out, fingerprint, request.shard) {
+    if out.exists() && request.update && output_is_current(out, scene, request.shard) {
         return Ok(Summary {
             up_to_date: true,
             seconds: started.elapsed().as_secs_f64(),

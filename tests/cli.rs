@@ -685,6 +685,12 @@ fn requests_beyond_any_machine_are_refused_within_a_second() {
         "--out",
         atlas.to_str().unwrap(),
     ];
+    // A scene that is a device would be read without end.
+    assert_refused(
+        &["run", "/dev/zero", "--out", atlas.to_str().unwrap()],
+        "not a regular file",
+        Some(&out.join("none")),
+    );
     for (args, needle) in [
         (&run_scene[..], "--shard I/N"),
         (&diagram[..], "fewer --samples"),

@@ -122,3 +122,24 @@ def test_submit_passes_options_and_names_logs(tmp_path):
     assert "#SBATCH --output=atlas/logs/%x-%A_%a.out" in text and "#SBATCH --open-mode=append" in text
     ignored = subprocess.run(["git", "check-ignore", "-q", "atlas/logs/rubber-atlas-1_1.out"], cwd=ROOT)
     assert ignored.returncode == 0
+
+
+def test_a_damaged_shard_is_not_taken_as_current(tmp_path):
+    """--update reads the whole shard: one with a variable missing, or a chunk overwritten,
+    is recomputed; the result equals the undamaged shard."""
+    (tmp_path / "atlas").mkdir()
+    (tmp_path / "atlas" / "tiny.toml").write_text(SCENE)
+    sbatch(tmp_path, "atlas/tiny.toml", task=1)
+    shard = tmp_path / "atlas" / "tiny.shard-1-of-3.h5"
+    good = tmp_path / "good.h5"
+    good.write_bytes(shard.read_bytes())
+    with h5py.File(shard, "r+") as f:
+        del f["drift"]
+    assert "nothing to do" not in sbatch(tmp_path, "atlas/tiny.toml", task=1)
+    assert _same_arrays(shard, good)
+    data = bytearray(shard.read_bytes())
+    middle = len(data) // 2
+    data[middle:middle + 4096] = b"\xff" * 4096
+    shard.write_bytes(bytes(data))
+    assert "nothing to do" not in sbatch(tmp_path, "atlas/tiny.toml", task=1)
+    assert _same_arrays(shard, good)
