@@ -79,6 +79,19 @@ impl Kind {
     pub fn per_cell(self) -> bool {
         matches!(self, Kind::CellFlag | Kind::CellValue)
     }
+
+    /// Bytes per cell of a variable of this kind, uncompressed.
+    pub fn bytes_per_cell(self) -> usize {
+        let value = match self {
+            Kind::Value | Kind::CellValue => 8,
+            Kind::Flag | Kind::CellFlag => 1,
+        };
+        if self.per_cell() {
+            value
+        } else {
+            value * COMPONENT_SLOTS
+        }
+    }
 }
 
 /// One variable of the atlas file.

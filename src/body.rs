@@ -209,12 +209,20 @@ impl Ellipsoid {
         if self.alpha * a.cos >= 0.0 || self.alpha.abs() <= 0.5 {
             return (z + self.alpha * a.cos, a.cos + self.alpha * z);
         }
-        let lift = self.beta * self.beta * a.sin * a.sin / (z + a.cos.abs());
+        let lift = self.lift(a, z);
         let rest = 1.0 - self.alpha.abs();
         (
             lift + rest * a.cos.abs(),
             self.alpha.signum() * (lift - rest * z),
         )
+    }
+
+    /// L = Z − |cosθ| = β² sin²θ / (Z + |cosθ|) (from Z² − cos²θ = β² sin²θ), without
+    /// cancellation, with Z = `z`: the part of U = L + (1 − |α|)|cosθ| left where Z and
+    /// α cosθ cancel.
+    #[inline]
+    fn lift(&self, a: Angle, z: f64) -> f64 {
+        self.beta * self.beta * a.sin * a.sin / (z + a.cos.abs())
     }
 
     /// Whether Z and α cosθ cancel where U′ and the divided differences of U are formed:
@@ -322,7 +330,7 @@ impl Shape for Ellipsoid {
         if self.cancels(a) {
             let b2 = self.beta * self.beta;
             let c = a.cos.abs();
-            let lift = b2 * a.sin * a.sin / (z + c);
+            let lift = self.lift(a, z);
             let (c2, s2) = (c * c, a.sin * a.sin);
             let lift_second =
                 (c * lift * (z * z + z * c + c2) + b2 * c2 * c2 + b2 * (1.0 - b2) * s2 * s2)
@@ -349,9 +357,9 @@ impl Shape for Ellipsoid {
         let z = self.centre_height_at(a);
         let b2 = self.beta * self.beta;
         if self.cancels(a) {
-            let c = a.cos.abs();
-            let lift = b2 * a.sin * a.sin / (z + c);
-            return self.alpha.signum() * ((1.0 - self.alpha.abs()) - (lift + b2 * c) / z);
+            let lift = self.lift(a, z);
+            return self.alpha.signum()
+                * ((1.0 - self.alpha.abs()) - (lift + b2 * a.cos.abs()) / z);
         }
         (b2 - 1.0) * a.cos / z - self.alpha
     }
@@ -386,12 +394,9 @@ impl Shape for Ellipsoid {
         let (zx, zy) = (self.centre_height_at(x), self.centre_height_at(y));
         let shape = (b2 - 1.0) * sin_sum / (zx + zy);
         if self.cancels(x) && self.cancels(y) {
-            let (cx, cy) = (x.cos.abs(), y.cos.abs());
-            let (dx, dy) = (zx + cx, zy + cy);
             let cdd = self.alpha.signum() * (x.sin + y.sin) / (1.0 + cos_diff);
             let e = shape + cdd;
-            let lift_y = b2 * y.sin * y.sin / dy;
-            let lift_dd = (b2 * sin_sum - lift_y * e) / dx;
+            let lift_dd = (b2 * sin_sum - self.lift(y, zy) * e) / (zx + x.cos.abs());
             let rest = (1.0 - self.alpha.abs()) * cdd;
             return (lift_dd + rest, lift_dd.abs() + rest.abs());
         }

@@ -594,8 +594,8 @@ fn drift_radius(drift: f64, drift_error: f64, n: f64, n_error: f64) -> (f64, f64
     if drift.is_nan() {
         return (f64::NAN, f64::NAN);
     }
+    let s = (PI * n).sin().abs();
     if drift == 0.0 {
-        let s = (PI * n).sin().abs();
         return (
             0.0,
             if drift_error == 0.0 {
@@ -605,7 +605,6 @@ fn drift_radius(drift: f64, drift_error: f64, n: f64, n_error: f64) -> (f64, f64
             },
         );
     }
-    let s = (PI * n).sin().abs();
     let r = drift / (2.0 * s);
     let rel = drift_error / drift + PI * n_error * (PI * n).cos().abs() / s;
     (r, r * rel)

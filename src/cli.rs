@@ -192,15 +192,67 @@ pub struct RunArgs {
     /// --shard, or --out) and exit.
     #[arg(long)]
     pub print_out: bool,
-    /// Run even where the estimated memory or disk exceeds what this machine has free.
-    #[arg(long)]
-    pub allow_large: bool,
+    #[command(flatten)]
+    pub limits: Limits,
     /// Compute part I of N of the grid (1 <= I <= N) into its own file.
     #[arg(long, value_name = "I/N")]
     pub shard: Option<String>,
     /// No progress and no summary.
     #[arg(long)]
     pub quiet: bool,
+}
+
+/// The size check of a command that may ask for more than the machine has.
+#[derive(Debug, Args)]
+pub struct Limits {
+    /// Run even where the estimated memory or disk exceeds what this machine has free.
+    #[arg(long)]
+    pub allow_large: bool,
+}
+
+impl Limits {
+    /// Refuses work whose estimated peak `memory` (over 80 % of what is available) or `disk`
+    /// for `out` (over what is free there) exceeds the machine, in one line with both
+    /// figures, the `remedy` and --allow-large; nothing with --allow-large.
+    fn check(
+        &self,
+        memory: f64,
+        disk: Option<f64>,
+        out: Option<&std::path::Path>,
+        remedy: &str,
+    ) -> Result<()> {
+        if self.allow_large {
+            return Ok(());
+        }
+        let mut short = Vec::new();
+        if let Some(free) = available_memory().filter(|&free| memory > 0.8 * free) {
+            short.push(format!(
+                "about {} of memory ({} available)",
+                show_bytes(memory),
+                show_bytes(free)
+            ));
+        }
+        if let (Some(disk), Some(out)) = (disk, out) {
+            if let Some(free) = free_disk(out).filter(|&free| disk > free) {
+                short.push(format!(
+                    "up to {} of disk ({} free there)",
+                    show_bytes(disk),
+                    show_bytes(free)
+                ));
+            }
+        }
+        if short.is_empty() {
+            return Ok(());
+        }
+        Err(AtlasError::Atlas {
+            path: out.map_or("the request".into(), |o| o.display().to_string()),
+            reason: format!(
+                "needs {}; {remedy}; --allow-large runs it anyway",
+                short.join(" and ")
+            ),
+        }
+        .into())
+    }
 }
 
 #[derive(Debug, Args)]
@@ -337,9 +389,8 @@ pub struct DiagramArgs {
     /// Samples of θ0 per half (θ0 < π/2, θ0 > π/2) of the fixed-point curves.
     #[arg(long, default_value_t = 2000)]
     pub samples: usize,
-    /// Run even where the estimated memory or disk exceeds what this machine has free.
-    #[arg(long)]
-    pub allow_large: bool,
+    #[command(flatten)]
+    pub limits: Limits,
     /// Truncate the sampled curves at this κ.
     #[arg(long, default_value_t = 3.0, allow_hyphen_values = true)]
     pub kappa_max: f64,
@@ -373,9 +424,8 @@ pub struct TrajectoryArgs {
     /// Number of output intervals (the file has SAMPLES + 1 rows).
     #[arg(long, default_value_t = 2000)]
     pub samples: usize,
-    /// Run even where the estimated memory or disk exceeds what this machine has free.
-    #[arg(long)]
-    pub allow_large: bool,
+    #[command(flatten)]
+    pub limits: Limits,
     /// Relative and absolute tolerance of the DOP853 integrator.
     #[arg(long, default_value_t = 1e-12, allow_hyphen_values = true)]
     pub tol: f64,
@@ -841,9 +891,17 @@ fn run_scene(args: RunArgs) -> Result<()> {
         None => std::thread::available_parallelism().map_or(1, |n| n.get()),
     };
     // Before anything is allocated: a grid the machine cannot hold is refused in one line.
-    if !args.allow_large {
-        check_footprint(&sweep::footprint(&scene, shard, threads), &out)?;
-    }
+    let need = sweep::footprint(&scene, shard, threads);
+    args.limits.check(
+        need.memory_bytes,
+        Some(need.disk_bytes),
+        Some(&out),
+        &format!(
+            "the run has {:.3e} cells: {}use fewer kappa or energy points",
+            need.cells,
+            shards_to_fit(&need)
+        ),
+    )?;
     // The global pool, so that the run's serial parts (file creation, writing) stay on the
     // main thread: on a pool thread glibc grows that thread's heap a page at a time, and
     // creating the HDF5 file took 7 ms of mprotect calls instead of 1.
@@ -899,13 +957,11 @@ fn run_scene(args: RunArgs) -> Result<()> {
     Ok(())
 }
 
-/// Bytes as a person reads them: 1.5 GB, 310 MB.
+/// Bytes as a person reads them, one format throughout: 1.5 GB, 310.0 MB.
 fn show_bytes(bytes: f64) -> String {
     let units = [("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("kB", 1e3)];
     match units.iter().find(|(_, size)| bytes >= *size) {
-        Some((name, size)) => format!("{:.3} {name}", bytes / size)
-            .replace(".000 ", " ")
-            .to_string(),
+        Some((name, size)) => format!("{:.1} {name}", bytes / size),
         None => format!("{bytes:.0} B"),
     }
 }
@@ -934,62 +990,15 @@ fn free_disk(out: &std::path::Path) -> Option<f64> {
     Some(stat.f_bavail as f64 * stat.f_frsize as f64)
 }
 
-/// Refuses work whose estimated peak `memory` (over 80 % of what is available) or `disk`
-/// for `out` (over what is free there) exceeds the machine, in one line with both figures,
-/// the `remedy` and --allow-large.
-fn check_resources(
-    memory: f64,
-    disk: Option<f64>,
-    out: Option<&std::path::Path>,
-    remedy: &str,
-) -> Result<()> {
-    let mut short = Vec::new();
-    if let Some(free) = available_memory().filter(|&free| memory > 0.8 * free) {
-        short.push(format!(
-            "about {} of memory ({} available)",
-            show_bytes(memory),
-            show_bytes(free)
-        ));
-    }
-    if let (Some(disk), Some(out)) = (disk, out) {
-        if let Some(free) = free_disk(out).filter(|&free| disk > free) {
-            short.push(format!(
-                "up to {} of disk ({} free there)",
-                show_bytes(disk),
-                show_bytes(free)
-            ));
-        }
-    }
-    if short.is_empty() {
-        return Ok(());
-    }
-    Err(AtlasError::Atlas {
-        path: out.map_or("the request".into(), |o| o.display().to_string()),
-        reason: format!(
-            "needs {}; {remedy}; --allow-large runs it anyway",
-            short.join(" and ")
-        ),
-    }
-    .into())
-}
-
-/// [`check_resources`] for a run, suggesting how many shards would fit in memory.
-fn check_footprint(need: &sweep::Footprint, out: &std::path::Path) -> Result<()> {
+/// The shards a run would need for its largest slice to fit in half the available memory,
+/// as a phrase for the refusal ("" when one machine would do).
+fn shards_to_fit(need: &sweep::Footprint) -> String {
     let shards = available_memory().map_or(1.0, |free| (need.memory_bytes / (0.5 * free)).ceil());
-    let split = if shards > 1.0 {
+    if shards > 1.0 {
         format!("split it with --shard I/N (N >= {shards:.0}) across machines, or ")
     } else {
         String::new()
-    };
-    check_resources(
-        need.memory_bytes,
-        Some(need.disk_bytes),
-        Some(out),
-        &format!(
-            "the run has {:.3e} cells: {split}use fewer kappa or energy points",
-            need.cells
-        ),
-    )
+    }
 }
 
 fn merge(args: MergeArgs) -> Result<()> {
@@ -1201,13 +1210,15 @@ fn diagram(args: DiagramArgs) -> Result<()> {
     if let Some(out) = &args.out {
         check_output(out, args.force, &[], &TABLE_EXTENSIONS)?;
     }
-    if !args.allow_large {
-        // Measured: 245 bytes of memory per sample at the peak, 2 points per sample of
-        // about 150 bytes each in a CSV file.
-        let memory = 300.0 * args.samples as f64;
-        let disk = args.out.as_ref().map(|_| 300.0 * args.samples as f64);
-        check_resources(memory, disk, args.out.as_deref(), "use fewer --samples")?;
-    }
+    // Measured: 245 bytes of memory per sample at the peak, 2 points per sample of about
+    // 150 bytes each in a CSV file.
+    let per_sample = 300.0 * args.samples as f64;
+    args.limits.check(
+        per_sample,
+        args.out.as_ref().map(|_| per_sample),
+        args.out.as_deref(),
+        "use fewer --samples",
+    )?;
     let body = EllipsoidBody::ellipsoid(args.shape.alpha, args.shape.beta, args.nu, args.eta)?;
     let set = CriticalSet::of(&body, args.samples, args.kappa_max)?;
     if args.json {
@@ -1392,17 +1403,15 @@ fn trajectory(args: TrajectoryArgs) -> Result<()> {
         }
         .into());
     }
-    if !args.allow_large {
-        // Measured: 135 bytes of memory per sample at the peak; a CSV row of 10 columns
-        // is under 250 bytes.
-        let rows = args.samples as f64 + 1.0;
-        check_resources(
-            160.0 * rows,
-            Some(250.0 * rows),
-            Some(&args.out),
-            "use fewer --samples",
-        )?;
-    }
+    // Measured: 135 bytes of memory per sample at the peak; a CSV row of 10 columns is
+    // under 250 bytes.
+    let rows = args.samples as f64 + 1.0;
+    args.limits.check(
+        160.0 * rows,
+        Some(250.0 * rows),
+        Some(&args.out),
+        "use fewer --samples",
+    )?;
     let start = match (args.start.energy, args.start.theta0) {
         (Some(e), None) => {
             if !e.is_finite() {

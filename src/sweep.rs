@@ -208,15 +208,10 @@ pub fn footprint(scene: &Scene, shard: Shard, threads: usize) -> Footprint {
     // This shard's share of the units, as `Shard::units` splits them.
     let share = (total / shard.count as f64).ceil();
     let unit_cells = rows * ne;
-    let bytes_per_cell: f64 = atlas::scene_variables(scene)
+    let bytes_per_cell = atlas::scene_variables(scene)
         .iter()
-        .map(|v| match v.kind {
-            atlas::Kind::Value => (8 * atlas::COMPONENT_SLOTS) as f64,
-            atlas::Kind::Flag => atlas::COMPONENT_SLOTS as f64,
-            atlas::Kind::CellFlag => 1.0,
-            atlas::Kind::CellValue => 8.0,
-        })
-        .sum();
+        .map(|v| v.kind.bytes_per_cell())
+        .sum::<usize>() as f64;
     let cells = share * unit_cells;
     let slice_run = share.min(per_slice) * unit_cells;
     Footprint {
@@ -228,41 +223,16 @@ pub fn footprint(scene: &Scene, shard: Shard, threads: usize) -> Footprint {
 }
 
 /// Whether `out` is an atlas made from `scene` (its text and this build: the fingerprint)
-/// for this shard, whole: every variable present with the grid's shape and readable to the
-/// last chunk (a damaged chunk fails its filter when read).
+/// for this shard, and whole ([`AtlasFile::is_whole`]).
 fn output_is_current(out: &Path, scene: &Scene, shard: Shard) -> bool {
-    let fingerprint = scene.fingerprint();
-    let Ok(file) = hdf5::File::open(out) else {
+    let Ok(file) = AtlasFile::open(out, scene, &atlas::scene_variables(scene)) else {
         return false;
     };
-    let grid = scene.shape();
-    let whole = atlas::scene_variables(scene).iter().all(|v| {
-        let Ok(d) = file.dataset(v.name) else {
-            return false;
-        };
-        let mut shape = grid.to_vec();
-        if !v.kind.per_cell() {
-            shape.push(atlas::COMPONENT_SLOTS);
-        }
-        d.shape() == shape
-            && match v.kind {
-                atlas::Kind::Value | atlas::Kind::CellValue => d.read_raw::<f64>().is_ok(),
-                atlas::Kind::Flag | atlas::Kind::CellFlag => d.read_raw::<u8>().is_ok(),
-            }
-    });
-    if !whole {
-        return false;
-    }
-    let text = |name: &str| {
-        file.attr(name)
-            .and_then(|a| a.read_scalar::<hdf5::types::VarLenUnicode>())
-            .map(|s| s.as_str().to_string())
-            .ok()
-    };
-    let integer = |name: &str| file.attr(name).and_then(|a| a.read_scalar::<i64>()).ok();
-    text("scene_fingerprint").as_deref() == Some(format!("{fingerprint:016x}").as_str())
-        && integer("shard_index") == Some(shard.index as i64)
-        && integer("shard_count") == Some(shard.count as i64)
+    file.text_attribute("scene_fingerprint").as_deref()
+        == Some(format!("{:016x}", scene.fingerprint()).as_str())
+        && file.integer_attribute("shard_index") == Some(shard.index as i64)
+        && file.integer_attribute("shard_count") == Some(shard.count as i64)
+        && file.is_whole()
 }
 
 /// Runs `scene` as `request` says; returns the summary.

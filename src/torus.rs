@@ -874,17 +874,18 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
     /// tangency.
     fn pieces(&self, energy: f64, component: &Component, cut: bool) -> Vec<Piece> {
         let end = |site: Site, turning: bool| {
-            let value = self.value(site.angle());
+            let angle = site.angle();
+            let value = self.value(angle);
             PieceEnd {
                 site,
-                angle: site.angle(),
+                angle,
                 excess: if turning { 0.0 } else { energy - value },
                 level: if turning { value } else { energy },
                 // ε − V(e) carries the rounding of V(e) and of the subtraction.
                 excess_error: if turning {
                     0.0
                 } else {
-                    4.0 * EPS * (self.value_scale(site.angle()) + energy.abs())
+                    4.0 * EPS * (self.value_scale(angle) + energy.abs())
                 },
             }
         };

@@ -288,6 +288,22 @@ impl AtlasFile {
         inner().map_err(|e| AtlasError::atlas(path, e))
     }
 
+    /// Whether every variable has the grid's shape and reads to its last chunk (a damaged
+    /// chunk fails its filter when read): an existing output taken as current must be whole.
+    pub fn is_whole(&self) -> bool {
+        self.variables.iter().zip(&self.datasets).all(|(v, d)| {
+            let mut shape = self.shape.to_vec();
+            if !v.kind.per_cell() {
+                shape.push(COMPONENT_SLOTS);
+            }
+            d.shape() == shape
+                && match v.kind {
+                    Kind::Value | Kind::CellValue => d.read_raw::<f64>().is_ok(),
+                    Kind::Flag | Kind::CellFlag => d.read_raw::<u8>().is_ok(),
+                }
+        })
+    }
+
     /// A text attribute of the root, if present.
     pub fn text_attribute(&self, name: &str) -> Option<String> {
         self.file
