@@ -1,10 +1,18 @@
 //! Build script: links the HDF5 high-level library (dimension scales, `H5DS*`) next to the
-//! HDF5 library that the `hdf5` crate links, and records the git commit for provenance
+//! HDF5 library that the `hdf5` crate links (with the `hdf5` feature), and records the git commit for provenance
 //! (marked `-dirty` when tracked files differ from it).
 
 use std::process::Command;
 
 fn main() {
+    // Without the `hdf5` feature (the Python extension) no HDF5 library is linked.
+    if std::env::var_os("CARGO_FEATURE_HDF5").is_some() {
+        link_hdf5_hl();
+    }
+    record_commit();
+}
+
+fn link_hdf5_hl() {
     // The hdf5 crate finds HDF5 with pkg-config (Debian: .../hdf5/serial); the high-level
     // library `hdf5_hl` sits in the same directory.
     let mut found = false;
@@ -30,7 +38,9 @@ fn main() {
         }
     }
     println!("cargo:rustc-link-lib=dylib=hdf5_hl");
+}
 
+fn record_commit() {
     let commit = Command::new("git")
         .args(["rev-parse", "HEAD"])
         .output()

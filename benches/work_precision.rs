@@ -11,9 +11,21 @@
 use rubber_atlas::cell::{solve_level, CellOptions, ComponentResult, Method};
 use rubber_atlas::torus::EffectivePotential;
 use rubber_atlas::EllipsoidBody;
-use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
+
+/// A row of `benches/work_precision_cells.csv`: a cell and its 40-digit truth.
+#[derive(serde::Deserialize)]
+struct Truth {
+    class: String,
+    alpha: f64,
+    beta: f64,
+    kappa: f64,
+    energy: f64,
+    theta: f64,
+    period: f64,
+    rotation_number: f64,
+}
 
 struct Cell {
     class: String,
@@ -26,21 +38,20 @@ struct Cell {
 }
 
 fn read_cells(path: &Path) -> Vec<Cell> {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    text.lines()
-        .skip(1)
-        .filter(|l| !l.trim().is_empty())
-        .map(|line| {
-            let f: Vec<&str> = line.split(',').collect();
-            let num = |i: usize| -> f64 { f[i].parse().expect("a number") };
+    let mut reader =
+        csv::Reader::from_path(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    reader
+        .deserialize::<Truth>()
+        .map(|row| {
+            let t = row.unwrap_or_else(|e| panic!("{}: {e}", path.display()));
             Cell {
-                class: f[0].to_string(),
-                body: EllipsoidBody::ellipsoid(num(1), num(2), 0.5, 0.5).expect("a valid body"),
-                kappa: num(3),
-                energy: num(4),
-                theta: num(5),
-                period: num(6),
-                rotation_number: num(7),
+                class: t.class,
+                body: EllipsoidBody::ellipsoid(t.alpha, t.beta, 0.5, 0.5).expect("a valid body"),
+                kappa: t.kappa,
+                energy: t.energy,
+                theta: t.theta,
+                period: t.period,
+                rotation_number: t.rotation_number,
             }
         })
         .collect()
@@ -55,16 +66,23 @@ fn component_at(components: &[ComponentResult], theta: f64) -> &ComponentResult 
         .expect("a cell of the study has motion")
 }
 
+/// A row of docs/work-precision.csv.
+#[derive(serde::Serialize)]
 struct Row {
     class: String,
     method: &'static str,
     tol: f64,
     cells: usize,
     seconds_per_cell: f64,
+    #[serde(rename = "max_abs_error_n")]
     max_error_n: f64,
+    #[serde(rename = "max_error_estimate_n")]
     max_estimate_n: f64,
+    #[serde(rename = "max_rel_error_t")]
     max_relative_error_t: f64,
+    #[serde(rename = "dishonest_cells")]
     dishonest: usize,
+    #[serde(rename = "mean_work")]
     work: f64,
 }
 
@@ -141,28 +159,16 @@ fn main() {
             }
         }
     }
-    let mut csv = String::from(
-        "class,method,tol,cells,seconds_per_cell,max_abs_error_n,max_error_estimate_n,\
-         max_rel_error_t,dishonest_cells,mean_work\n",
-    );
-    for r in &rows {
-        writeln!(
-            csv,
-            "{},{},{:e},{},{:e},{:e},{:e},{:e},{},{:.1}",
-            r.class,
-            r.method,
-            r.tol,
-            r.cells,
-            r.seconds_per_cell,
-            r.max_error_n,
-            r.max_estimate_n,
-            r.max_relative_error_t,
-            r.dishonest,
-            r.work
-        )
-        .expect("writing to a String");
-    }
     let out = root.join("docs/work-precision.csv");
-    std::fs::write(&out, csv).unwrap_or_else(|e| panic!("{}: {e}", out.display()));
+    let mut writer =
+        csv::Writer::from_path(&out).unwrap_or_else(|e| panic!("{}: {e}", out.display()));
+    for r in &rows {
+        writer
+            .serialize(r)
+            .unwrap_or_else(|e| panic!("{}: {e}", out.display()));
+    }
+    writer
+        .flush()
+        .unwrap_or_else(|e| panic!("{}: {e}", out.display()));
     println!("wrote {}", out.display());
 }

@@ -31,14 +31,18 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from atlas_io import open_atlas  # noqa: E402
-from trajectory_io import read_table  # noqa: E402
+from rubber_atlas import open_atlas, read_table  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 BIN = os.environ.get("RUBBER_ATLAS_BIN", str(ROOT / "target" / "release" / "rubber-atlas"))
 NU = ETA = 0.5
 # The paper's bodies of Figs. bifa, bifb, php (type c), bifd, bife.
 BODIES = {"a": (0.5, 0.5), "b": (0.5, 1.1), "c": (0.5, 3.0), "d": (0.0, 0.5), "e": (0.0, 1.5)}
+
+
+def columns(path) -> dict[str, np.ndarray]:
+    """The columns of a table file as numpy arrays."""
+    return {name: v.values for name, v in read_table(path).variables.items()}
 
 
 def run(*args: str) -> str:
@@ -58,7 +62,7 @@ def diagram_curves(alpha: float, beta: float, kappa_max: float = 3.0):
     with tempfile.TemporaryDirectory() as d:
         path = Path(d) / "diagram.csv"
         run("diagram", *body_args(alpha, beta), "--kappa-max", kappa_max, "--out", path)
-        cols, _ = read_table(path)
+        cols = columns(path)
     out = []
     for seg in np.unique(cols["segment"]):
         m = cols["segment"] == seg
@@ -178,7 +182,7 @@ def phase_portrait(ax, alpha: float, beta: float, kappa: float, levels: int = 9)
                 path = Path(d) / f"p{e:.4f}-{i}.csv"
                 run("trajectory", *body_args(alpha, beta), "--kappa", kappa, "--energy", repr(float(e)),
                     "--component", i, "--periods", 1, "--samples", 300, "--out", path)
-                cols, _ = read_table(path)
+                cols = columns(path)
                 theta = np.mod(cols["theta"], 2 * np.pi) if kappa == 0 else cols["theta"]
                 ax.plot(theta, cols["theta_dot"], ".", ms=0.8, color=plt.cm.viridis((e - eps_lo) / 2.6))
     ax.set_xlabel("θ")
@@ -222,7 +226,7 @@ def fig_res(out: Path, targets=("0", "1", "-1/2", "-1/7", "-2/3"), grid: int = 3
             path = Path(d) / "n0.csv"
             run("trajectory", *body_args(alpha, beta), "--kappa", repr(n0["kappa"]), "--energy", repr(n0["energy"]),
                 "--component", n0["component"], "--periods", 12, "--samples", 3000, "--out", path)
-            cols, _ = read_table(path)
+            cols = columns(path)
         left.plot(cols["x_c"], cols["y_c"], "-", color="darkred", lw=1, label="centre of mass")
         left.plot(cols["x_p"], cols["y_p"], ":", color="darkblue", lw=1, label="contact point")
         left.set_aspect("equal")
@@ -241,7 +245,7 @@ def fig_xy(out: Path) -> Path:
             path = Path(d) / f"xy-{kappa}.csv"
             run("trajectory", *body_args(alpha, beta), "--kappa", kappa, "--theta0", theta0, "--periods", periods,
                 "--samples", 200 * periods, "--out", path)
-            cols, _ = read_table(path)
+            cols = columns(path)
             ax.plot(cols["x_c"], cols["y_c"], "-", color="darkred", lw=0.8, label="centre of mass")
             ax.plot(cols["x_p"], cols["y_p"], ":", color="darkblue", lw=0.8, label="contact point")
             ax.set_aspect("equal")

@@ -9,18 +9,17 @@ import argparse
 import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from trajectory_io import read_table  # noqa: E402
+from rubber_atlas import read_table  # noqa: E402
 
 
 def plot(path: str | Path, out: str | Path) -> Path:
-    cols, attrs = read_table(path)
+    table = read_table(path)
+    cols, attrs = {k: v.values for k, v in table.variables.items()}, table.attrs
     fig, (ax_xy, ax_t) = plt.subplots(1, 2, figsize=(11, 5), gridspec_kw={"width_ratios": [1, 1.2]})
     ax_xy.plot(cols["x_p"], cols["y_p"], lw=0.6, color="tab:orange", label="contact point")
     ax_xy.plot(cols["x_c"], cols["y_c"], lw=0.9, color="tab:blue", label="centre of mass")

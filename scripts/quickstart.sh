@@ -14,12 +14,12 @@ mkdir -p atlas/out
 echo "quickstart: rubber-atlas run atlas/demo.toml --out atlas/out/demo.h5 --force"
 "$bin" run atlas/demo.toml --out atlas/out/demo.h5 --force
 echo "quickstart: opening atlas/out/demo.h5 in xarray"
-(cd scripts && ../.venv/bin/python -c "
-from atlas_io import open_atlas
-ds = open_atlas('../atlas/out/demo.h5')
+.venv/bin/python -c "
+import rubber_atlas as ra
+ds = ra.open_atlas('atlas/out/demo.h5')
 print(ds)
-")
-(cd scripts && ../.venv/bin/python plot_atlas.py ../atlas/out/demo.h5 --out ../atlas/out/demo.png)
+"
+.venv/bin/python scripts/plot_atlas.py atlas/out/demo.h5 --out atlas/out/demo.png
 # The same body (the paper's Figs. php, res and xy): diagram type (c).
 alpha=0.5 beta=3 nu=0.5 eta=0.5
 echo "quickstart: rubber-atlas diagram --alpha $alpha --beta $beta --nu $nu --eta $eta"

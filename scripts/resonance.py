@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from atlas_io import open_atlas
+from rubber_atlas import open_atlas
 
 ROOT = Path(__file__).resolve().parents[1]
 BIN = os.environ.get("RUBBER_ATLAS_BIN", str(ROOT / "target" / "release" / "rubber-atlas"))

@@ -1,17 +1,23 @@
 #!/usr/bin/env bash
 # Every test of rubber-atlas: formatting and lints, the Rust tests (release mode: the numerical
-# tests integrate the equations of motion), and the Python tests of scripts/. Installs what is
-# missing first (scripts/setup.sh). Exits non-zero if any suite fails or runs no test.
+# tests integrate the equations of motion), the Python tests of scripts/ and those of the
+# installed package (python/tests). Installs what is missing first (scripts/setup.sh). Exits non-zero if any suite fails or runs no test.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$root"
 bash scripts/setup.sh
 echo "test: cargo fmt --check"
 cargo fmt --all -- --check
-echo "test: cargo clippy -D warnings"
+echo "test: cargo clippy -D warnings (the program, and the Python extension's features)"
 cargo clippy --release --all-targets --quiet -- -D warnings
+cargo clippy --release --lib --no-default-features --features python --quiet -- -D warnings
 echo "test: cargo test --release"
 cargo test --release
 echo "test: pytest scripts/tests"
 cargo build --release --quiet
 RUBBER_ATLAS_BIN="$root/target/release/rubber-atlas" .venv/bin/python -m pytest -q scripts/tests
+echo "test: pytest python/tests, on the installed package, from a folder outside the repository"
+outside="$(mktemp -d)"
+trap 'rm -rf "$outside"' EXIT
+(cd "$outside" && RUBBER_ATLAS_BIN="$root/target/release/rubber-atlas" \
+  "$root/.venv/bin/python" -m pytest -q -p no:cacheprovider --rootdir "$outside" "$root/python/tests")

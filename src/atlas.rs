@@ -5,6 +5,7 @@
 #[cfg(test)]
 use crate::cell::CellOptions;
 use crate::cell::{solve_high_energy_limit, solve_level, CellResult, ComponentResult, Status};
+use crate::cf::{self, Units};
 use crate::error::{AtlasError, Result};
 use crate::scene::{Field, Plane, Scene};
 use crate::torus::{EffectivePotential, MotionKind};
@@ -60,6 +61,30 @@ pub mod motion_flag {
 /// The fill value of the u8 variables where a component does not exist.
 pub const FLAG_FILL: u8 = 255;
 
+/// The long name and units of a coordinate of the cells: the body's α, β, ν, η, the level's
+/// κ and ε, and the component slot (the atlas file's coordinates, and the Python package's).
+pub fn coordinate(name: &str) -> Option<(&'static str, Units)> {
+    Some(match name {
+        "alpha" => (
+            "alpha = a / b3, offset of the centre of mass along the symmetry axis",
+            cf::NUMBER,
+        ),
+        "beta" => ("beta = b1 / b3, ratio of the semi-axes", cf::NUMBER),
+        "nu" => ("nu = i3 / i1, ratio of the moments of inertia", cf::NUMBER),
+        "eta" => ("eta = m b3^2 / i1", cf::NUMBER),
+        "kappa" => ("kappa = F2, the first integral of the reduction", cf::PAPER),
+        "energy" => (
+            "energy, the value of the reduced energy integral",
+            cf::ENERGY,
+        ),
+        "component" => (
+            "component of the allowed set, in increasing theta_min",
+            cf::NUMBER,
+        ),
+        _ => return None,
+    })
+}
+
 /// How a variable is laid out.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Kind {
@@ -100,19 +125,37 @@ pub struct Variable {
     pub name: &'static str,
     pub kind: Kind,
     pub long_name: &'static str,
-    pub units: &'static str,
+    pub units: Units,
     /// `flag_values` and `flag_meanings` for flag variables.
     pub flags: Option<(&'static [u8], &'static str)>,
     value: fn(&ComponentResult) -> f64,
 }
 
-const TIME: &str = "sqrt(b3/g)";
-const RATE: &str = "rad/sqrt(b3/g)";
+/// The meaning of [`FLAG_FILL`] in a per-component flag: no component in this slot, or (for
+/// `bounded`) no verdict.
+pub const FLAG_FILL_MEANING: &str = "no_value";
+
+impl Variable {
+    /// The CF `flag_values` and `flag_meanings` as the files carry them: a per-component
+    /// flag has [`FLAG_FILL`] as a value of its own ([`FLAG_FILL_MEANING`]), so that it
+    /// needs no _FillValue and stays an integer in xarray.
+    pub fn flag_attributes(&self) -> Option<(Vec<u8>, String)> {
+        let (values, meanings) = self.flags?;
+        let mut values = values.to_vec();
+        let mut meanings = meanings.to_string();
+        if self.kind == Kind::Flag {
+            values.push(FLAG_FILL);
+            meanings.push(' ');
+            meanings.push_str(FLAG_FILL_MEANING);
+        }
+        Some((values, meanings))
+    }
+}
 
 fn float(
     name: &'static str,
     long_name: &'static str,
-    units: &'static str,
+    units: Units,
     value: fn(&ComponentResult) -> f64,
 ) -> Variable {
     Variable {
@@ -135,7 +178,7 @@ fn flag(
         name,
         kind: Kind::Flag,
         long_name,
-        units: "1",
+        units: cf::NUMBER,
         flags: Some(flags),
         value,
     }
@@ -149,12 +192,8 @@ pub fn scene_variables(scene: &Scene) -> Vec<Variable> {
         vars.push(Variable {
             name,
             kind: Kind::CellValue,
-            long_name: if name == "kappa" {
-                "kappa = F2, the first integral of the reduction, of each cell"
-            } else {
-                "energy, the value of the reduced energy integral, of each cell"
-            },
-            units: "paper units (m = b3 = g = 1)",
+            long_name: coordinate(name).expect("kappa or energy").0,
+            units: coordinate(name).expect("kappa or energy").1,
             flags: None,
             value: |_| f64::NAN,
         });
@@ -171,7 +210,7 @@ pub fn variables(fields: &[Field]) -> Vec<Variable> {
             name: "n_components",
             kind: Kind::CellFlag,
             long_name: "number of connected components of the allowed set {V <= energy}",
-            units: "1",
+            units: cf::NUMBER,
             flags: None,
             value: |_| 0.0,
         },
@@ -179,7 +218,7 @@ pub fn variables(fields: &[Field]) -> Vec<Variable> {
             name: "cell_status",
             kind: Kind::CellFlag,
             long_name: "status of the cell",
-            units: "1",
+            units: cf::NUMBER,
             flags: Some((&cell_status::VALUES, cell_status::MEANINGS)),
             value: |_| 0.0,
         },
@@ -187,34 +226,43 @@ pub fn variables(fields: &[Field]) -> Vec<Variable> {
     for &field in fields {
         let (var, error): (Variable, Option<Variable>) = match field {
             Field::ThetaMin => (
-                float("theta_min", "lower turning point of theta", "rad", |c| {
-                    c.theta_min
-                }),
+                float(
+                    "theta_min",
+                    "lower turning point of theta",
+                    cf::ANGLE,
+                    |c| c.theta_min,
+                ),
                 None,
             ),
             Field::ThetaMax => (
-                float("theta_max", "upper turning point of theta", "rad", |c| {
-                    c.theta_max
-                }),
+                float(
+                    "theta_max",
+                    "upper turning point of theta",
+                    cf::ANGLE,
+                    |c| c.theta_max,
+                ),
                 None,
             ),
             Field::Period => (
-                float("period", "period T of theta", TIME, |c| c.period),
+                float("period", "period T of theta", cf::TIME, |c| c.period),
                 Some(float(
                     "period_error",
                     "estimated absolute error of period",
-                    TIME,
+                    cf::TIME,
                     |c| c.errors.period,
                 )),
             ),
             Field::OmegaTheta => (
-                float("omega_theta", "frequency of theta, 2 pi / T", RATE, |c| {
-                    c.omega_theta
-                }),
+                float(
+                    "omega_theta",
+                    "frequency of theta, 2 pi / T",
+                    cf::RATE,
+                    |c| c.omega_theta,
+                ),
                 Some(float(
                     "omega_theta_error",
                     "estimated absolute error of omega_theta",
-                    RATE,
+                    cf::RATE,
                     |c| c.errors.omega_theta,
                 )),
             ),
@@ -222,13 +270,13 @@ pub fn variables(fields: &[Field]) -> Vec<Variable> {
                 float(
                     "omega_psi",
                     "mean precession rate, (psi advance over a period) / T",
-                    RATE,
+                    cf::RATE,
                     |c| c.omega_psi,
                 ),
                 Some(float(
                     "omega_psi_error",
                     "estimated absolute error of omega_psi",
-                    RATE,
+                    cf::RATE,
                     |c| c.errors.omega_psi,
                 )),
             ),
@@ -236,7 +284,7 @@ pub fn variables(fields: &[Field]) -> Vec<Variable> {
                 float(
                     "rotation_number",
                     "rotation number N = -omega_psi / omega_theta",
-                    "1",
+                    cf::NUMBER,
                     |c| c.rotation_number,
                 ),
                 None,
@@ -245,13 +293,13 @@ pub fn variables(fields: &[Field]) -> Vec<Variable> {
                 float(
                     "drift",
                     "displacement |delta zeta| of the centre of mass over one period of theta",
-                    "b3",
+                    cf::LENGTH,
                     |c| c.drift,
                 ),
                 Some(float(
                     "drift_error",
                     "estimated absolute error of drift",
-                    "b3",
+                    cf::LENGTH,
                     |c| c.errors.drift,
                 )),
             ),
@@ -259,13 +307,13 @@ pub fn variables(fields: &[Field]) -> Vec<Variable> {
                 float(
                     "drift_radius",
                     "radius |delta zeta| / (2 |sin pi N|) of the circle of stroboscopic points",
-                    "b3",
+                    cf::LENGTH,
                     |c| c.drift_radius,
                 ),
                 Some(float(
                     "drift_radius_error",
                     "estimated absolute error of drift_radius",
-                    "b3",
+                    cf::LENGTH,
                     |c| c.errors.drift_radius,
                 )),
             ),
@@ -318,7 +366,7 @@ pub fn variables(fields: &[Field]) -> Vec<Variable> {
                 float(
                     "error_estimate",
                     "estimated absolute error of rotation_number",
-                    "1",
+                    cf::NUMBER,
                     |c| c.error_estimate,
                 ),
                 None,
@@ -483,28 +531,150 @@ impl Shard {
         Ok(Shard { index, count })
     }
 
-    /// The contiguous range of unit indices that belongs to this shard out of `total`.
-    pub fn units(&self, total: usize) -> Range<usize> {
-        // In 128 bits: total · index does not overflow for any usize shard.
-        let at = |i: usize| (total as u128 * i as u128 / self.count as u128) as usize;
-        at(self.index - 1)..at(self.index)
+    /// How a grid of shape `shape` is cut into this many shards: the counts along α, β and
+    /// the blocks of κ-rows (work units never straddle two shards), whose product is the
+    /// shard count. Of the ways to factor the count, the one whose largest shard has the
+    /// fewest units (slower axes first on a tie). None where the count does not factor
+    /// over the axes' lengths (e.g. 3 shards of a 2 × 2 × 1 grid).
+    pub fn layout(&self, shape: [usize; 4]) -> Option<[usize; 3]> {
+        let lengths = Region::positions(shape);
+        let n = self.count;
+        let mut best: Option<(usize, [usize; 3])> = None;
+        // Larger counts of the slower axes first: the first of equal layouts is kept.
+        for a in (1..=lengths[0].min(n)).rev().filter(|&a| n.is_multiple_of(a)) {
+            for b in (1..=lengths[1].min(n / a))
+                .rev()
+                .filter(|&b| (n / a).is_multiple_of(b))
+            {
+                let k = n / a / b;
+                if k > lengths[2] {
+                    continue;
+                }
+                let counts = [a, b, k];
+                let largest: usize = (0..3).map(|i| lengths[i].div_ceil(counts[i])).product();
+                if best.is_none_or(|(l, _)| largest < l) {
+                    best = Some((largest, counts));
+                }
+            }
+        }
+        best.map(|(_, counts)| counts)
     }
 
-    /// Checks that this shard of a grid of `total` work units has at least one unit.
-    pub fn check_against(&self, total: usize) -> Result<()> {
+    /// The part of a grid of shape `shape` that belongs to this shard: a box of the
+    /// [`Shard::layout`], shards numbered with α slowest. Shard files hold just their
+    /// region, so that xarray combines them by coordinates. The shard must have passed
+    /// [`Shard::check_against`].
+    pub fn region(&self, shape: [usize; 4]) -> Region {
+        let counts = self
+            .layout(shape)
+            .expect("a shard checked against its grid");
+        let lengths = Region::positions(shape);
+        let mut rest = self.index - 1;
+        let mut ranges = [0..0, 0..0, 0..0];
+        for axis in (0..3).rev() {
+            let i = rest % counts[axis];
+            rest /= counts[axis];
+            // In 128 bits: positions · index does not overflow for any usize shard.
+            let at = |i: usize| (lengths[axis] as u128 * i as u128 / counts[axis] as u128) as usize;
+            ranges[axis] = at(i)..at(i + 1);
+        }
+        let rows = rows_per_unit(shape);
+        let [alpha, beta, blocks] = ranges;
+        Region {
+            alpha,
+            beta,
+            rows: blocks.start * rows..(blocks.end * rows).min(shape[2]),
+            columns: shape[3],
+        }
+    }
+
+    /// This shard's work units among `all` (the grid's [`units`]), in their order.
+    pub fn units<'u>(&self, all: &'u [Unit], shape: [usize; 4]) -> Vec<&'u Unit> {
+        let region = self.region(shape);
+        all.iter().filter(|u| region.holds(u)).collect()
+    }
+
+    /// Checks that the grid of shape `shape` splits into this many shards: boxes, one per
+    /// shard, each with work of its own.
+    pub fn check_against(&self, shape: [usize; 4]) -> Result<()> {
         if self.index == 0 || self.index > self.count {
             return Err(AtlasError::Atlas {
                 path: format!("shard {self}"),
                 reason: "needs 1 <= I <= N".into(),
             });
         }
-        if self.count > total {
+        if self.layout(shape).is_none() {
+            let [a, b, k] = Region::positions(shape);
+            let fits = (1..=self.count.min(a * b * k))
+                .rev()
+                .find(|&n| Shard { index: 1, count: n }.layout(shape).is_some())
+                .unwrap_or(1);
             return Err(AtlasError::Atlas {
                 path: format!("shard {self}"),
-                reason: format!("the grid has only {total} work units: use at most {total} shards"),
+                reason: format!(
+                    "shards are boxes of the grid, and {} shards do not tile its {a} alpha x \
+                     {b} beta x {k} blocks of kappa rows: use a count that is a product of \
+                     at most {a}, {b} and {k} (e.g. {fits})",
+                    self.count
+                ),
             });
         }
         Ok(())
+    }
+}
+
+/// A box of the grid: ranges of α, β and κ-row indices, with every ε. A whole atlas is one
+/// region; a shard file holds the region of its shard.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Region {
+    pub alpha: Range<usize>,
+    pub beta: Range<usize>,
+    pub rows: Range<usize>,
+    /// Columns (ε), always all of them.
+    pub columns: usize,
+}
+
+impl Region {
+    /// The whole grid of shape `shape`.
+    pub fn whole(shape: [usize; 4]) -> Region {
+        let [na, nb, nk, ne] = shape;
+        Region {
+            alpha: 0..na,
+            beta: 0..nb,
+            rows: 0..nk,
+            columns: ne,
+        }
+    }
+
+    /// The region's own shape (α, β, κ, ε).
+    pub fn shape(&self) -> [usize; 4] {
+        [
+            self.alpha.len(),
+            self.beta.len(),
+            self.rows.len(),
+            self.columns,
+        ]
+    }
+
+    /// κ-rows per chunk of a file of this region of a grid of shape `grid`: a work unit's
+    /// (each unit is one chunk), or fewer where the region has fewer rows (a chunk may not
+    /// be larger than its dataset).
+    pub fn chunk_rows(&self, grid: [usize; 4]) -> usize {
+        rows_per_unit(grid).min(self.rows.len()).max(1)
+    }
+
+    /// Whether `unit` lies in this region (units never straddle shards' regions).
+    pub fn holds(&self, unit: &Unit) -> bool {
+        self.alpha.contains(&unit.alpha_index)
+            && self.beta.contains(&unit.beta_index)
+            && self.rows.contains(&unit.rows.start)
+    }
+
+    /// The positions shards can split a grid of shape `shape` at: its α values, β values
+    /// and blocks of κ-rows (one work unit each per slice).
+    pub fn positions(shape: [usize; 4]) -> [usize; 3] {
+        let [na, nb, nk, _] = shape;
+        [na, nb, nk.div_ceil(rows_per_unit(shape))]
     }
 }
 
@@ -579,6 +749,61 @@ pub fn compute_rows(
         })
         .collect();
     Block::concat(variables, blocks)
+}
+
+/// One cell given by all its numbers: the body (α, β, ν, η) and the level (κ, ε).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CellPoint {
+    pub alpha: f64,
+    pub beta: f64,
+    pub nu: f64,
+    pub eta: f64,
+    pub kappa: f64,
+    pub energy: f64,
+}
+
+/// Cells computed in this many at a time per rayon task.
+const POINTS_PER_TASK: usize = 64;
+
+/// Computes `points`, each with its own body, on the current rayon pool, into one block laid
+/// out as the atlas file lays out a row (the Python package's `cells`). Each cell is solved
+/// as `rubber-atlas cell` and `run` solve it, so the values are the same bit for bit. Every
+/// point is checked first: a bad one is refused, naming its index and value.
+pub fn compute_cells(
+    points: &[CellPoint],
+    variables: &[Variable],
+    options: &crate::cell::CellOptions,
+) -> Result<Block> {
+    options.validate()?;
+    let bodies = points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let at = |e: AtlasError| AtlasError::Atlas {
+                path: format!("cell {i}"),
+                reason: e.to_string(),
+            };
+            crate::error::check_range("kappa", p.kappa, None, None, "must be finite")
+                .map_err(at)?;
+            crate::error::check_range("energy", p.energy, None, None, "must be finite")
+                .map_err(at)?;
+            crate::EllipsoidBody::ellipsoid(p.alpha, p.beta, p.nu, p.eta).map_err(at)
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let blocks: Vec<Block> = points
+        .par_chunks(POINTS_PER_TASK)
+        .zip(bodies.par_chunks(POINTS_PER_TASK))
+        .map(|(points, bodies)| {
+            let mut block = Block::empty(variables, points.len());
+            for (j, (p, body)) in points.iter().zip(bodies).enumerate() {
+                fill_cell(&mut block, variables, j, (p.kappa, p.energy), || {
+                    solve_level(&EffectivePotential::new(body, p.kappa), p.energy, options)
+                });
+            }
+            block
+        })
+        .collect();
+    Ok(Block::concat(variables, blocks))
 }
 
 /// One cell of `block`: `solve` gives its components; `(kappa, energy)` are its κ and ε,
@@ -667,15 +892,53 @@ mod tests {
         let all = units(shape);
         let cells: usize = all.iter().map(|u| u.rows.len() * shape[3]).sum();
         assert_eq!(cells, 2 * 3 * 50 * 100);
-        for count in 1..7 {
-            let mut seen = vec![0; all.len()];
-            for index in 1..=count {
-                for u in (Shard { index, count }).units(all.len()) {
-                    seen[u] += 1;
+        for shape in [shape, [7, 2, 50, 100], [1, 1, 6000, 3], [3, 9, 10, 4000]] {
+            let all = units(shape);
+            let units_total = all.len();
+            let mut tiled = 0;
+            for count in 1..=units_total.min(24) {
+                if (Shard { index: 1, count }).check_against(shape).is_err() {
+                    continue;
                 }
+                tiled += 1;
+                let mut seen = vec![0; all.len()];
+                let mut cells = 0;
+                for index in 1..=count {
+                    let shard = Shard { index, count };
+                    shard.check_against(shape).unwrap();
+                    let region = shard.region(shape);
+                    let mine = shard.units(&all, shape);
+                    assert!(!mine.is_empty());
+                    for u in mine {
+                        seen[u.index] += 1;
+                        // A unit lies in its shard's region whole.
+                        assert!(u.rows.end <= region.rows.end, "{shape:?} {shard}");
+                    }
+                    cells += region.shape().iter().product::<usize>();
+                }
+                assert!(seen.iter().all(|&s| s == 1), "{shape:?} {count}");
+                assert_eq!(cells, shape.iter().product::<usize>());
             }
-            assert!(seen.iter().all(|&s| s == 1));
+            assert!(tiled >= 4, "{shape:?}");
+            assert!((Shard {
+                index: 1,
+                count: units_total + 1
+            })
+            .check_against(shape)
+            .is_err());
         }
+        // A count that does not factor over the axes is refused: 3 of 2 x 2 x 1.
+        let small = [2, 2, 24, 40];
+        assert!((Shard { index: 1, count: 3 }).check_against(small).is_err());
+        assert_eq!(
+            (Shard { index: 1, count: 4 }).layout(small),
+            Some([2, 2, 1])
+        );
+        // The fewest units in the largest shard: 6 shards of 7 x 2 x 1 split beta too.
+        assert_eq!(
+            (Shard { index: 1, count: 6 }).layout([7, 2, 1, 4000]),
+            Some([3, 2, 1])
+        );
         assert!(Shard::parse("0/3").is_err());
         assert!(Shard::parse("4/3").is_err());
         assert!(Shard::parse("x").is_err());

@@ -5,15 +5,15 @@ use anyhow::{Context, Result};
 use clap::{ArgGroup, Args, Parser, Subcommand, ValueEnum};
 use rubber_atlas::atlas::Shard;
 use rubber_atlas::cell::{solve_cell, solve_component, CellOptions, CellResult, Method, Status};
+use rubber_atlas::cf::AttrValue;
 use rubber_atlas::critical::CriticalSet;
 use rubber_atlas::error::AtlasError;
 use rubber_atlas::resonance::{self, ResonanceOptions};
 use rubber_atlas::scene::Scene;
-use rubber_atlas::store::atlas_file::AttrValue;
-use rubber_atlas::store::{check_output, write_table, Column};
+use rubber_atlas::store::{check_output, write_table};
 use rubber_atlas::sweep::{self, RunRequest};
 use rubber_atlas::torus::EffectivePotential;
-use rubber_atlas::trajectory::{integrate, Model, Start};
+use rubber_atlas::trajectory::{self, Duration, Model, Start, StartAt};
 use rubber_atlas::verdict::{self, VerdictOptions};
 use rubber_atlas::EllipsoidBody;
 use std::path::PathBuf;
@@ -648,31 +648,15 @@ fn resonance(args: ResonanceArgs) -> Result<()> {
     }
     let body = EllipsoidBody::ellipsoid(args.shape.alpha, args.shape.beta, args.nu, args.eta)?;
     let target = parse_rotation_number(&args.rotation_number)?;
-    let energy_min = match args.energy_min {
-        Some(e) => e,
-        None => {
-            // The lowest minimum of V over the window's κ (V grows with |κ| at every θ).
-            let potential = EffectivePotential::new(&body, args.kappa_min.max(0.0));
-            potential
-                .critical_points()
-                .iter()
-                .map(|p| p.value)
-                .fold(f64::INFINITY, f64::min)
-        }
-    };
-    let options = ResonanceOptions {
+    let options = ResonanceOptions::window(
+        &body,
         target,
-        kappa: (args.kappa_min, args.kappa_max),
-        energy: (energy_min, args.energy_max),
-        grid: args.grid,
-        cell: CellOptions {
-            tol: args.tol,
-            drift: false,
-            ..CellOptions::default()
-        },
-        max_points: 20_000,
-        max_point_error: 1e-6,
-    };
+        (args.kappa_min, args.kappa_max),
+        args.energy_min,
+        args.energy_max,
+        args.grid,
+        args.tol,
+    );
     let header = serde_json::json!({
         "alpha": args.shape.alpha,
         "beta": args.shape.beta,
@@ -681,7 +665,7 @@ fn resonance(args: ResonanceArgs) -> Result<()> {
         "rotation_number": target,
         "kappa_window": [options.kappa.0, options.kappa.1],
         "energy_window": [options.energy.0, options.energy.1],
-        "tol": args.tol,
+        "tolerance": args.tol,
     });
     if args.fold {
         let fold = resonance::fold(&body, &options)?;
@@ -712,88 +696,21 @@ fn resonance(args: ResonanceArgs) -> Result<()> {
         return Ok(());
     }
     if let Some(out) = &args.out {
-        let rows: Vec<(usize, usize, &resonance::CurvePoint)> = curves
-            .iter()
-            .enumerate()
-            .flat_map(|(i, c)| c.points.iter().enumerate().map(move |(j, p)| (i, j, p)))
-            .collect();
-        let col = |f: &dyn Fn(&(usize, usize, &resonance::CurvePoint)) -> f64| -> Vec<f64> {
-            rows.iter().map(f).collect()
-        };
-        let data = [
-            ("curve", col(&|r| r.0 as f64), "1", "index of the curve"),
-            (
-                "point",
-                col(&|r| r.1 as f64),
-                "1",
-                "index of the point along the curve",
-            ),
-            ("kappa", col(&|r| r.2.kappa), "paper units", "kappa"),
-            ("energy", col(&|r| r.2.energy), "paper units", "energy"),
-            (
-                "rotation_number",
-                col(&|r| r.2.rotation_number),
-                "1",
-                "rotation number N",
-            ),
-            (
-                "error_estimate",
-                col(&|r| r.2.error_estimate),
-                "1",
-                "estimated error of N",
-            ),
-            (
-                "component",
-                col(&|r| r.2.component as f64),
-                "1",
-                "component index (increasing theta_min)",
-            ),
-            (
-                "theta_min",
-                col(&|r| r.2.theta_min),
-                "rad",
-                "lower turning point",
-            ),
-            (
-                "theta_max",
-                col(&|r| r.2.theta_max),
-                "rad",
-                "upper turning point",
-            ),
-            (
-                "well",
-                col(&|r| r.2.well),
-                "rad",
-                "theta of the minimum of V inside the component",
-            ),
-            (
-                "closed",
-                col(&|r| f64::from(u8::from(curves[r.0].closed))),
-                "1",
-                "1 if the curve is closed",
-            ),
-        ];
-        let columns: Vec<Column<'_>> = data
-            .iter()
-            .map(|(name, values, units, long_name)| Column {
-                name,
-                values,
-                units,
-                long_name,
-            })
-            .collect();
-        write_table(
-            out,
-            &columns,
-            &[
-                ("header_json", header.to_string()),
-                ("command_line", command_line()),
-            ],
-        )?;
+        let mut table = rubber_atlas::table::resonance(&curves);
+        table.attributes.extend(table_attributes(&[
+            ("alpha", AttrValue::Number(args.shape.alpha)),
+            ("beta", AttrValue::Number(args.shape.beta)),
+            ("nu", AttrValue::Number(args.nu)),
+            ("eta", AttrValue::Number(args.eta)),
+            ("rotation_number", AttrValue::Number(target)),
+            ("tolerance", AttrValue::Number(args.tol)),
+            ("header_json", AttrValue::Text(header.to_string())),
+        ]));
+        write_table(out, &table)?;
         println!(
             "wrote {} curves ({} points) to {}",
             curves.len(),
-            rows.len(),
+            curves.iter().map(|c| c.points.len()).sum::<usize>(),
             out.display()
         );
         return Ok(());
@@ -826,15 +743,31 @@ fn resonance(args: ResonanceArgs) -> Result<()> {
     Ok(())
 }
 
-/// The attributes a command adds to the files it writes: its command line and the time.
+/// The attributes a command adds to the atlases it writes: its command line, the time, and
+/// the CF `history`.
 fn invocation_attributes() -> Vec<(String, AttrValue)> {
+    let command = command_line();
     vec![
-        ("command_line".into(), AttrValue::Text(command_line())),
+        ("command_line".into(), AttrValue::Text(command.clone())),
         (
             "created".into(),
-            AttrValue::Text(crate::progress::utc_now()),
+            AttrValue::Text(rubber_atlas::cf::utc_now()),
+        ),
+        (
+            "history".into(),
+            AttrValue::Text(rubber_atlas::cf::history(&command)),
         ),
     ]
+}
+
+/// The root attributes of a table: provenance (program, commit, history, command line)
+/// and `own`, the command's parameters (numbers as numbers).
+fn table_attributes(own: &[(&str, AttrValue)]) -> Vec<(String, AttrValue)> {
+    let command = command_line();
+    let mut attributes = rubber_atlas::store::provenance(&command);
+    attributes.push(("command_line".into(), AttrValue::Text(command)));
+    attributes.extend(own.iter().map(|(k, v)| (k.to_string(), v.clone())));
+    attributes
 }
 
 fn run_scene(args: RunArgs) -> Result<()> {
@@ -843,6 +776,9 @@ fn run_scene(args: RunArgs) -> Result<()> {
         Some(text) => Shard::parse(text)?,
         None => Shard::WHOLE,
     };
+    // A shard count that does not tile the grid is refused at once (also by --print-out,
+    // which submit.sh calls before anything is queued).
+    shard.check_against(scene.shape())?;
     let out = args.out.clone().unwrap_or_else(|| {
         if shard == Shard::WHOLE {
             PathBuf::from(format!("atlas/{}.h5", scene.name))
@@ -1108,7 +1044,7 @@ fn cell(args: CellArgs) -> Result<()> {
             "eta": args.level.eta,
             "kappa": args.level.kappa,
             "energy": energy,
-            "tol": args.tol,
+            "tolerance": args.tol,
             "method": options.method,
             "status": result.status,
             "components": result.components,
@@ -1186,19 +1122,6 @@ fn json_name<T: serde::Serialize>(value: &T) -> String {
 
 fn command_line() -> String {
     std::env::args().collect::<Vec<_>>().join(" ")
-}
-
-fn positive_finite(name: &'static str, value: f64) -> Result<f64> {
-    if value.is_finite() && value > 0.0 {
-        Ok(value)
-    } else {
-        Err(AtlasError::InvalidParameter {
-            name,
-            value,
-            reason: "must be a finite number > 0",
-        }
-        .into())
-    }
 }
 
 /// Tables (`diagram`, `trajectory`, `resonance`).
@@ -1292,80 +1215,19 @@ fn print_diagram(set: &CriticalSet) {
     }
 }
 
-/// (name, units, long_name) of the columns `diagram --out` writes, in order.
-const DIAGRAM_COLUMNS: [(&str, &str, &str); 9] = [
-    (
-        "segment",
-        "1",
-        "index of the run of one stability along a branch",
-    ),
-    (
-        "branch",
-        "1",
-        "0 sigma_s0, 1 sigma_u, 2 sigma_spi, 3 sigma_pi2",
-    ),
-    ("theta0", "rad", "inclination of the permanent rotation"),
-    (
-        "kappa",
-        "sqrt(m g b3)",
-        "integral F2 on the curve (kappa >= 0)",
-    ),
-    ("energy", "m g b3", "energy on the curve"),
-    ("stable", "1", "1 linearly stable (centre), 0 unstable"),
-    ("rho_c", "b3", "radius of the circle of the centre of mass"),
-    ("rho_p", "b3", "radius of the circle of the contact point"),
-    (
-        "rotation_number",
-        "1",
-        "rotation number of the small oscillations, -psi_dot/omega0 (NaN where unstable)",
-    ),
-];
-
 fn write_diagram(out: &std::path::Path, set: &CriticalSet) -> Result<()> {
-    let names = ["sigma_s0", "sigma_u", "sigma_spi", "sigma_pi2"];
-    let mut cols: [Vec<f64>; 9] = Default::default();
-    for (i, b) in set.branches.iter().enumerate() {
-        let code = names.iter().position(|n| *n == b.name).unwrap_or(0) as f64;
-        for p in &b.points {
-            for (col, v) in cols.iter_mut().zip([
-                i as f64,
-                code,
-                p.theta0,
-                p.kappa,
-                p.energy,
-                if p.stable { 1.0 } else { 0.0 },
-                p.rho_c,
-                p.rho_p,
-                p.rotation_number.unwrap_or(f64::NAN),
-            ]) {
-                col.push(v);
-            }
-        }
-    }
-    let columns: Vec<Column> = DIAGRAM_COLUMNS
-        .iter()
-        .zip(&cols)
-        .map(|(&(name, units, long_name), values)| Column {
-            name,
-            values,
-            units,
-            long_name,
-        })
-        .collect();
-    let summary = serde_json::to_string(set)?;
-    write_table(
-        out,
-        &columns,
-        &[
-            (
-                "program",
-                format!("rubber-atlas {}", env!("CARGO_PKG_VERSION")),
-            ),
-            ("command_line", command_line()),
-            ("critical_set_json", summary),
-        ],
-    )
-    .with_context(|| {
+    let mut table = rubber_atlas::table::diagram(set);
+    table.attributes.extend(table_attributes(&[
+        ("alpha", AttrValue::Number(set.alpha)),
+        ("beta", AttrValue::Number(set.beta)),
+        ("nu", AttrValue::Number(set.nu)),
+        ("eta", AttrValue::Number(set.eta)),
+        (
+            "critical_set_json",
+            AttrValue::Text(serde_json::to_string(set)?),
+        ),
+    ]));
+    write_table(out, &table).with_context(|| {
         format!(
             "writing the diagram of alpha = {}, beta = {}",
             set.alpha, set.beta
@@ -1378,23 +1240,6 @@ fn trajectory(args: TrajectoryArgs) -> Result<()> {
     check_start(&args.start, args.component)?;
     check_output(&args.out, args.force, &[], &TABLE_EXTENSIONS)?;
     let body = args.level.body()?;
-    if !args.level.kappa.is_finite() {
-        return Err(AtlasError::InvalidParameter {
-            name: "kappa",
-            value: args.level.kappa,
-            reason: "must be a finite number",
-        }
-        .into());
-    }
-    let tol = args.tol;
-    if !(tol.is_finite() && tol > 0.0 && tol < 1.0) {
-        return Err(AtlasError::InvalidParameter {
-            name: "tol",
-            value: tol,
-            reason: "must satisfy 0 < tol < 1",
-        }
-        .into());
-    }
     if args.samples == 0 {
         return Err(AtlasError::InvalidParameter {
             name: "samples",
@@ -1412,93 +1257,53 @@ fn trajectory(args: TrajectoryArgs) -> Result<()> {
         Some(&args.out),
         "use fewer --samples",
     )?;
-    let start = match (args.start.energy, args.start.theta0) {
-        (Some(e), None) => {
-            if !e.is_finite() {
-                return Err(AtlasError::InvalidParameter {
-                    name: "energy",
-                    value: e,
-                    reason: "must be a finite number",
-                }
-                .into());
-            }
-            Start::at_energy(&body, args.level.kappa, e, args.component.unwrap_or(0))?
-        }
-        (None, Some(t)) => {
-            let start = args.start.at_theta0(args.level.kappa, t)?;
-            start.checked_energy(&body)?;
-            start
-        }
-        _ => unreachable!("clap requires exactly one of --energy, --theta0"),
-    };
-    let t_end = match (args.periods, args.t_end) {
-        (Some(k), None) => positive_finite("periods", k)? * start.period(&body, 1e-13)?,
-        (None, Some(t)) => positive_finite("t-end", t)?,
-        _ => unreachable!("clap requires exactly one of --periods, --t-end"),
-    };
     let model = match args.model {
         ModelArg::Reduced => Model::Reduced,
         ModelArg::Full => Model::Full,
     };
-    let traj = integrate(&body, &start, model, t_end, args.samples, tol)?;
-    let units = [
-        "sqrt(b3/g)",
-        "rad",
-        "rad/sqrt(b3/g)",
-        "rad",
-        "rad",
-        "b3",
-        "b3",
-        "b3",
-        "b3",
-        "b3",
-    ];
-    let long = [
-        "time",
-        "inclination of the symmetry axis to the vertical",
-        "rate of inclination",
-        "proper rotation angle",
-        "precession angle (azimuth of the axis)",
-        "x of the centre of mass",
-        "y of the centre of mass",
-        "height of the centre of mass",
-        "x of the contact point",
-        "y of the contact point",
-    ];
-    let columns: Vec<Column> = traj
-        .columns()
-        .into_iter()
-        .zip(units.iter().zip(long.iter()))
-        .map(|((name, values), (u, l))| Column {
-            name,
-            values,
-            units: u,
-            long_name: l,
-        })
-        .collect();
-    let attrs = [
-        (
-            "program",
-            format!("rubber-atlas {}", env!("CARGO_PKG_VERSION")),
-        ),
-        ("command_line", command_line()),
-        ("model", format!("{:?}", model).to_lowercase()),
-        ("alpha", args.level.shape.alpha.to_string()),
-        ("beta", args.level.shape.beta.to_string()),
-        ("nu", args.level.nu.to_string()),
-        ("eta", args.level.eta.to_string()),
-        ("kappa", start.kappa.to_string()),
-        ("energy", start.energy(&body).to_string()),
-        ("theta0", start.theta0.to_string()),
-        ("theta_dot0", start.theta_dot0.to_string()),
-        ("tolerance", tol.to_string()),
-    ];
-    write_table(&args.out, &columns, &attrs)?;
+    let request = trajectory::Request {
+        kappa: args.level.kappa,
+        start: match (args.start.energy, args.start.theta0) {
+            (Some(energy), None) => StartAt::Energy {
+                energy,
+                component: args.component.unwrap_or(0),
+            },
+            (None, Some(theta0)) => StartAt::Angle {
+                theta0,
+                theta_dot0: args.start.theta_dot0.unwrap_or(0.0),
+            },
+            _ => unreachable!("clap requires exactly one of --energy, --theta0"),
+        },
+        duration: match (args.periods, args.t_end) {
+            (Some(k), None) => Duration::Periods(k),
+            (None, Some(t)) => Duration::Until(t),
+            _ => unreachable!("clap requires exactly one of --periods, --t-end"),
+        },
+        samples: args.samples,
+        model,
+        tol: args.tol,
+    };
+    let (start, traj) = request.run(&body)?;
+    let (tol, t_end) = (args.tol, traj.t.last().copied().unwrap_or(0.0));
+    let mut table = rubber_atlas::table::trajectory(&traj);
+    table.attributes.extend(table_attributes(&[
+        ("model", AttrValue::Text(json_name(&model))),
+        ("alpha", AttrValue::Number(args.level.shape.alpha)),
+        ("beta", AttrValue::Number(args.level.shape.beta)),
+        ("nu", AttrValue::Number(args.level.nu)),
+        ("eta", AttrValue::Number(args.level.eta)),
+        ("kappa", AttrValue::Number(start.kappa)),
+        ("energy", AttrValue::Number(start.energy(&body))),
+        ("theta0", AttrValue::Number(start.theta0)),
+        ("theta_dot0", AttrValue::Number(start.theta_dot0)),
+        ("tolerance", AttrValue::Number(tol)),
+    ]));
+    write_table(&args.out, &table)?;
     eprintln!(
         "wrote {} samples over t in [0, {}] ({} model) to {}",
         traj.t.len(),
         t_end,
-        format!("{:?}", model).to_lowercase(),
+        json_name(&model),
         args.out.display()
     );
     Ok(())

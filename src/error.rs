@@ -53,6 +53,7 @@ pub enum AtlasError {
 
 impl AtlasError {
     /// An [`AtlasError::Atlas`] naming `path`.
+    #[cfg_attr(not(feature = "hdf5"), allow(dead_code))]
     pub(crate) fn atlas(path: &std::path::Path, reason: impl std::fmt::Display) -> Self {
         AtlasError::Atlas {
             path: path.display().to_string(),

@@ -23,8 +23,12 @@
 //!   the β at which its verdict changes.
 //! - [`scene`]: the TOML scene files of atlas runs.
 //! - [`atlas`]: the grid driver — work units, rayon over κ-rows, dense per-cell arrays.
+//! - [`cf`]: the CF units and attributes every file shares; [`table`]: the tables of
+//!   trajectories and curves, column by column.
 //! - [`store`]: CSV and HDF5 output, the atlas file and the resume journal.
-//! - [`sweep`]: a whole run (resume, shards) and the merge of shards.
+//! - [`sweep`]: a whole run (resume, shards) and the merge of shards (feature `hdf5`).
+//! - `python` (feature `python`): the extension module of the Python package
+//!   `rubber_atlas`, built without HDF5.
 //!
 //! Units are the paper's: length b3, mass m, time √(b3/g). The paper's misprints (in B(θ), the
 //! velocity of the centre of mass, θ*, ε_min, the stability of the equator, the type (c)
@@ -34,6 +38,7 @@
 pub mod atlas;
 pub mod body;
 pub mod cell;
+pub mod cf;
 pub mod critical;
 pub mod error;
 pub mod full;
@@ -45,10 +50,15 @@ pub mod reduced;
 pub mod resonance;
 pub mod scene;
 pub mod store;
+#[cfg(feature = "hdf5")]
 pub mod sweep;
+pub mod table;
 pub mod torus;
 pub mod trajectory;
 pub mod verdict;
+
+#[cfg(feature = "python")]
+mod python;
 
 pub use body::{Angle, Body, Ellipsoid, EllipsoidBody, Shape};
 pub use error::{AtlasError, Result};

@@ -32,6 +32,43 @@ pub struct ResonanceOptions {
     pub max_point_error: f64,
 }
 
+impl ResonanceOptions {
+    /// The options of the `resonance` command (and of the Python package's `resonance`): N =
+    /// `target` in the window κ ∈ `kappa`, ε ∈ [`energy_min`, `energy_max`], where a missing
+    /// `energy_min` is the lowest minimum of V at the window's smallest κ (V grows with |κ|
+    /// at every θ, so it is the lowest over the window).
+    pub fn window<S: Shape>(
+        body: &Body<S>,
+        target: f64,
+        kappa: (f64, f64),
+        energy_min: Option<f64>,
+        energy_max: f64,
+        grid: usize,
+        tol: f64,
+    ) -> Self {
+        let energy_min = energy_min.unwrap_or_else(|| {
+            EffectivePotential::new(body, kappa.0.max(0.0))
+                .critical_points()
+                .iter()
+                .map(|p| p.value)
+                .fold(f64::INFINITY, f64::min)
+        });
+        Self {
+            target,
+            kappa,
+            energy: (energy_min, energy_max),
+            grid,
+            cell: CellOptions {
+                tol,
+                drift: false,
+                ..CellOptions::default()
+            },
+            max_points: 20_000,
+            max_point_error: 1e-6,
+        }
+    }
+}
+
 /// One point of a resonance curve.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct CurvePoint {

@@ -1,11 +1,18 @@
-//! Writing tables of columns (trajectories, sampled bifurcation curves) as CSV or HDF5, chosen
-//! by the file's extension. Files are written to a temporary name and renamed into place, so
+//! Writing tables ([`crate::table`]: trajectories, sampled bifurcation and resonance curves)
+//! as CSV or HDF5, chosen by the file's extension; the atlas file and the resume journal
+//! (with the `hdf5` feature). Files are written to a temporary name and renamed into place, so
 //! a failed write never leaves a partial output behind.
 
+#[cfg(feature = "hdf5")]
 pub mod atlas_file;
+#[cfg(feature = "hdf5")]
+mod h5;
+#[cfg(feature = "hdf5")]
 pub mod journal;
 
+use crate::cf::{self, AttrValue};
 use crate::error::{AtlasError, Result};
+use crate::table::{Table, Values};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -33,15 +40,6 @@ impl TableFormat {
             }),
         }
     }
-}
-
-/// A named numeric column with its unit and description.
-#[derive(Debug, Clone)]
-pub struct Column<'a> {
-    pub name: &'a str,
-    pub values: &'a [f64],
-    pub units: &'a str,
-    pub long_name: &'a str,
 }
 
 fn output_error(path: &Path, e: impl std::fmt::Display) -> AtlasError {
@@ -211,19 +209,18 @@ fn temp_path(path: &Path) -> PathBuf {
     with_suffix(path, &format!(".partial-{}", std::process::id()))
 }
 
-/// Writes equal-length columns to `path` (CSV: a header line, then rows with shortest
-/// round-trip decimals; HDF5: one 1-D dataset per column with `units` and `long_name`, plus the
-/// string attributes `attributes` on the root).
-pub fn write_table(
-    path: &Path,
-    columns: &[Column<'_>],
-    attributes: &[(&str, String)],
-) -> Result<()> {
+/// Writes `table` to `path`, as CSV (`# key: value` comment lines for the attributes, a
+/// header, then rows: shortest round-trip decimals) or HDF5 (one 1-D variable per column
+/// along the table's dimension, whose coordinate is a dimension scale; CF attributes).
+pub fn write_table(path: &Path, table: &Table) -> Result<()> {
     let format = TableFormat::from_path(path)?;
     let tmp = temp_path(path);
     let written = match format {
-        TableFormat::Csv => write_csv(&tmp, columns, attributes),
-        TableFormat::Hdf5 => write_hdf5(&tmp, columns, attributes),
+        TableFormat::Csv => write_csv(&tmp, table),
+        #[cfg(feature = "hdf5")]
+        TableFormat::Hdf5 => write_hdf5(&tmp, table),
+        #[cfg(not(feature = "hdf5"))]
+        TableFormat::Hdf5 => Err("built without the hdf5 feature: write .csv".to_string()),
     };
     if let Err(e) = written {
         let _ = std::fs::remove_file(&tmp);
@@ -235,63 +232,85 @@ pub fn write_table(
     })
 }
 
-fn write_csv(
-    path: &Path,
-    columns: &[Column<'_>],
-    attributes: &[(&str, String)],
-) -> std::result::Result<(), String> {
+fn write_csv(path: &Path, table: &Table) -> std::result::Result<(), String> {
     let file = std::fs::File::create(path).map_err(|e| e.to_string())?;
     let mut w = std::io::BufWriter::new(file);
     let io = |e: std::io::Error| e.to_string();
-    for (k, v) in attributes {
-        writeln!(w, "# {k}: {}", v.replace('\n', " ")).map_err(io)?;
+    writeln!(w, "# Conventions: {}", cf::CONVENTIONS).map_err(io)?;
+    for (k, v) in &table.attributes {
+        writeln!(w, "# {k}: {}", v.display().replace('\n', " ")).map_err(io)?;
     }
-    let header: Vec<&str> = columns.iter().map(|c| c.name).collect();
-    writeln!(w, "{}", header.join(",")).map_err(io)?;
-    let rows = columns.first().map_or(0, |c| c.values.len());
-    let mut line = String::new();
-    for i in 0..rows {
-        line.clear();
-        for (j, c) in columns.iter().enumerate() {
-            if j > 0 {
-                line.push(',');
-            }
-            line.push_str(&format!("{:e}", c.values[i]));
-        }
-        writeln!(w, "{line}").map_err(io)?;
+    let mut csv = csv::Writer::from_writer(w);
+    let text = |e: csv::Error| e.to_string();
+    csv.write_record(table.columns.iter().map(|c| c.name))
+        .map_err(text)?;
+    let mut record = Vec::with_capacity(table.columns.len());
+    for i in 0..table.rows() {
+        record.clear();
+        record.extend(table.columns.iter().map(|c| match &c.values {
+            Values::F64(v) => format!("{:e}", v[i]),
+            Values::I32(v) => v[i].to_string(),
+            Values::U8(v) => v[i].to_string(),
+        }));
+        csv.write_record(&record).map_err(text)?;
     }
-    w.flush().map_err(io)
+    let mut w = csv.into_inner().map_err(|e| e.to_string())?;
+    w.flush().map_err(io)?;
+    w.get_ref().sync_all().map_err(io)
 }
 
-fn write_hdf5(
-    path: &Path,
-    columns: &[Column<'_>],
-    attributes: &[(&str, String)],
-) -> std::result::Result<(), String> {
-    use hdf5::types::VarLenUnicode;
-    let err = |e: hdf5::Error| e.to_string();
-    let file = hdf5::File::create(path).map_err(err)?;
-    let string_attr =
-        |loc: &hdf5::Location, name: &str, value: &str| -> std::result::Result<(), String> {
-            let v: VarLenUnicode = value
-                .parse()
-                .map_err(|e: hdf5::types::StringError| e.to_string())?;
-            loc.new_attr::<VarLenUnicode>()
-                .create(name)
-                .and_then(|a| a.write_scalar(&v))
-                .map_err(err)
-        };
-    for (k, v) in attributes {
-        string_attr(&file, k, v)?;
-    }
-    for c in columns {
-        let ds = file
-            .new_dataset_builder()
-            .with_data(c.values)
-            .create(c.name)
-            .map_err(err)?;
-        string_attr(&ds, "units", c.units)?;
-        string_attr(&ds, "long_name", c.long_name)?;
-    }
-    file.close().map_err(err)
+#[cfg(feature = "hdf5")]
+fn write_hdf5(path: &Path, table: &Table) -> std::result::Result<(), String> {
+    use h5::{attach_scale, describe, set_scale, text_attr, write_attr};
+    let file = hdf5::File::create(path).map_err(|e| e.to_string())?;
+    let inner = || -> hdf5::Result<()> {
+        text_attr(&file, "Conventions", cf::CONVENTIONS)?;
+        for (k, v) in &table.attributes {
+            write_attr(&file, k, v)?;
+        }
+        let mut scale: Option<hdf5::Dataset> = None;
+        for c in &table.columns {
+            let builder = file.new_dataset_builder();
+            let d = match &c.values {
+                Values::F64(v) => builder.with_data(v.as_slice()).create(c.name)?,
+                Values::I32(v) => builder.with_data(v.as_slice()).create(c.name)?,
+                Values::U8(v) => builder.with_data(v.as_slice()).create(c.name)?,
+            };
+            describe(&d, c.long_name, c.units)?;
+            if let Some(flags) = c.flags {
+                h5::flags(&d, flags)?;
+            }
+            match &scale {
+                None if c.name == table.dimension => {
+                    set_scale(&d, c.name)?;
+                    scale = Some(d);
+                }
+                None => return Err("a table's first column is its dimension".into()),
+                Some(s) => attach_scale(&d, s, 0)?,
+            }
+        }
+        Ok(())
+    };
+    inner().map_err(|e| e.to_string())?;
+    file.close().map_err(|e| e.to_string())?;
+    std::fs::File::open(path)
+        .and_then(|f| f.sync_all())
+        .map_err(|e| e.to_string())
+}
+
+/// The root attributes of a table written by a command: the program, its commit, and the
+/// CF `history` of `command_line`.
+pub fn provenance(command_line: &str) -> Vec<(String, AttrValue)> {
+    vec![
+        ("program".into(), AttrValue::Text("rubber-atlas".into())),
+        (
+            "program_version".into(),
+            AttrValue::Text(env!("CARGO_PKG_VERSION").into()),
+        ),
+        (
+            "git_commit".into(),
+            AttrValue::Text(env!("RUBBER_ATLAS_GIT_COMMIT").into()),
+        ),
+        ("history".into(), AttrValue::Text(cf::history(command_line))),
+    ]
 }

@@ -4,7 +4,7 @@
 //! Memory stays at one slice's worth whatever the grid.
 
 use crate::atlas::{
-    self, compute_rows, status_flag, Block, Shard, Unit, Variable, COMPONENT_SLOTS,
+    self, compute_rows, status_flag, Block, Region, Shard, Unit, Variable, COMPONENT_SLOTS,
 };
 use crate::error::{AtlasError, Result};
 use crate::scene::Scene;
@@ -205,8 +205,15 @@ pub fn footprint(scene: &Scene, shard: Shard, threads: usize) -> Footprint {
     let rows = atlas::rows_per_unit(shape) as f64;
     let per_slice = (nk / rows).ceil();
     let total = na * nb * per_slice;
-    // This shard's share of the units, as `Shard::units` splits them.
-    let share = (total / shard.count as f64).ceil();
+    // This shard's share of the units: its box of the layout (the largest one), or all.
+    let share = match shard.layout(shape) {
+        Some(counts) => Region::positions(shape)
+            .iter()
+            .zip(counts)
+            .map(|(&p, c)| p.div_ceil(c) as f64)
+            .product(),
+        None => total,
+    };
     let unit_cells = rows * ne;
     let bytes_per_cell = atlas::scene_variables(scene)
         .iter()
@@ -225,7 +232,8 @@ pub fn footprint(scene: &Scene, shard: Shard, threads: usize) -> Footprint {
 /// Whether `out` is an atlas made from `scene` (its text and this build: the fingerprint)
 /// for this shard, and whole ([`AtlasFile::is_whole`]).
 fn output_is_current(out: &Path, scene: &Scene, shard: Shard) -> bool {
-    let Ok(file) = AtlasFile::open(out, scene, &atlas::scene_variables(scene)) else {
+    let region = shard.region(scene.shape());
+    let Ok(file) = AtlasFile::open(out, &region, &atlas::scene_variables(scene)) else {
         return false;
     };
     file.text_attribute("scene_fingerprint").as_deref()
@@ -240,9 +248,7 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
     let started = Instant::now();
     let out = &request.out;
     // Before anything is written: the shard must have work units of its own.
-    request
-        .shard
-        .check_against(atlas::units(scene.shape()).len())?;
+    request.shard.check_against(scene.shape())?;
     // Held until the file is in place and the journal gone.
     let _claim = crate::store::OutputLock::acquire(out)?;
     let fingerprint = scene.fingerprint();
@@ -280,8 +286,17 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
     };
 
     let variables = atlas::scene_variables(scene);
-    let all_units = atlas::units(scene.shape());
-    let mine = &all_units[request.shard.units(all_units.len())];
+    let shape = scene.shape();
+    let all_units = atlas::units(shape);
+    let region = request.shard.region(shape);
+    let chunk_rows = region.chunk_rows(shape);
+    let mine: Vec<Unit> = request
+        .shard
+        .units(&all_units, shape)
+        .into_iter()
+        .cloned()
+        .collect();
+    let mine = &mine[..];
     let cells_of = |u: &Unit| u.rows.len() * scene.energy.len();
     // Units with a file in the journal; each is checked when it is read, below, and computed
     // again if its file turns out damaged.
@@ -311,9 +326,8 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
     let mut attributes = scene_attributes(scene, request.shard, all_units.len());
     attributes.extend(request.attributes.iter().cloned());
     let advance = |cells: usize| progress.advance(cells as u64);
-    let shape = scene.shape();
     let written = (|| -> Result<()> {
-        let file = AtlasFile::create(&tmp, scene, &variables, &borrowed(&attributes))?;
+        let file = AtlasFile::create(&tmp, scene, &region, &variables, &borrowed(&attributes))?;
         let mut first = 0;
         for run in slice_runs(mine) {
             let run_done = &done[first..first + run.len()];
@@ -348,7 +362,7 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
                     );
                     let mut part = Summary::default();
                     part.count(&variables, &block);
-                    let chunks = encode_unit(&variables, &block, shape);
+                    let chunks = encode_unit(&variables, &block, chunk_rows, scene.energy.len());
                     journal.write(u.index, &chunks, &part.words())?;
                     part.cells_computed = block.cells as u64;
                     Ok(Some((chunks, part)))
@@ -422,12 +436,18 @@ pub fn merge(
     let scene_text = read_root_text(first, "scene")?;
     let scene = Scene::parse(&scene_text, &first.display().to_string())?;
     let variables = atlas::scene_variables(&scene);
-    let all_units = atlas::units(scene.shape());
+    let shape = scene.shape();
+    let all_units = atlas::units(shape);
     let fingerprint = format!("{:016x}", scene.fingerprint());
     let mut by_index: Vec<Option<(PathBuf, AtlasFile)>> = Vec::new();
     let mut count = None;
     for path in shards {
-        let file = AtlasFile::open(path, &scene, &variables)?;
+        let (index, n) = shard_attributes(path)?;
+        let shard = Shard { index, count: n };
+        shard
+            .check_against(shape)
+            .map_err(|e| AtlasError::atlas(path, e))?;
+        let file = AtlasFile::open(path, &shard.region(shape), &variables)?;
         if file.text_attribute("scene_fingerprint").as_deref() != Some(fingerprint.as_str()) {
             return Err(AtlasError::atlas(
                 path,
@@ -437,25 +457,6 @@ pub fn merge(
                 ),
             ));
         }
-        let (Some(index), Some(n)) = (
-            file.integer_attribute("shard_index"),
-            file.integer_attribute("shard_count"),
-        ) else {
-            return Err(AtlasError::atlas(path, "has no shard_index / shard_count"));
-        };
-        // The attributes are the file's word: checked before any use.
-        let (index, n) = match (usize::try_from(index), usize::try_from(n)) {
-            (Ok(i), Ok(n)) => (i, n),
-            _ => {
-                return Err(AtlasError::atlas(
-                    path,
-                    format!("has shard_index {index} / shard_count {n}, not a shard"),
-                ))
-            }
-        };
-        Shard { index, count: n }
-            .check_against(all_units.len())
-            .map_err(|e| AtlasError::atlas(path, e))?;
         if *count.get_or_insert(n) != n {
             return Err(AtlasError::atlas(
                 path,
@@ -496,6 +497,8 @@ pub fn merge(
         std::fs::remove_file(&tmp).map_err(|e| AtlasError::atlas(&tmp, e))?;
     }
     let mut attributes = scene_attributes(&scene, Shard::WHOLE, all_units.len());
+    let whole = Region::whole(shape);
+    let chunk_rows = whole.chunk_rows(shape);
     // Provenance of the computation: the first shard's program and commit.
     let (_, first_file) = by_index[0].as_ref().unwrap();
     for key in ["program_version", "git_commit"] {
@@ -521,18 +524,18 @@ pub fn merge(
     };
     let n = by_index.len();
     let written = (|| -> Result<()> {
-        let file = AtlasFile::create(&tmp, &scene, &variables, &borrowed(&attributes))?;
+        let file = AtlasFile::create(&tmp, &scene, &whole, &variables, &borrowed(&attributes))?;
         for (i, shard) in by_index.iter().enumerate() {
             let (_, source) = shard.as_ref().unwrap();
-            let range = Shard {
+            let shard = Shard {
                 index: i + 1,
                 count: n,
-            }
-            .units(all_units.len());
-            for u in &all_units[range] {
+            };
+            for u in shard.units(&all_units, shape) {
                 let block = source.read_unit(u)?;
                 summary.count(&variables, &block);
-                file.write_encoded(u, &encode_unit(&variables, &block, scene.shape()))?;
+                let encoded = encode_unit(&variables, &block, chunk_rows, scene.energy.len());
+                file.write_encoded(u, &encoded)?;
             }
         }
         file.close()
@@ -549,6 +552,22 @@ pub fn merge(
 /// Consecutive runs of units of one (α, β) slice.
 fn slice_runs(units: &[Unit]) -> impl Iterator<Item = &[Unit]> {
     units.chunk_by(|a, b| (a.alpha_index, a.beta_index) == (b.alpha_index, b.beta_index))
+}
+
+/// A shard file's `shard_index` and `shard_count`, checked (they are the file's word).
+fn shard_attributes(path: &Path) -> Result<(usize, usize)> {
+    let file = hdf5::File::open(path).map_err(|e| AtlasError::atlas(path, e))?;
+    let read = |name: &str| file.attr(name).and_then(|a| a.read_scalar::<i64>()).ok();
+    let (Some(index), Some(n)) = (read("shard_index"), read("shard_count")) else {
+        return Err(AtlasError::atlas(path, "has no shard_index / shard_count"));
+    };
+    match (usize::try_from(index), usize::try_from(n)) {
+        (Ok(i), Ok(n)) => Ok((i, n)),
+        _ => Err(AtlasError::atlas(
+            path,
+            format!("has shard_index {index} / shard_count {n}, not a shard"),
+        )),
+    }
 }
 
 fn read_root_text(path: &Path, name: &str) -> Result<String> {

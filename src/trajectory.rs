@@ -11,7 +11,8 @@ use crate::torus::{Component, EffectivePotential, MotionKind};
 use nalgebra::SVector;
 
 /// Which equations are integrated.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Model {
     /// The reduced system with its quadratures (6 equations).
     Reduced,
@@ -147,6 +148,95 @@ impl Start {
         Ok(potential
             .integrate(self.energy(body), &comp, tol, false)?
             .period)
+    }
+}
+
+/// How long a trajectory runs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Duration {
+    /// This many θ-periods of the start's component.
+    Periods(f64),
+    /// Up to this time.
+    Until(f64),
+}
+
+/// Where a trajectory starts, as a user gives it: at an energy (the lower turning point of
+/// a component, at rest), or at θ(0), θ̇(0).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StartAt {
+    Energy { energy: f64, component: usize },
+    Angle { theta0: f64, theta_dot0: f64 },
+}
+
+/// A whole trajectory request, checked as one (the `trajectory` command and the Python
+/// package's `trajectory`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Request {
+    pub kappa: f64,
+    pub start: StartAt,
+    pub duration: Duration,
+    /// Samples after t = 0 (≥ 1): `samples + 1` equally spaced times.
+    pub samples: usize,
+    pub model: Model,
+    /// The integrator's tolerance, 0 < tol < 1.
+    pub tol: f64,
+}
+
+impl Request {
+    /// The checked start of this request on `body`.
+    pub fn start<S: Shape>(&self, body: &Body<S>) -> Result<Start> {
+        crate::error::check_range("kappa", self.kappa, None, None, "must be a finite number")?;
+        match self.start {
+            StartAt::Energy { energy, component } => {
+                crate::error::check_range("energy", energy, None, None, "must be a finite number")?;
+                Start::at_energy(body, self.kappa, energy, component)
+            }
+            StartAt::Angle { theta0, theta_dot0 } => {
+                let start = Start {
+                    kappa: self.kappa,
+                    theta0,
+                    theta_dot0,
+                };
+                start.check()?;
+                start.checked_energy(body)?;
+                Ok(start)
+            }
+        }
+    }
+
+    /// Checks the request and integrates it on `body`: the start and the samples.
+    pub fn run<S: Shape>(&self, body: &Body<S>) -> Result<(Start, Trajectory)> {
+        let tol = self.tol;
+        if !(tol.is_finite() && tol > 0.0 && tol < 1.0) {
+            return Err(AtlasError::InvalidParameter {
+                name: "tol",
+                value: tol,
+                reason: "must satisfy 0 < tol < 1",
+            });
+        }
+        if self.samples == 0 {
+            return Err(AtlasError::InvalidParameter {
+                name: "samples",
+                value: 0.0,
+                reason: "must be >= 1",
+            });
+        }
+        let start = self.start(body)?;
+        let positive = |name, value| {
+            crate::error::check_range(
+                name,
+                value,
+                Some((0.0, false)),
+                None,
+                "must be a finite number > 0",
+            )
+        };
+        let t_end = match self.duration {
+            Duration::Periods(k) => positive("periods", k)? * start.period(body, 1e-13)?,
+            Duration::Until(t) => positive("t-end", t)?,
+        };
+        let traj = integrate(body, &start, self.model, t_end, self.samples, tol)?;
+        Ok((start, traj))
     }
 }
 

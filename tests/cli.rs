@@ -29,6 +29,19 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
+/// The header and the rows of a CSV table of the program (comment lines `# …` first).
+fn read_csv(path: &std::path::Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let mut reader = csv::ReaderBuilder::new()
+        .comment(Some(b'#'))
+        .from_path(path)
+        .unwrap();
+    let header = reader.headers().unwrap().iter().map(String::from).collect();
+    let rows = reader
+        .records()
+        .map(|r| r.unwrap().iter().map(|x| x.parse().unwrap()).collect())
+        .collect();
+    (header, rows)
+}
 #[test]
 fn diagram_json_gives_the_corrected_critical_set() {
     let o = run(&["diagram", "--alpha", "0.5", "--beta", "3", "--json"]);
@@ -84,11 +97,24 @@ fn diagram_and_trajectory_write_csv_and_hdf5() {
         }
     }
     // The CSV trajectory returns to θ(0) = 2.1 after two periods, with θ̇ = 0.
-    let text = std::fs::read_to_string(dir.path().join("t-reduced.csv")).unwrap();
-    let rows: Vec<&str> = text.lines().filter(|l| !l.starts_with('#')).collect();
-    assert_eq!(rows[0], "t,theta,theta_dot,phi,psi,x_c,y_c,z_c,x_p,y_p");
-    assert_eq!(rows.len(), 102);
-    let last: Vec<f64> = rows[101].split(',').map(|x| x.parse().unwrap()).collect();
+    let (header, rows) = read_csv(&dir.path().join("t-reduced.csv"));
+    assert_eq!(
+        header,
+        [
+            "t",
+            "theta",
+            "theta_dot",
+            "phi",
+            "psi",
+            "x_c",
+            "y_c",
+            "z_c",
+            "x_p",
+            "y_p"
+        ]
+    );
+    assert_eq!(rows.len(), 101);
+    let last = &rows[100];
     assert!(
         (last[1] - 2.1).abs() < 1e-9 && last[2].abs() < 1e-9,
         "{last:?}"
@@ -117,15 +143,7 @@ fn trajectory_from_an_energy_starts_at_the_lower_turning_point() {
     ]);
     let o = run(&args);
     assert!(o.status.success(), "{}", stderr(&o));
-    let text = std::fs::read_to_string(&out).unwrap();
-    let first: Vec<f64> = text
-        .lines()
-        .filter(|l| !l.starts_with('#'))
-        .nth(1)
-        .unwrap()
-        .split(',')
-        .map(|x| x.parse().unwrap())
-        .collect();
+    let first = &read_csv(&out).1[0];
     // Component 1 of the two tori lies beyond the local maximum of V at θ ≈ 1.29.
     assert!(first[1] > 1.29 && first[2] == 0.0, "{first:?}");
 }
@@ -361,12 +379,7 @@ fn a_trajectory_started_by_energy_on_a_rotation_rolls_over_the_top_once_per_peri
         out.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let text = std::fs::read_to_string(&out).unwrap();
-    let rows: Vec<Vec<f64>> = text
-        .lines()
-        .filter(|l| !l.starts_with('#') && !l.starts_with('t'))
-        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
-        .collect();
+    let rows = read_csv(&out).1;
     let (first, last) = (&rows[0], &rows[rows.len() - 1]);
     assert!(first[2] > 0.3, "θ̇(0) = {}", first[2]);
     assert!(
@@ -396,16 +409,16 @@ fn edge_inputs_get_one_line_and_never_a_panic() {
     std::fs::create_dir(&outs).unwrap();
     let out = outs.join("o.h5");
     let out_s = out.to_str().unwrap();
-    // A shard index that overflowed `Shard::units`, and more shards than work units.
+    // A shard index that overflowed `Shard::region`, and more shards than the split axis has.
     let huge = "498560650640798693/498560650640798693";
     assert_refused(
         &["run", scene_s, "--out", out_s, "--shard", huge],
-        "work units",
+        "do not tile",
         Some(&out),
     );
     assert_refused(
         &["run", scene_s, "--out", out_s, "--shard", "2/3"],
-        "work units",
+        "do not tile",
         Some(&out),
     );
     // A grid whose step overflows (inf · 0 = NaN passed the monotonic check).

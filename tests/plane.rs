@@ -121,7 +121,7 @@ fn excess_energy_plane_starts_at_the_bottom_of_every_row() {
     }
     assert_eq!(
         text_attr(&f.dataset("rotation_number").unwrap(), "coordinates"),
-        "energy"
+        "nu eta energy"
     );
     let energy = read4(&f, "energy");
     let n = read5(&f, "rotation_number");
@@ -176,7 +176,7 @@ fn compact_plane_reaches_infinite_energy_exactly() {
         "lambda = { start = 0.05, stop = 1.4, num = 6 }\ns = { start = 0.0, stop = 0.5, num = 6 }",
     );
     let rn = f.dataset("rotation_number").unwrap();
-    assert_eq!(text_attr(&rn, "coordinates"), "kappa energy");
+    assert_eq!(text_attr(&rn, "coordinates"), "nu eta kappa energy");
     let kappa = read4(&f, "kappa");
     let energy = read4(&f, "energy");
     let n = read5(&f, "rotation_number");

@@ -383,7 +383,7 @@ fn a_run_killed_at_any_point_resumes_to_the_same_arrays() {
 }
 
 #[test]
-fn three_shards_merged_equal_a_single_run() {
+fn four_shards_merged_equal_a_single_run() {
     let dir = tempfile::tempdir().unwrap();
     let scene = small_scene(dir.path());
     let s = scene.to_str().unwrap();
@@ -395,7 +395,7 @@ fn three_shards_merged_equal_a_single_run() {
         single.to_str().unwrap(),
         "--quiet",
     ]));
-    let shards: Vec<PathBuf> = (1..=3)
+    let shards: Vec<PathBuf> = (1..=4)
         .map(|i| {
             let path = dir.path().join(format!("shard-{i}.h5"));
             ok(&run(&[
@@ -404,7 +404,7 @@ fn three_shards_merged_equal_a_single_run() {
                 "--out",
                 path.to_str().unwrap(),
                 "--shard",
-                &format!("{i}/3"),
+                &format!("{i}/4"),
                 "--quiet",
             ]));
             path
@@ -413,7 +413,7 @@ fn three_shards_merged_equal_a_single_run() {
     let merged = dir.path().join("merged.h5");
     let mut args = vec!["merge".to_string()];
     // In another order than made: the shards know their index.
-    for i in [2, 0, 1] {
+    for i in [2, 0, 3, 1] {
         args.push(shards[i].to_str().unwrap().to_string());
     }
     args.extend(["--out".to_string(), merged.to_str().unwrap().to_string()]);
@@ -432,7 +432,7 @@ fn three_shards_merged_equal_a_single_run() {
         r,
     ]);
     assert_eq!(missing.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&missing.stderr).contains("missing: 2/3"));
+    assert!(String::from_utf8_lossy(&missing.stderr).contains("missing: 2/4, 4/4"));
     let twice = run(&[
         "merge",
         shards[0].to_str().unwrap(),
@@ -457,7 +457,7 @@ fn three_shards_merged_equal_a_single_run() {
         "--out",
         other.to_str().unwrap(),
         "--shard",
-        "2/3",
+        "2/4",
         "--quiet",
     ]));
     let mixed = run(&[
@@ -473,56 +473,58 @@ fn three_shards_merged_equal_a_single_run() {
     assert!(!refused.exists());
 }
 
-/// Issue 13 item 2: a shard file opened alone shows the cells it did not compute as
-/// `not_computed` (its own flag value, the file's fill value), never as `ok`.
+/// Issue 14 item 4: a shard file holds just its region of the grid (a range of its longest
+/// axis), every cell of it computed and equal to a single run's, so that xarray combines
+/// the shards by their coordinates.
 #[test]
-fn a_shard_opened_alone_marks_the_cells_it_did_not_compute() {
-    use rubber_atlas::atlas::{cell_status, units, Shard};
+fn a_shard_file_holds_just_its_region_equal_to_a_single_run() {
+    use rubber_atlas::atlas::cell_status;
     let dir = tempfile::tempdir().unwrap();
     let scene = small_scene(dir.path());
-    let shard = dir.path().join("one.h5");
-    ok(&run(&[
-        "run",
-        scene.to_str().unwrap(),
-        "--out",
-        shard.to_str().unwrap(),
-        "--shard",
-        "1/2",
-        "--quiet",
-    ]));
-    let parsed = rubber_atlas::scene::Scene::from_file(&scene).unwrap();
-    let all = units(parsed.shape());
-    let mine = (Shard { index: 1, count: 2 }).units(all.len());
-    let f = hdf5::File::open(&shard).unwrap();
-    let status = f
-        .dataset("cell_status")
+    let whole = run_quietly(scene.to_str().unwrap(), &dir.path().join("whole.h5"));
+    let whole = hdf5::File::open(&whole).unwrap();
+    let read_f64 = |f: &hdf5::File, name: &str| f.dataset(name).unwrap().read_raw::<f64>().unwrap();
+    let whole_alpha = read_f64(&whole, "alpha");
+    let whole_n = whole
+        .dataset("rotation_number")
         .unwrap()
-        .read::<u8, ndarray::Ix4>()
+        .read::<f64, ndarray::Ix5>()
         .unwrap();
-    let meanings = f
-        .dataset("cell_status")
-        .unwrap()
-        .attr("flag_meanings")
-        .unwrap()
-        .read_scalar::<hdf5::types::VarLenUnicode>()
-        .unwrap();
-    assert!(meanings.as_str().ends_with("not_computed"));
-    let (mut computed, mut not) = (0, 0);
-    for (i, u) in all.iter().enumerate() {
-        for row in u.rows.clone() {
-            for e in 0..parsed.shape()[3] {
-                let s = status[[u.alpha_index, u.beta_index, row, e]];
-                if mine.contains(&i) {
-                    assert!(s <= cell_status::FAILED, "unit {i}: {s}");
-                    computed += 1;
-                } else {
-                    assert_eq!(s, cell_status::NOT_COMPUTED, "unit {i}");
-                    not += 1;
-                }
-            }
-        }
+    let mut seen = Vec::new();
+    for i in 1..=2 {
+        let shard = dir.path().join(format!("s{i}.h5"));
+        ok(&run(&[
+            "run",
+            scene.to_str().unwrap(),
+            "--out",
+            shard.to_str().unwrap(),
+            "--shard",
+            &format!("{i}/2"),
+            "--quiet",
+        ]));
+        let f = hdf5::File::open(&shard).unwrap();
+        // The scene has two alpha, two beta and one block of kappa rows: shards split alpha.
+        let alpha = read_f64(&f, "alpha");
+        assert_eq!(alpha.len(), 1);
+        assert_eq!(read_f64(&f, "beta"), read_f64(&whole, "beta"));
+        let ia = whole_alpha.iter().position(|&a| a == alpha[0]).unwrap();
+        seen.push(ia);
+        let status = f.dataset("cell_status").unwrap().read_raw::<u8>().unwrap();
+        assert!(status.iter().all(|&s| s <= cell_status::FAILED));
+        let n = f
+            .dataset("rotation_number")
+            .unwrap()
+            .read::<f64, ndarray::Ix5>()
+            .unwrap();
+        let expected = whole_n.slice(ndarray::s![ia..ia + 1, .., .., .., ..]);
+        assert_eq!(n.shape(), expected.shape());
+        assert!(n
+            .iter()
+            .zip(expected.iter())
+            .all(|(a, b)| a.to_bits() == b.to_bits()));
     }
-    assert!(computed > 0 && not > 0);
+    seen.sort();
+    assert_eq!(seen, [0, 1]);
 }
 
 /// Runs `scene` into `out` (quietly; it must succeed) and returns `out`.

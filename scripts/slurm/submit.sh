@@ -12,6 +12,9 @@ fi
 scene="$1" count="$2"
 shift 2
 here="$(dirname "${BASH_SOURCE[0]}")"
+# Nothing is queued for a scene the program refuses, or a shard count that does not tile its
+# grid (shards are boxes of it): the program says why, in one line.
+"${RUBBER_ATLAS_BIN:-target/release/rubber-atlas}" run "$scene" --shard "1/$count" --print-out >/dev/null
 mkdir -p atlas/logs
 jobid=$(sbatch --parsable --array=1-"$count" "$@" "$here/atlas.sbatch" "$scene")
 echo "submitted shards: job array $jobid (1-$count)"

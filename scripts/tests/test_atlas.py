@@ -14,11 +14,14 @@ import h5py
 import numpy as np
 import pytest
 
+from rubber_atlas import components, flag_names, open_atlas
+
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "scripts"))
 
-from atlas_io import DIMENSIONS, components, flag_names, open_atlas  # noqa: E402
 from plot_atlas import plot  # noqa: E402
+
+DIMENSIONS = ("alpha", "beta", "kappa", "energy", "component")
 
 BIN = os.environ.get("RUBBER_ATLAS_BIN", str(ROOT / "target" / "release" / "rubber-atlas"))
 SCENE = ROOT / "atlas" / "demo.toml"
@@ -46,10 +49,15 @@ def test_h5py_sees_dimension_scales_and_cf_attributes(demo):
         for name in ("alpha", "beta", "kappa", "energy"):
             # The axis values are the scene's (within a rounding of the evenly spaced points).
             np.testing.assert_allclose(f[name][:], axis(scene["axes"][name]), rtol=0, atol=1e-15)
+        for name in ("nu", "eta"):
+            # The body's mass parameters: scalar coordinates of every variable.
+            assert f[name].shape == () and f[name][()] == scene["body"][name]
+            assert "long_name" in f[name].attrs and f[name].attrs["units"] == "1"
         for name, var in f.items():
-            if name in DIMENSIONS:
+            if name in DIMENSIONS or name in ("nu", "eta"):
                 continue
             assert "long_name" in var.attrs and "units" in var.attrs, name
+            assert "nu eta" in var.attrs["coordinates"], name
             dims = [var.dims[i][0].name.lstrip("/") for i in range(var.ndim)]
             assert dims == list(DIMENSIONS[: var.ndim]), name
             # Chunks tile one (alpha, beta) slice along kappa (whole rows of energy), compressed.
@@ -70,6 +78,15 @@ def test_xarray_opens_it_with_named_dimensions(demo):
     assert not any(d.startswith("phony_dim") for d in ds.dims)
     assert list(ds.component.values) == [0, 1, 2]
     assert flag_names(ds.status)[0] == "ok"
+    # Flags stay integers in xarray (no _FillValue: 255 is a flag value of its own).
+    for name in ("status", "motion", "bounded", "cell_status", "n_components"):
+        assert ds[name].dtype == np.uint8, name
+    assert flag_names(ds.status)[255] == "no_value"
+    assert float(ds.nu) == 0.5 and float(ds.eta) == 0.5 and "nu" in ds.coords
+    # Units that UDUNITS parses; the paper's scale in a comment.
+    assert ds.period.attrs["units"] == "1" and "sqrt(b3/g)" in ds.period.attrs["comment"]
+    assert ds.theta_min.attrs["units"] == "rad"
+    assert ds.attrs["history"].startswith(ds.attrs["created"] + ": ")
     # The motion is where the scene says: N is finite exactly on the existing components.
     count = ds.n_components.values
     finite = np.isfinite(ds.rotation_number.values).sum(axis=-1)

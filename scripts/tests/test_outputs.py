@@ -2,6 +2,7 @@
 plot script on them."""
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -10,11 +11,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from rubber_atlas import read_table
+
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "scripts"))
 
 from plot_trajectory import plot  # noqa: E402
-from trajectory_io import critical_set, read_table  # noqa: E402
 
 BIN = os.environ.get("RUBBER_ATLAS_BIN", str(ROOT / "target" / "release" / "rubber-atlas"))
 BODY = ["--alpha", "0.5", "--beta", "3", "--nu", "0.5", "--eta", "0.5"]
@@ -37,22 +39,28 @@ def trajectories(tmp_path_factory):
 
 
 def test_hdf5_and_csv_trajectories_hold_the_same_numbers(trajectories):
-    h5, h5_attrs = read_table(trajectories["h5"])
-    csv, csv_attrs = read_table(trajectories["csv"])
-    assert list(csv) == ["t", "theta", "theta_dot", "phi", "psi", "x_c", "y_c", "z_c", "x_p", "y_p"]
-    for name in csv:
+    h5 = read_table(trajectories["h5"])
+    csv = read_table(trajectories["csv"])
+    assert list(csv.dims) == ["t"]
+    assert set(csv.variables) == {"t", "theta", "theta_dot", "phi", "psi", "x_c", "y_c", "z_c", "x_p", "y_p"}
+    for name in csv.variables:
         # CSV holds shortest round-trip decimals: the same doubles.
-        np.testing.assert_array_equal(h5[name], csv[name])
-    assert float(h5_attrs["kappa"]) == 0.8
+        np.testing.assert_array_equal(h5[name].values, csv[name].values)
+    # Numbers stay numbers in both.
+    assert h5.attrs["kappa"] == 0.8 and csv.attrs["kappa"] == 0.8
+    assert h5.attrs["tolerance"] == csv.attrs["tolerance"] == 1e-12
+    # t is the dimension coordinate.
+    assert h5.theta.dims == ("t",) and "t" in h5.indexes
     import h5py
 
     with h5py.File(trajectories["h5"]) as f:
         assert f["theta"].attrs["units"] == "rad"
+        assert f["x_c"].attrs["units"] == "1" and "b3" in f["x_c"].attrs["comment"]
         assert "centre of mass" in f["x_c"].attrs["long_name"]
 
 
 def test_resonant_trajectory_closes(trajectories):
-    cols, _ = read_table(trajectories["h5"])
+    cols = {k: v.values for k, v in read_table(trajectories["h5"]).variables.items()}
     size = np.hypot(np.ptp(cols["x_c"]), np.ptp(cols["y_c"]))
     gap = np.hypot(cols["x_c"][-1] - cols["x_c"][0], cols["y_c"][-1] - cols["y_c"][0])
     # θ0 = 0.4670288 is N = -1/7 to 7 digits: the path closes to far better than 1e-4.
@@ -74,8 +82,12 @@ def test_plot_script_writes_a_picture(trajectories, tmp_path):
 def test_diagram_file_opens_with_branches_and_summary(tmp_path):
     p = tmp_path / "d.h5"
     run("diagram", *BODY, "--out", str(p))
-    cols, _ = read_table(p)
-    summary = critical_set(p)
+    table = read_table(p)
+    cols = {k: v.values for k, v in table.variables.items()}
+    summary = json.loads(table.attrs["critical_set_json"])
+    # Flags and indices stay integers.
+    assert table.branch.dtype == np.uint8 and table.stable.dtype == np.uint8
+    assert table.segment.dtype == np.int32 and table.branch.dims == ("sample",)
     assert summary["diagram_type"] == "c"
     assert set(np.unique(cols["branch"]).astype(int)) == {0, 1, 2}
     # Along σ_u (code 1) every point is unstable; σ_s0 and σ_sπ are stable.

@@ -87,15 +87,16 @@ def test_the_command_line(atlas, tmp_path):
 
 
 def test_the_resonance_command_writes_tables_and_refuses_bad_input(tmp_path):
-    from trajectory_io import read_table
+    from rubber_atlas import read_table
 
     body = ["--alpha", "0.5", "--beta", "3", "--nu", "0.5", "--eta", "0.5"]
     for ext in ("csv", "h5"):
         out = tmp_path / f"n0.{ext}"
         subprocess.run([BIN, "resonance", *body, "--rotation-number", "0", "--out", str(out)], check=True,
                        capture_output=True)
-        cols, attrs = read_table(out)
-        assert len(cols["kappa"]) > 20
+        table = read_table(out)
+        cols, attrs = {k: v.values for k, v in table.variables.items()}, table.attrs
+        assert len(cols["kappa"]) > 20 and table.kappa.dims == ("sample",)
         assert np.all(np.abs(cols["rotation_number"]) <= np.maximum(1e-10, cols["error_estimate"]))
         assert json.loads(attrs["header_json"])["rotation_number"] == 0.0
     for bad, name in ((["--rotation-number", "one"], "--rotation-number"), (["--rotation-number", "1/0"], "--rotation-number"),

@@ -20,7 +20,7 @@ eta = 0.5
 [axes]
 alpha = [0.3, 0.5]
 beta = [3.0]
-kappa = { start = 0.0, stop = 1.5, num = 30 }
+kappa = { start = 0.0, stop = 1.5, num = 60 }
 energy = { start = 0.5, stop = 4.0, num = 200 }
 [solver]
 tolerance = 1e-9
@@ -109,9 +109,14 @@ def test_submit_passes_options_and_names_logs(tmp_path):
     fake = bindir / "sbatch"
     fake.write_text(f'#!/usr/bin/env bash\nprintf "%s\\n" "$*" >> {calls}\necho 4242\n')
     fake.chmod(0o755)
-    env = dict(os.environ, PATH=f"{bindir}:{os.environ['PATH']}")
-    subprocess.run(["bash", str(ROOT / "scripts" / "slurm" / "submit.sh"), "atlas/tiny.toml", "3",
-                    "--partition=short", "--account=proj"], cwd=tmp_path, env=env, check=True,
+    env = dict(os.environ, PATH=f"{bindir}:{os.environ['PATH']}", RUBBER_ATLAS_BIN=BIN)
+    (tmp_path / "atlas").mkdir()
+    (tmp_path / "atlas" / "tiny.toml").write_text(SCENE)
+    submit = ["bash", str(ROOT / "scripts" / "slurm" / "submit.sh"), "atlas/tiny.toml"]
+    # 7 shards do not tile the 2 x 1 x 3 grid: refused in one line, nothing queued.
+    refused = subprocess.run([*submit, "7"], cwd=tmp_path, env=env, capture_output=True, text=True)
+    assert refused.returncode == 2 and "do not tile" in refused.stderr and not calls.exists()
+    subprocess.run([*submit, "3", "--partition=short", "--account=proj"], cwd=tmp_path, env=env, check=True,
                    capture_output=True)
     array, merge = calls.read_text().splitlines()
     assert "--array=1-3" in array and "--partition=short" in array and "--account=proj" in array

@@ -3,37 +3,14 @@
 //! xarray's h5netcdf engine shows named dimensions), CF-style attributes, and variables
 //! chunked one (α, β) slice per chunk and compressed.
 
-use crate::atlas::{Block, Column, Kind, Unit, Variable, COMPONENT_SLOTS, FLAG_FILL};
+use super::h5::{attach_scale, describe, set_scale, text_attr, write_attr};
+use crate::atlas::{Block, Column, Kind, Region, Unit, Variable, COMPONENT_SLOTS, FLAG_FILL};
+use crate::cf;
 use crate::error::{AtlasError, Result};
 use crate::scene::{Plane, Scene};
 use hdf5::types::VarLenUnicode;
 use ndarray::s;
-use std::ffi::CString;
 use std::path::{Path, PathBuf};
-
-/// The HDF5 high-level library's dimension-scale calls (`hdf5_hl`, linked by build.rs; the
-/// `hdf5` crate has no binding for them).
-mod ds {
-    use std::ffi::{c_char, c_int, c_uint, c_void};
-    pub type Hid = i64;
-    extern "C" {
-        pub fn H5DSset_scale(dsid: Hid, dimname: *const c_char) -> c_int;
-        pub fn H5DSattach_scale(did: Hid, dsid: Hid, idx: c_uint) -> c_int;
-    }
-    // HDF5 ≥ 1.10.2: write a chunk that is already filtered (here: shuffled and deflated).
-    extern "C" {
-        pub fn H5Dwrite_chunk(
-            dset_id: Hid,
-            dxpl_id: Hid,
-            filters: u32,
-            offset: *const u64,
-            data_size: usize,
-            buf: *const c_void,
-        ) -> c_int;
-    }
-    /// H5P_DEFAULT.
-    pub const DEFAULT: Hid = 0;
-}
 
 /// The deflate level of the variables (1: a third of level 4's time for 10–20 % more bytes
 /// on these arrays after the shuffle filter).
@@ -42,13 +19,7 @@ const DEFLATE_LEVEL: u8 = 1;
 /// The names of the dimensions, slowest first.
 pub const DIMENSIONS: [&str; 5] = ["alpha", "beta", "kappa", "energy", "component"];
 
-/// A root attribute value.
-#[derive(Debug, Clone, PartialEq)]
-pub enum AttrValue {
-    Text(String),
-    Number(f64),
-    Integer(i64),
-}
+pub use crate::cf::AttrValue;
 
 /// An open atlas file.
 pub struct AtlasFile {
@@ -56,135 +27,99 @@ pub struct AtlasFile {
     file: hdf5::File,
     datasets: Vec<hdf5::Dataset>,
     variables: Vec<Variable>,
-    shape: [usize; 4],
-}
-
-fn text_attr(loc: &hdf5::Location, name: &str, value: &str) -> hdf5::Result<()> {
-    let v: VarLenUnicode = value
-        .parse()
-        .map_err(|e: hdf5::types::StringError| hdf5::Error::from(e.to_string().as_str()))?;
-    loc.new_attr::<VarLenUnicode>()
-        .create(name)?
-        .write_scalar(&v)
-}
-
-fn write_attr(loc: &hdf5::Location, name: &str, value: &AttrValue) -> hdf5::Result<()> {
-    match value {
-        AttrValue::Text(t) => text_attr(loc, name, t),
-        AttrValue::Number(x) => loc.new_attr::<f64>().create(name)?.write_scalar(x),
-        AttrValue::Integer(i) => loc.new_attr::<i64>().create(name)?.write_scalar(i),
-    }
-}
-
-fn set_scale(dataset: &hdf5::Dataset, name: &str) -> hdf5::Result<()> {
-    let name = CString::new(name).expect("dimension names have no NUL");
-    let status = hdf5::sync::sync(|| unsafe { ds::H5DSset_scale(dataset.id(), name.as_ptr()) });
-    if status < 0 {
-        return Err(format!("H5DSset_scale failed for {name:?}").as_str().into());
-    }
-    Ok(())
-}
-
-fn attach_scale(dataset: &hdf5::Dataset, scale: &hdf5::Dataset, index: usize) -> hdf5::Result<()> {
-    let status = hdf5::sync::sync(|| unsafe {
-        ds::H5DSattach_scale(dataset.id(), scale.id(), index as std::ffi::c_uint)
-    });
-    if status < 0 {
-        return Err("H5DSattach_scale failed".into());
-    }
-    Ok(())
+    region: Region,
 }
 
 impl AtlasFile {
-    /// Creates the file at `path` (which must not exist) with the scene's coordinates, every
-    /// variable at its fill value, and `attributes` on the root.
+    /// Creates the file at `path` (which must not exist) for the part `region` of the
+    /// scene's grid (all of it, or a shard's), with its coordinates, every variable at its
+    /// fill value, and `attributes` on the root.
     pub fn create(
         path: &Path,
         scene: &Scene,
+        region: &Region,
         variables: &[Variable],
         attributes: &[(&str, AttrValue)],
     ) -> Result<AtlasFile> {
-        Self::create_inner(path, scene, variables, attributes)
+        Self::create_inner(path, scene, region, variables, attributes)
             .map_err(|e| AtlasError::atlas(path, e))
     }
 
     fn create_inner(
         path: &Path,
         scene: &Scene,
+        region: &Region,
         variables: &[Variable],
         attributes: &[(&str, AttrValue)],
     ) -> hdf5::Result<AtlasFile> {
         let file = hdf5::File::create_excl(path)?;
-        text_attr(&file, "Conventions", "CF-1.8")?;
+        text_attr(&file, "Conventions", cf::CONVENTIONS)?;
         for (name, value) in attributes {
             write_attr(&file, name, value)?;
         }
         let [row_name, column_name] = scene.plane.axis_names();
-        let (row_long, column_long) = match scene.plane {
-            Plane::KappaEnergy => (
-                "kappa = F2, the first integral of the reduction",
-                "energy, the value of the reduced energy integral",
-            ),
+        let known = |name: &str| crate::atlas::coordinate(name).expect("a coordinate's name");
+        let (row, column) = match scene.plane {
+            Plane::KappaEnergy => (known("kappa"), known("energy")),
             Plane::KappaExcess => (
-                "kappa = F2, the first integral of the reduction",
-                "excess energy: energy minus the bottom of V (its deepest minimum) at this kappa",
+                known("kappa"),
+                (
+                    "excess energy: energy minus the bottom of V (its deepest minimum) at this kappa",
+                    cf::ENERGY,
+                ),
             ),
             Plane::Compact => (
-                "lambda = kappa / sqrt(energy), fixed along the high-energy limit",
-                "s = 1 / sqrt(energy): s = 0 is energy = infinity (the high-energy limit)",
+                (
+                    "lambda = kappa / sqrt(energy), fixed along the high-energy limit",
+                    cf::PAPER,
+                ),
+                (
+                    "s = 1 / sqrt(energy): s = 0 is energy = infinity (the high-energy limit)",
+                    cf::PAPER,
+                ),
             ),
         };
-        let coords: [(&str, &[f64], &str, &str); 4] = [
+        let coords: [(&str, &[f64], (&str, cf::Units)); 4] = [
             (
                 "alpha",
-                &scene.alpha.values,
-                "alpha = a / b3, offset of the centre of mass along the symmetry axis",
-                "1",
+                &scene.alpha.values[region.alpha.clone()],
+                known("alpha"),
             ),
             (
                 "beta",
-                &scene.beta.values,
-                "beta = b1 / b3, ratio of the semi-axes",
-                "1",
+                &scene.beta.values[region.beta.clone()],
+                known("beta"),
             ),
-            (
-                row_name,
-                &scene.kappa.values,
-                row_long,
-                "paper units (m = b3 = g = 1)",
-            ),
-            (
-                column_name,
-                &scene.energy.values,
-                column_long,
-                "paper units (m = b3 = g = 1)",
-            ),
+            (row_name, &scene.kappa.values[region.rows.clone()], row),
+            (column_name, &scene.energy.values, column),
         ];
         let mut scales = Vec::new();
-        for (name, values, long_name, units) in coords {
+        for (name, values, (long_name, units)) in coords {
             let d = file.new_dataset_builder().with_data(values).create(name)?;
-            text_attr(&d, "long_name", long_name)?;
-            text_attr(&d, "units", units)?;
+            describe(&d, long_name, units)?;
             set_scale(&d, name)?;
             scales.push(d);
+        }
+        // The body's mass parameters: scalar coordinates of every variable.
+        for (name, value) in [("nu", scene.nu), ("eta", scene.eta)] {
+            let d = file.new_dataset::<f64>().create(name)?;
+            d.write_scalar(&value)?;
+            let (long_name, units) = known(name);
+            describe(&d, long_name, units)?;
         }
         let slots: Vec<i32> = (0..COMPONENT_SLOTS as i32).collect();
         let d = file
             .new_dataset_builder()
             .with_data(&slots)
             .create("component")?;
-        text_attr(
-            &d,
-            "long_name",
-            "component of the allowed set, in increasing theta_min",
-        )?;
-        text_attr(&d, "units", "1")?;
+        let (long_name, units) = known("component");
+        describe(&d, long_name, units)?;
         set_scale(&d, "component")?;
         scales.push(d);
 
         let shape = scene.shape();
-        let [na, nb, nk, ne] = shape;
-        let rows = crate::atlas::rows_per_unit(shape);
+        let [na, nb, nk, ne] = region.shape();
+        let rows = region.chunk_rows(shape);
         let mut datasets = Vec::with_capacity(variables.len());
         for v in variables {
             let per_cell = v.kind.per_cell();
@@ -228,32 +163,25 @@ impl AtlasFile {
                     .shape([na, nb, nk, ne, COMPONENT_SLOTS])
                     .create(v.name)?
             };
-            text_attr(&d, "long_name", v.long_name)?;
-            text_attr(&d, "units", v.units)?;
-            match v.kind {
-                Kind::Value | Kind::CellValue => d
-                    .new_attr::<f64>()
+            describe(&d, v.long_name, v.units)?;
+            // Floats are NaN where a component does not exist. Flags take FLAG_FILL there,
+            // a value of their own (`flag_values`, `flag_meanings`), not a _FillValue: a
+            // _FillValue would make xarray decode them as floats with NaN.
+            if matches!(v.kind, Kind::Value | Kind::CellValue) {
+                d.new_attr::<f64>()
                     .create("_FillValue")?
-                    .write_scalar(&f64::NAN)?,
-                Kind::Flag => d
-                    .new_attr::<u8>()
-                    .create("_FillValue")?
-                    .write_scalar(&FLAG_FILL)?,
-                Kind::CellFlag => {}
+                    .write_scalar(&f64::NAN)?;
             }
-            if let Some((values, meanings)) = v.flags {
-                d.new_attr::<u8>()
-                    .shape(values.len())
-                    .create("flag_values")?
-                    .write_raw(values)?;
-                text_attr(&d, "flag_meanings", meanings)?;
+            if let Some((values, meanings)) = v.flag_attributes() {
+                super::h5::flags(&d, (&values, &meanings))?;
             }
-            // κ and ε per cell, where they are not axes: CF auxiliary coordinates of every
-            // variable of the grid.
-            let auxiliary = scene.plane.auxiliary();
-            if !auxiliary.is_empty() && v.kind != Kind::CellValue {
-                text_attr(&d, "coordinates", &auxiliary.join(" "))?;
+            // ν and η, and κ and ε per cell where they are not axes (CF auxiliary
+            // coordinates).
+            let mut coordinates = vec!["nu", "eta"];
+            if v.kind != Kind::CellValue {
+                coordinates.extend(scene.plane.auxiliary());
             }
+            text_attr(&d, "coordinates", &coordinates.join(" "))?;
             let dims = if per_cell { 4 } else { 5 };
             for (i, scale) in scales.iter().take(dims).enumerate() {
                 attach_scale(&d, scale, i)?;
@@ -265,12 +193,13 @@ impl AtlasFile {
             file,
             datasets,
             variables: variables.to_vec(),
-            shape,
+            region: region.clone(),
         })
     }
 
-    /// Opens an existing atlas file for reading; `variables` are those its scene asks for.
-    pub fn open(path: &Path, scene: &Scene, variables: &[Variable]) -> Result<AtlasFile> {
+    /// Opens an existing atlas file of the part `region` of the scene's grid for reading;
+    /// `variables` are those its scene asks for.
+    pub fn open(path: &Path, region: &Region, variables: &[Variable]) -> Result<AtlasFile> {
         let inner = || -> hdf5::Result<AtlasFile> {
             let file = hdf5::File::open(path)?;
             let datasets = variables
@@ -282,7 +211,7 @@ impl AtlasFile {
                 file,
                 datasets,
                 variables: variables.to_vec(),
-                shape: scene.shape(),
+                region: region.clone(),
             })
         };
         inner().map_err(|e| AtlasError::atlas(path, e))
@@ -292,7 +221,7 @@ impl AtlasFile {
     /// chunk fails its filter when read): an existing output taken as current must be whole.
     pub fn is_whole(&self) -> bool {
         self.variables.iter().zip(&self.datasets).all(|(v, d)| {
-            let mut shape = self.shape.to_vec();
+            let mut shape = self.region.shape().to_vec();
             if !v.kind.per_cell() {
                 shape.push(COMPONENT_SLOTS);
             }
@@ -329,19 +258,20 @@ impl AtlasFile {
             .zip(&self.datasets)
             .zip(&encoded.chunks)
         {
+            let r = &self.region;
             let mut offset = vec![
-                unit.alpha_index as u64,
-                unit.beta_index as u64,
-                unit.rows.start as u64,
+                (unit.alpha_index - r.alpha.start) as u64,
+                (unit.beta_index - r.beta.start) as u64,
+                (unit.rows.start - r.rows.start) as u64,
                 0,
             ];
             if !v.kind.per_cell() {
                 offset.push(0);
             }
             let status = hdf5::sync::sync(|| unsafe {
-                ds::H5Dwrite_chunk(
+                hdf5_sys::h5d::H5Dwrite_chunk(
                     d.id(),
-                    ds::DEFAULT,
+                    hdf5_sys::h5p::H5P_DEFAULT,
                     0,
                     offset.as_ptr(),
                     bytes.len(),
@@ -360,7 +290,12 @@ impl AtlasFile {
 
     /// Reads the values of `unit`.
     pub fn read_unit(&self, unit: &Unit) -> Result<Block> {
-        let (ia, ib, r) = (unit.alpha_index, unit.beta_index, unit.rows.clone());
+        let g = &self.region;
+        let (ia, ib) = (
+            unit.alpha_index - g.alpha.start,
+            unit.beta_index - g.beta.start,
+        );
+        let r = unit.rows.start - g.rows.start..unit.rows.end - g.rows.start;
         let read = || -> hdf5::Result<Block> {
             let mut columns = Vec::with_capacity(self.variables.len());
             for (v, d) in self.variables.iter().zip(&self.datasets) {
@@ -388,7 +323,7 @@ impl AtlasFile {
                 });
             }
             Ok(Block {
-                cells: unit.rows.len() * self.shape[3],
+                cells: unit.rows.len() * self.region.columns,
                 columns,
             })
         };
@@ -423,12 +358,18 @@ impl EncodedUnit {
     }
 }
 
-/// Encodes `block`, the values of one unit of a grid of shape `shape`, chunk by chunk as
-/// HDF5's shuffle and deflate filters would (a unit is one chunk of every variable). Done in
+/// Encodes `block`, the values of one unit, as chunks of `chunk_rows` κ-rows of `columns`
+/// cells ([`Region::chunk_rows`]), as HDF5's shuffle and deflate filters would (a unit is
+/// one chunk of every variable). Done in
 /// the worker threads: HDF5 runs its filters on the one thread that writes, which cost a
 /// 2-thread run a third of its speed.
-pub fn encode_unit(variables: &[Variable], block: &Block, shape: [usize; 4]) -> EncodedUnit {
-    let chunk_cells = crate::atlas::rows_per_unit(shape) * shape[3];
+pub fn encode_unit(
+    variables: &[Variable],
+    block: &Block,
+    chunk_rows: usize,
+    columns: usize,
+) -> EncodedUnit {
+    let chunk_cells = chunk_rows * columns;
     let chunks = variables
         .iter()
         .zip(&block.columns)

@@ -1,0 +1,293 @@
+"""The installed package as a user meets it in a notebook in any folder: where it is imported
+from, `cells` against the `cell` command and an atlas file (bit for bit), the GIL released,
+bad input, the tables and the verdict against the commands, and the accessor."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import rubber_atlas as ra
+from conftest import BIN, ROOT, run
+
+COMPONENT_KEYS = ["theta_min", "theta_max", "period", "omega_theta", "omega_psi", "rotation_number",
+                  "drift", "drift_radius", "error_estimate"]
+
+
+def test_the_package_is_the_installed_one_and_not_the_repository():
+    for module in (ra, ra._core):
+        path = Path(module.__file__).resolve()
+        assert ROOT / "python" not in path.parents, path
+        assert "site-packages" in path.parts, path
+    assert not Path.cwd().resolve().is_relative_to(ROOT)
+    assert ra.__version__ == run("--version").split()[1]
+
+
+def bits(x) -> np.ndarray:
+    """The bytes of an array's values (NaN equal to NaN of the same bits)."""
+    return np.atleast_1d(np.asarray(x)).view(np.uint8)
+
+
+def same_double(a, b) -> bool:
+    return np.float64(a).tobytes() == np.float64(b).tobytes()
+
+
+def test_cells_equal_the_cell_command_bit_for_bit_on_random_cells():
+    rng = np.random.default_rng(20261123)
+    n = 40
+    alpha = rng.uniform(0.0, 0.95, n)
+    beta = np.exp(rng.uniform(np.log(0.2), np.log(5.0), n))
+    nu = rng.uniform(0.1, 2.0, n)
+    eta = rng.uniform(0.1, 3.0, n)
+    kappa = np.where(rng.random(n) < 0.15, 0.0, rng.uniform(0.0, 2.0, n))
+    energy = rng.uniform(0.2, 6.0, n)
+    ds = ra.cells(alpha, beta, nu, eta, kappa, energy)
+    assert ds.rotation_number.dims == ("cell", "component")
+    flags = {name: ra.flag_names(ds[name]) for name in ("status", "motion")}
+    with_motion = 0
+    for i in range(n):
+        args = ["cell", *[a for name, values in (("--alpha", alpha), ("--beta", beta), ("--nu", nu), ("--eta", eta),
+                                                  ("--kappa", kappa), ("--energy", energy))
+                          for a in (name, repr(float(values[i])))], "--json"]
+        expected = json.loads(run(*args))["components"]
+        cell = ds.isel(cell=i)
+        assert int(cell.n_components) == len(expected), i
+        with_motion += bool(expected)
+        for slot, e in enumerate(expected):
+            c = cell.isel(component=slot)
+            for key in COMPONENT_KEYS:
+                if e[key] is None:  # JSON null: NaN or an infinity
+                    assert not np.isfinite(float(c[key])), (i, key)
+                else:
+                    assert same_double(c[key], e[key]), (i, key, float(c[key]), e[key])
+            for key, names in flags.items():
+                assert names[int(c[key])] == e[key], (i, key)
+            assert (None if int(c.bounded) == 255 else bool(c.bounded)) == e["bounded"], i
+        # Slots beyond the components are NaN and the flags' no_value.
+        for slot in range(len(expected), ds.sizes["component"]):
+            assert np.isnan(float(cell.period.isel(component=slot)))
+            assert int(cell.status.isel(component=slot)) == 255
+    assert with_motion > n // 2
+
+
+def test_cells_on_named_dimensions_equal_an_atlas_file(slice_atlas):
+    """DataArrays broadcast by their dimension names: a (kappa, energy) grid gives the atlas's
+    slice, with the same variables, attributes and values."""
+    with ra.open_atlas(slice_atlas) as atlas:
+        atlas = atlas.load()
+    kappa = xr.DataArray(atlas.kappa.values, dims="kappa", coords={"kappa": atlas.kappa.values})
+    energy = xr.DataArray(atlas.energy.values, dims="energy", coords={"energy": atlas.energy.values})
+    ds = ra.cells(0.5, 3.0, 0.5, 0.5, kappa, energy, threads=2)
+    cut = atlas.isel(alpha=0, beta=0)
+    assert set(ds.data_vars) == set(atlas.data_vars)
+    for name in atlas.data_vars:
+        assert ds[name].dims == cut[name].dims, name
+        np.testing.assert_array_equal(bits(ds[name]), bits(cut[name]), err_msg=name)
+        assert ds[name].dtype == cut[name].dtype, name
+        for key in ("long_name", "units", "comment", "flag_meanings"):
+            assert ds[name].attrs.get(key) == cut[name].attrs.get(key), (name, key)
+        if "flag_values" in cut[name].attrs:
+            np.testing.assert_array_equal(ds[name].attrs["flag_values"], cut[name].attrs["flag_values"])
+    for name in ("kappa", "energy", "alpha", "beta", "nu", "eta", "component"):
+        for key in ("long_name", "units", "comment"):
+            assert ds[name].attrs.get(key) == atlas[name].attrs.get(key), (name, key)
+    assert ds.attrs["tolerance"] == atlas.attrs["tolerance"] and ds.attrs["Conventions"] == atlas.attrs["Conventions"]
+    # Fewer fields: only theirs (and the cell's counts). Without the drift the quadrature
+    # stops when N alone has converged: the same N within its error estimate (as an atlas
+    # with these fields gives it), not bit for bit.
+    few = ra.cells(0.5, 3.0, 0.5, 0.5, kappa, energy, fields=["rotation_number", "error_estimate"])
+    assert set(few.data_vars) == {"n_components", "cell_status", "rotation_number", "error_estimate"}
+    np.testing.assert_array_equal(np.isnan(few.rotation_number), np.isnan(ds.rotation_number))
+    gap = np.abs(few.rotation_number - ds.rotation_number).fillna(0)
+    assert (gap <= few.error_estimate.fillna(0) + ds.error_estimate.fillna(0)).all()
+
+
+def test_cells_release_the_gil():
+    """Another Python thread keeps running while cells() works."""
+    ticks = []
+    stop = threading.Event()
+
+    def tick():
+        while not stop.is_set():
+            ticks.append(time.perf_counter())
+            time.sleep(0.001)
+
+    kappa = np.linspace(0.05, 2.0, 20000)
+    start = time.perf_counter()
+    thread = threading.Thread(target=tick)
+    thread.start()
+    ra.cells(0.5, 3.0, 0.5, 0.5, kappa, 3.0, threads=1, fields=["rotation_number"])
+    end = time.perf_counter()
+    stop.set()
+    thread.join()
+    during = [t for t in ticks if start < t < end]
+    # With the GIL held the thread would not tick at all during the call.
+    assert end - start > 0.05
+    assert len(during) > 0.25 * (end - start) / 0.002, (len(during), end - start)
+
+
+@pytest.mark.parametrize("kwargs, words", [
+    (dict(alpha=1.5), ["alpha", "1.5"]),
+    (dict(beta=-1.0), ["beta", "-1"]),
+    (dict(nu=3.0), ["nu", "3"]),
+    (dict(energy=np.nan), ["energy", "NaN"]),
+    (dict(kappa=[0.5, np.inf]), ["cell 1", "kappa"]),
+])
+def test_bad_cells_raise_one_value_error_naming_the_value(kwargs, words):
+    args = dict(alpha=0.5, beta=3.0, nu=0.5, eta=0.5, kappa=0.5, energy=2.0)
+    args.update(kwargs)
+    with pytest.raises(ValueError) as e:
+        ra.cells(**args)
+    for w in words:
+        assert w in str(e.value), str(e.value)
+
+
+def test_bad_options_raise_value_errors():
+    with pytest.raises(ValueError, match="omega"):
+        ra.cells(0.5, 3, 0.5, 0.5, 0.5, 2.0, fields=["omega"])
+    with pytest.raises(ValueError, match="method"):
+        ra.cells(0.5, 3, 0.5, 0.5, 0.5, 2.0, method="euler")
+    with pytest.raises(ValueError, match="tol"):
+        ra.cells(0.5, 3, 0.5, 0.5, 0.5, 2.0, tol=0.0)
+    with pytest.raises(ValueError, match="threads"):
+        ra.cells(0.5, 3, 0.5, 0.5, 0.5, 2.0, threads=0)
+
+
+IMPORT_AND_ROUND_TRIP = """
+import {first}, {second}, {third}
+import numpy as np, xarray as xr, h5py, rubber_atlas as ra
+ds = ra.cells(0.5, 3.0, 0.5, 0.5, np.linspace(0.1, 1.5, 7), 2.5)
+ds.to_netcdf("round.nc", engine="h5netcdf")
+back = xr.open_dataset("round.nc", engine="h5netcdf").load()
+assert (back.rotation_number.values.view(np.uint8) == ds.rotation_number.values.view(np.uint8)).all()
+assert back.status.dtype == np.uint8
+with h5py.File("round.nc") as f:
+    assert f["rotation_number"].shape == (7, 3)
+maps = open("/proc/self/maps").read()
+libraries = {{line.split()[-1] for line in maps.splitlines() if "libhdf5" in line.split()[-1]}}
+print(sorted(libraries))
+"""
+
+
+@pytest.mark.parametrize("order", [("h5py", "xarray", "rubber_atlas"), ("rubber_atlas", "xarray", "h5py"),
+                                   ("xarray", "rubber_atlas", "h5py")])
+def test_h5py_xarray_and_the_package_import_together_with_one_hdf5(order, tmp_path):
+    code = IMPORT_AND_ROUND_TRIP.format(first=order[0], second=order[1], third=order[2])
+    out = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    libraries = eval(out.stdout.strip().splitlines()[-1])
+    # Only h5py's own HDF5 (its wheel's libhdf5, and its high-level library) is loaded.
+    assert libraries and all("h5py" in lib for lib in libraries), libraries
+    core = Path(ra._core.__file__)
+    ldd = subprocess.run(["ldd", str(core)], capture_output=True, text=True).stdout
+    assert "hdf5" not in ldd, ldd
+
+
+def table_values(ds: xr.Dataset) -> dict:
+    return {name: v.values for name, v in ds.variables.items()}
+
+
+def assert_same_tables(made: xr.Dataset, written: xr.Dataset):
+    assert set(made.data_vars) == set(written.data_vars) and set(made.coords) == set(written.coords)
+    for name, v in made.variables.items():
+        w = written[name]
+        assert v.dims == w.dims and v.dtype == w.dtype, name
+        np.testing.assert_array_equal(bits(v.values), bits(w.values), err_msg=name)
+        for key in ("long_name", "units", "comment", "flag_meanings"):
+            assert v.attrs.get(key) == w.attrs.get(key), (name, key)
+
+
+def test_trajectory_diagram_and_resonance_equal_the_commands(tmp_path):
+    body = ["--alpha", "0.5", "--beta", "3", "--nu", "0.5", "--eta", "0.5"]
+    t_file = tmp_path / "t.h5"
+    run("trajectory", *body, "--kappa", "0.8", "--energy", "2.5", "--periods", "3", "--samples", "300",
+        "--out", t_file)
+    traj = ra.trajectory(0.5, 3, 0.5, 0.5, kappa=0.8, energy=2.5, periods=3, samples=300)
+    written = ra.read_table(t_file)
+    assert_same_tables(traj, written)
+    for key in ("kappa", "energy", "theta0", "theta_dot0", "tolerance", "model"):
+        assert traj.attrs[key] == written.attrs[key], key
+    assert "t" in traj.indexes and traj.theta.dims == ("t",)
+
+    d_file = tmp_path / "d.h5"
+    run("diagram", *body, "--out", d_file)
+    diagram = ra.diagram(0.5, 3)
+    assert_same_tables(diagram, ra.read_table(d_file))
+    assert json.loads(diagram.attrs["critical_set_json"])["diagram_type"] == "c"
+
+    r_file = tmp_path / "r.h5"
+    run("resonance", *body, "--rotation-number", "-1/7", "--grid", "16", "--out", r_file)
+    curves = ra.resonance(0.5, 3, 0.5, 0.5, "-1/7", grid=16)
+    assert_same_tables(curves, ra.read_table(r_file))
+    assert curves.sizes["sample"] > 10
+    assert np.all(np.abs(curves.rotation_number + 1 / 7) <= np.maximum(1e-10, curves.error_estimate))
+
+    with pytest.raises(ValueError, match="periods"):
+        ra.trajectory(0.5, 3, 0.5, 0.5, kappa=0.8, energy=2.5, periods=-1)
+    with pytest.raises(ValueError, match="exactly one"):
+        ra.trajectory(0.5, 3, 0.5, 0.5, kappa=0.8, energy=2.5, theta0=1.0, periods=1)
+
+
+def test_verdicts_equal_the_command():
+    alpha = xr.DataArray([0.5, 0.2], dims="body")
+    beta = xr.DataArray([0.5, 3.0], dims="body")
+    found = ra.verdict(alpha, beta, 0.5, 0.5, resolution=16)
+    assert found.holds.dims == ("body",) and found.holds.dtype == np.uint8
+    for i in range(2):
+        expected = json.loads(run("verdict", "--alpha", float(alpha[i]), "--beta", float(beta[i]), "--nu", "0.5",
+                                  "--eta", "0.5", "--resolution", "16", "--json"))
+        got = json.loads(str(found.verdict_json[i].item()))
+        assert got == expected
+        holds = int(found.holds[i])
+        assert ({0: False, 1: True, 255: None}[holds]) == expected["holds"]
+        assert ra.flag_names(found.case)[int(found.case[i])] == "case_" + expected["case"]
+
+
+def test_the_accessor_gives_components_and_a_figure(slice_atlas):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.figure
+
+    with ra.open_atlas(slice_atlas) as ds:
+        kappa, energy = float(ds.kappa[8]), float(ds.energy[10])
+        got = ds.rubber.components(alpha=0.5, beta=3.0, kappa=kappa, energy=energy)
+        expected = json.loads(run("cell", "--alpha", "0.5", "--beta", "3", "--nu", "0.5", "--eta", "0.5",
+                                  "--kappa", repr(kappa), "--energy", repr(energy), "--json"))["components"]
+        assert len(got) == len(expected) > 0
+        for g, e in zip(got, expected):
+            for key in ("rotation_number", "period", "drift", "status", "motion", "bounded"):
+                assert g[key] == e[key], key
+        assert ds.rubber.flags("status")[3] == "separatrix"
+        fig = ds.rubber.plot_slice()
+        assert isinstance(fig, matplotlib.figure.Figure) and len(fig.axes) >= 2
+    # A cells result too.
+    cells = ra.cells(0.5, 3.0, 0.5, 0.5, [kappa, 0.3], energy)
+    assert cells.rubber.components(cell=0) == [
+        {k: v for k, v in c.items()} for c in ra.components(cells, cell=0)
+    ]
+    assert cells.rubber.components(cell=0)[0]["rotation_number"] == got[0]["rotation_number"]
+
+
+def test_rayon_num_threads_is_honoured_when_threads_is_absent(tmp_path):
+    """Without threads=, cells runs on rayon's global pool, which RAYON_NUM_THREADS sizes:
+    the process gains exactly that many threads."""
+    count = "import os; print(len(os.listdir('/proc/self/task')))"
+    probe = ("import numpy as np, rubber_atlas as ra; "
+             "ra.cells(0.5, 3.0, 0.5, 0.5, np.linspace(0.05, 2, 200), 3.0, fields=['rotation_number']); ")
+    threads = {}
+    for n in (1, 3):
+        env = dict(os.environ, RAYON_NUM_THREADS=str(n))
+        after = subprocess.run([sys.executable, "-c", probe + count], cwd=tmp_path, env=env,
+                               capture_output=True, text=True)
+        assert after.returncode == 0, after.stderr
+        threads[n] = int(after.stdout)
+    assert threads[3] - threads[1] == 2, threads

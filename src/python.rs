@@ -1,0 +1,409 @@
+//! The extension module `rubber_atlas._core` of the Python package (feature `python`, built
+//! by maturin without the `hdf5` feature, so that the only HDF5 in a Python process is
+//! h5py's). Thin: it converts arguments, releases the GIL around the library's work, and
+//! hands back flat numpy arrays and table columns with their CF metadata; the package's
+//! Python code shapes them into xarray objects.
+
+use crate::atlas::{self, CellPoint, Column, Kind, COMPONENT_SLOTS};
+use crate::cell::{CellOptions, Method};
+use crate::critical::CriticalSet;
+use crate::error::AtlasError;
+use crate::resonance::{trace_curves, ResonanceOptions};
+use crate::scene::Field;
+use crate::table::{Table, Values};
+use crate::trajectory::{Duration, Model, Request, StartAt};
+use crate::verdict::{self, VerdictOptions};
+use crate::EllipsoidBody;
+use numpy::{PyArray1, PyReadonlyArray1};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+fn value_error(e: AtlasError) -> PyErr {
+    PyValueError::new_err(e.to_string())
+}
+
+fn bad(message: String) -> PyErr {
+    PyValueError::new_err(message)
+}
+
+/// The fields named by `names` (all of them for None).
+fn parse_fields(names: Option<Vec<String>>) -> PyResult<Vec<Field>> {
+    match names {
+        None => Ok(Field::ALL.to_vec()),
+        Some(names) => names
+            .iter()
+            .map(|n| {
+                Field::from_name(n).ok_or_else(|| {
+                    bad(format!(
+                        "unknown field {n:?}; known: {}",
+                        Field::ALL.map(|f| f.name()).join(", ")
+                    ))
+                })
+            })
+            .collect(),
+    }
+}
+
+/// Runs `work` with `threads` threads (the global pool, which honours RAYON_NUM_THREADS,
+/// for None), with the GIL released.
+fn in_pool<T: Send>(
+    py: Python<'_>,
+    threads: Option<usize>,
+    work: impl FnOnce() -> T + Send,
+) -> PyResult<T> {
+    match threads {
+        Some(0) => Err(bad("threads must be >= 1".into())),
+        Some(n) => {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map_err(|e| bad(e.to_string()))?;
+            Ok(py.detach(|| pool.install(work)))
+        }
+        None => Ok(py.detach(work)),
+    }
+}
+
+/// The metadata of the variables of `fields`, in file order: name, whether it has a value
+/// per component, dtype, long_name, units, comment, flag_values and flag_meanings.
+#[pyfunction]
+#[pyo3(signature = (fields=None))]
+fn variables(py: Python<'_>, fields: Option<Vec<String>>) -> PyResult<Bound<'_, PyList>> {
+    let list = PyList::empty(py);
+    for v in atlas::variables(&parse_fields(fields)?) {
+        let d = PyDict::new(py);
+        d.set_item("name", v.name)?;
+        d.set_item("per_component", !v.kind.per_cell())?;
+        d.set_item(
+            "dtype",
+            match v.kind {
+                Kind::Value | Kind::CellValue => "float64",
+                Kind::Flag | Kind::CellFlag => "uint8",
+            },
+        )?;
+        d.set_item("long_name", v.long_name)?;
+        d.set_item("units", v.units.units)?;
+        d.set_item("comment", v.units.comment)?;
+        if let Some((values, meanings)) = v.flag_attributes() {
+            d.set_item("flag_values", values)?;
+            d.set_item("flag_meanings", meanings)?;
+        }
+        list.append(d)?;
+    }
+    Ok(list)
+}
+
+/// Solves cells given by six equal-length arrays, in parallel with the GIL released. Returns
+/// the values of every variable of `fields` as (name, flat array) pairs, in file order; a
+/// per-component variable has `COMPONENT_SLOTS` values per cell, slot fastest.
+#[pyfunction]
+#[pyo3(signature = (alpha, beta, nu, eta, kappa, energy, tol, method, resonance_tol, fields=None, threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn cells<'py>(
+    py: Python<'py>,
+    alpha: PyReadonlyArray1<'py, f64>,
+    beta: PyReadonlyArray1<'py, f64>,
+    nu: PyReadonlyArray1<'py, f64>,
+    eta: PyReadonlyArray1<'py, f64>,
+    kappa: PyReadonlyArray1<'py, f64>,
+    energy: PyReadonlyArray1<'py, f64>,
+    tol: f64,
+    method: &str,
+    resonance_tol: f64,
+    fields: Option<Vec<String>>,
+    threads: Option<usize>,
+) -> PyResult<Bound<'py, PyList>> {
+    let arrays = [&alpha, &beta, &nu, &eta, &kappa, &energy];
+    let slices = arrays
+        .iter()
+        .map(|a| a.as_slice().map_err(|e| bad(e.to_string())))
+        .collect::<PyResult<Vec<&[f64]>>>()?;
+    let n = slices[0].len();
+    if slices.iter().any(|s| s.len() != n) {
+        return Err(bad(
+            "alpha, beta, nu, eta, kappa and energy must have one length".into(),
+        ));
+    }
+    let points: Vec<CellPoint> = (0..n)
+        .map(|i| CellPoint {
+            alpha: slices[0][i],
+            beta: slices[1][i],
+            nu: slices[2][i],
+            eta: slices[3][i],
+            kappa: slices[4][i],
+            energy: slices[5][i],
+        })
+        .collect();
+    let fields = parse_fields(fields)?;
+    let options = CellOptions {
+        tol,
+        method: match method {
+            "quadrature" => Method::Quadrature,
+            "ode" => Method::Ode,
+            other => {
+                return Err(bad(format!(
+                    "method {other:?}: use \"quadrature\" or \"ode\""
+                )))
+            }
+        },
+        drift: fields.iter().any(|f| f.needs_drift()),
+        resonance_tol,
+    };
+    let vars = atlas::variables(&fields);
+    let block = in_pool(py, threads, || {
+        atlas::compute_cells(&points, &vars, &options)
+    })?
+    .map_err(value_error)?;
+    let list = PyList::empty(py);
+    for (v, column) in vars.iter().zip(block.columns) {
+        let array = match column {
+            Column::F64(x) => PyArray1::from_vec(py, x).into_any(),
+            Column::U8(x) => PyArray1::from_vec(py, x).into_any(),
+        };
+        list.append((v.name, array))?;
+    }
+    Ok(list)
+}
+
+/// A table as a dict: `dimension`, `columns` (dicts of name, values, long_name, units,
+/// comment, flag_values, flag_meanings) and `attributes`.
+fn table_dict<'py>(py: Python<'py>, table: Table) -> PyResult<Bound<'py, PyDict>> {
+    let columns = PyList::empty(py);
+    for c in table.columns {
+        let d = PyDict::new(py);
+        d.set_item("name", c.name)?;
+        let values = match c.values {
+            Values::F64(x) => PyArray1::from_vec(py, x).into_any(),
+            Values::I32(x) => PyArray1::from_vec(py, x).into_any(),
+            Values::U8(x) => PyArray1::from_vec(py, x).into_any(),
+        };
+        d.set_item("values", values)?;
+        d.set_item("long_name", c.long_name)?;
+        d.set_item("units", c.units.units)?;
+        d.set_item("comment", c.units.comment)?;
+        if let Some((values, meanings)) = c.flags {
+            d.set_item("flag_values", values.to_vec())?;
+            d.set_item("flag_meanings", meanings)?;
+        }
+        columns.append(d)?;
+    }
+    let attributes = PyDict::new(py);
+    for (k, v) in table.attributes {
+        match v {
+            crate::cf::AttrValue::Text(t) => attributes.set_item(k, t)?,
+            crate::cf::AttrValue::Number(x) => attributes.set_item(k, x)?,
+            crate::cf::AttrValue::Integer(i) => attributes.set_item(k, i)?,
+        }
+    }
+    let d = PyDict::new(py);
+    d.set_item("dimension", table.dimension)?;
+    d.set_item("columns", columns)?;
+    d.set_item("attributes", attributes)?;
+    Ok(d)
+}
+
+fn body(alpha: f64, beta: f64, nu: f64, eta: f64) -> PyResult<EllipsoidBody> {
+    EllipsoidBody::ellipsoid(alpha, beta, nu, eta).map_err(value_error)
+}
+
+/// The critical set of one body (paper §4): its fixed-point curves as a table, and its
+/// summary as JSON.
+#[pyfunction]
+#[pyo3(signature = (alpha, beta, nu, eta, samples, kappa_max))]
+fn diagram(
+    py: Python<'_>,
+    alpha: f64,
+    beta: f64,
+    nu: f64,
+    eta: f64,
+    samples: usize,
+    kappa_max: f64,
+) -> PyResult<(Bound<'_, PyDict>, String)> {
+    let body = body(alpha, beta, nu, eta)?;
+    let set = py
+        .detach(|| CriticalSet::of(&body, samples, kappa_max))
+        .map_err(value_error)?;
+    let summary = serde_json::to_string(&set).map_err(|e| bad(e.to_string()))?;
+    Ok((table_dict(py, crate::table::diagram(&set))?, summary))
+}
+
+/// A trajectory (the reduced model or the full one) as a table along `t`, with its start
+/// (κ, ε, θ(0), θ̇(0)).
+#[pyfunction]
+#[pyo3(signature = (alpha, beta, nu, eta, kappa, energy, component, theta0, theta_dot0, periods, t_end, samples, model, tol))]
+#[allow(clippy::too_many_arguments)]
+fn trajectory<'py>(
+    py: Python<'py>,
+    alpha: f64,
+    beta: f64,
+    nu: f64,
+    eta: f64,
+    kappa: f64,
+    energy: Option<f64>,
+    component: usize,
+    theta0: Option<f64>,
+    theta_dot0: f64,
+    periods: Option<f64>,
+    t_end: Option<f64>,
+    samples: usize,
+    model: &str,
+    tol: f64,
+) -> PyResult<(Bound<'py, PyDict>, [f64; 4])> {
+    let body = body(alpha, beta, nu, eta)?;
+    let start = match (energy, theta0) {
+        (Some(energy), None) => StartAt::Energy { energy, component },
+        (None, Some(theta0)) => StartAt::Angle { theta0, theta_dot0 },
+        _ => return Err(bad("give exactly one of energy= and theta0=".into())),
+    };
+    let duration = match (periods, t_end) {
+        (Some(k), None) => Duration::Periods(k),
+        (None, Some(t)) => Duration::Until(t),
+        _ => return Err(bad("give exactly one of periods= and t_end=".into())),
+    };
+    let model = match model {
+        "reduced" => Model::Reduced,
+        "full" => Model::Full,
+        other => return Err(bad(format!("model {other:?}: use \"reduced\" or \"full\""))),
+    };
+    let request = Request {
+        kappa,
+        start,
+        duration,
+        samples,
+        model,
+        tol,
+    };
+    let (start, traj) = py.detach(|| request.run(&body)).map_err(value_error)?;
+    let start = [
+        start.kappa,
+        start.energy(&body),
+        start.theta0,
+        start.theta_dot0,
+    ];
+    Ok((table_dict(py, crate::table::trajectory(&traj))?, start))
+}
+
+/// The resonance curves N = `rotation_number` in a window of the (κ, ε) plane, as a table
+/// along `sample`, and the window's smallest energy.
+#[pyfunction]
+#[pyo3(signature = (alpha, beta, nu, eta, rotation_number, kappa_min, kappa_max, energy_min, energy_max, grid, tol))]
+#[allow(clippy::too_many_arguments)]
+fn resonance(
+    py: Python<'_>,
+    alpha: f64,
+    beta: f64,
+    nu: f64,
+    eta: f64,
+    rotation_number: f64,
+    kappa_min: f64,
+    kappa_max: f64,
+    energy_min: Option<f64>,
+    energy_max: f64,
+    grid: usize,
+    tol: f64,
+) -> PyResult<(Bound<'_, PyDict>, f64)> {
+    let body = body(alpha, beta, nu, eta)?;
+    let options = ResonanceOptions::window(
+        &body,
+        rotation_number,
+        (kappa_min, kappa_max),
+        energy_min,
+        energy_max,
+        grid,
+        tol,
+    );
+    let curves = py
+        .detach(|| trace_curves(&body, &options))
+        .map_err(value_error)?;
+    Ok((
+        table_dict(py, crate::table::resonance(&curves))?,
+        options.energy.0,
+    ))
+}
+
+/// The verdict of the boundedness hypothesis (SPEC §4) for each body, as JSON (the
+/// `verdict --json` object), computed in parallel with the GIL released.
+#[pyfunction]
+#[pyo3(signature = (alpha, beta, nu, eta, tol, resolution, threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn verdicts(
+    py: Python<'_>,
+    alpha: Vec<f64>,
+    beta: Vec<f64>,
+    nu: Vec<f64>,
+    eta: Vec<f64>,
+    tol: f64,
+    resolution: usize,
+    threads: Option<usize>,
+) -> PyResult<Vec<String>> {
+    use rayon::prelude::*;
+    let n = alpha.len();
+    if [beta.len(), nu.len(), eta.len()].iter().any(|&m| m != n) {
+        return Err(bad("alpha, beta, nu and eta must have one length".into()));
+    }
+    let bodies = (0..n)
+        .map(|i| body(alpha[i], beta[i], nu[i], eta[i]))
+        .collect::<PyResult<Vec<_>>>()?;
+    let options = VerdictOptions {
+        tol,
+        resolution,
+        counterexamples: true,
+        coarse_first: true,
+    };
+    let found = in_pool(py, threads, || {
+        bodies
+            .par_iter()
+            .with_max_len(1)
+            .map(|b| verdict::verdict(b, &options))
+            .collect::<Vec<_>>()
+    })?;
+    found
+        .into_iter()
+        .map(|v| {
+            let v = v.map_err(value_error)?;
+            serde_json::to_string(&v).map_err(|e| bad(e.to_string()))
+        })
+        .collect()
+}
+
+/// The long name, units and comment of a coordinate (`alpha`, …, `energy`, `component`).
+#[pyfunction]
+fn coordinate(name: &str) -> PyResult<(&'static str, &'static str, Option<&'static str>)> {
+    let (long_name, units) =
+        atlas::coordinate(name).ok_or_else(|| bad(format!("no coordinate {name:?}")))?;
+    Ok((long_name, units.units, units.comment))
+}
+
+/// The root attributes of a result made by `call` (a Python call, as text): the program, its
+/// version and commit, the CF conventions and `history`.
+#[pyfunction]
+fn provenance(call: &str) -> Vec<(String, String)> {
+    let mut out = vec![(
+        "Conventions".to_string(),
+        crate::cf::CONVENTIONS.to_string(),
+    )];
+    out.extend(
+        crate::store::provenance(call)
+            .into_iter()
+            .map(|(k, v)| (k, v.display())),
+    );
+    out
+}
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("git_commit", env!("RUBBER_ATLAS_GIT_COMMIT"))?;
+    m.add("COMPONENT_SLOTS", COMPONENT_SLOTS)?;
+    m.add("FIELDS", Field::ALL.map(|f| f.name()).to_vec())?;
+    m.add_function(wrap_pyfunction!(variables, m)?)?;
+    m.add_function(wrap_pyfunction!(coordinate, m)?)?;
+    m.add_function(wrap_pyfunction!(provenance, m)?)?;
+    m.add_function(wrap_pyfunction!(cells, m)?)?;
+    m.add_function(wrap_pyfunction!(diagram, m)?)?;
+    m.add_function(wrap_pyfunction!(trajectory, m)?)?;
+    m.add_function(wrap_pyfunction!(resonance, m)?)?;
+    m.add_function(wrap_pyfunction!(verdicts, m)?)?;
+    Ok(())
+}
