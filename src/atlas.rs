@@ -541,7 +541,10 @@ impl Shard {
         let n = self.count;
         let mut best: Option<(usize, [usize; 3])> = None;
         // Larger counts of the slower axes first: the first of equal layouts is kept.
-        for a in (1..=lengths[0].min(n)).rev().filter(|&a| n.is_multiple_of(a)) {
+        for a in (1..=lengths[0].min(n))
+            .rev()
+            .filter(|&a| n.is_multiple_of(a))
+        {
             for b in (1..=lengths[1].min(n / a))
                 .rev()
                 .filter(|&b| (n / a).is_multiple_of(b))
@@ -795,9 +798,21 @@ pub fn compute_cells(
         .zip(bodies.par_chunks(POINTS_PER_TASK))
         .map(|(points, bodies)| {
             let mut block = Block::empty(variables, points.len());
+            // Consecutive cells of one body and κ (a row of a grid) share V's critical
+            // points, as the cells of an atlas row do: found once.
+            let mut row: Option<(usize, EffectivePotential<'_, _>)> = None;
             for (j, (p, body)) in points.iter().zip(bodies).enumerate() {
+                let same_row = |i: usize| {
+                    let key =
+                        |q: &CellPoint| [q.alpha, q.beta, q.nu, q.eta, q.kappa].map(f64::to_bits);
+                    key(&points[i]) == key(p)
+                };
+                if !row.as_ref().is_some_and(|(i, _)| same_row(*i)) {
+                    row = Some((j, EffectivePotential::new(body, p.kappa)));
+                }
+                let potential = &row.as_ref().expect("set above").1;
                 fill_cell(&mut block, variables, j, (p.kappa, p.energy), || {
-                    solve_level(&EffectivePotential::new(body, p.kappa), p.energy, options)
+                    solve_level(potential, p.energy, options)
                 });
             }
             block

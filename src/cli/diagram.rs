@@ -1,0 +1,147 @@
+//! `rubber-atlas diagram`: the critical set of one body (paper §4), printed, as JSON or as a
+//! table file.
+
+use super::*;
+use anyhow::{Context, Result};
+use clap::Args;
+use rubber_atlas::cf::AttrValue;
+use rubber_atlas::critical::CriticalSet;
+use rubber_atlas::store::{check_output, write_table};
+use rubber_atlas::EllipsoidBody;
+use std::path::PathBuf;
+
+#[derive(Debug, Args)]
+pub struct DiagramArgs {
+    #[command(flatten)]
+    pub shape: ShapeArgs,
+    /// ν = i3/i1 (does not change the critical set; recorded in the output).
+    #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
+    pub nu: f64,
+    /// η = m b3²/i1 (does not change the critical set; recorded in the output).
+    #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
+    pub eta: f64,
+    /// Print the critical set as one JSON object.
+    #[arg(long, conflicts_with = "out")]
+    pub json: bool,
+    /// Write the sampled curves to FILE (.csv, .h5 or .hdf5).
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// Overwrite an existing --out file.
+    #[arg(long)]
+    pub force: bool,
+    /// Samples of θ0 per half (θ0 < π/2, θ0 > π/2) of the fixed-point curves.
+    #[arg(long, default_value_t = 2000)]
+    pub samples: usize,
+    #[command(flatten)]
+    pub limits: Limits,
+    /// Truncate the sampled curves at this κ.
+    #[arg(long, default_value_t = 3.0, allow_hyphen_values = true)]
+    pub kappa_max: f64,
+}
+
+pub(super) fn diagram(args: DiagramArgs) -> Result<()> {
+    if let Some(out) = &args.out {
+        check_output(out, args.force, &[], &TABLE_EXTENSIONS)?;
+    }
+    // Measured: 245 bytes of memory per sample at the peak, 2 points per sample of about
+    // 150 bytes each in a CSV file.
+    let per_sample = 300.0 * args.samples as f64;
+    args.limits.check(
+        per_sample,
+        args.out.as_ref().map(|_| per_sample),
+        args.out.as_deref(),
+        "use fewer --samples",
+    )?;
+    let body = EllipsoidBody::ellipsoid(args.shape.alpha, args.shape.beta, args.nu, args.eta)?;
+    let set = CriticalSet::of(&body, args.samples, args.kappa_max)?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&set)?);
+        return Ok(());
+    }
+    if let Some(out) = &args.out {
+        write_diagram(out, &set)?;
+        eprintln!(
+            "wrote {} points on {} branches to {}",
+            set.branches.iter().map(|b| b.points.len()).sum::<usize>(),
+            set.branches.len(),
+            out.display()
+        );
+    }
+    print_diagram(&set);
+    Ok(())
+}
+
+pub(super) fn print_diagram(set: &CriticalSet) {
+    println!(
+        "ellipsoid alpha = {}, beta = {} (nu = {}, eta = {}): diagram type ({})",
+        set.alpha,
+        set.beta,
+        set.nu,
+        set.eta,
+        set.diagram_type.label()
+    );
+    println!(
+        "  eps_min (roll over the top at kappa = 0) = {:.12}",
+        set.energy_min
+    );
+    if let Some(t) = set.theta_star {
+        println!("  inclined equilibrium theta* = {t:.12}");
+    }
+    for e in &set.equilibria {
+        println!(
+            "  equilibrium {:<10} theta = {:.12}  eps = {:.12}  {}{}",
+            e.name,
+            e.theta,
+            e.energy,
+            if e.stable { "stable" } else { "unstable" },
+            if e.isolated { ", isolated" } else { "" }
+        );
+    }
+    if let Some(c) = &set.cusp {
+        println!(
+            "  cusp theta_c = {:.12}  kappa_c = {:.12}  eps_c = {:.12}",
+            c.theta, c.kappa, c.energy
+        );
+    }
+    if let Some(k) = set.kappa_c_equator {
+        println!("  equator sigma_pi2 stable for |kappa| > {k:.12}");
+    }
+    for b in &set.branches {
+        let bottom = b
+            .rotation_number_range
+            .map(|[lo, hi]| format!("  N at the bottom in [{lo:.6}, {hi:.6}]"))
+            .unwrap_or_default();
+        println!(
+            "  branch {:<10} {:<8} theta0 in [{:.6}, {:.6}]  kappa in [{:.6}, {:.6}]  eps in [{:.6}, {:.6}]{bottom}",
+            b.name,
+            if b.stable { "stable" } else { "unstable" },
+            b.theta0_range[0],
+            b.theta0_range[1],
+            b.kappa_range[0],
+            b.kappa_range[1],
+            b.energy_range[0],
+            b.energy_range[1]
+        );
+    }
+}
+
+pub(super) fn write_diagram(out: &std::path::Path, set: &CriticalSet) -> Result<()> {
+    let mut table = rubber_atlas::table::diagram(set);
+    table.attributes.extend(table_attributes(&[
+        ("alpha", AttrValue::Number(set.alpha)),
+        ("beta", AttrValue::Number(set.beta)),
+        ("nu", AttrValue::Number(set.nu)),
+        ("eta", AttrValue::Number(set.eta)),
+        (
+            "critical_set_json",
+            AttrValue::Text(serde_json::to_string(set)?),
+        ),
+    ]));
+    write_table(out, &table).with_context(|| {
+        format!(
+            "writing the diagram of alpha = {}, beta = {}",
+            set.alpha, set.beta
+        )
+    })?;
+    Ok(())
+}

@@ -1,0 +1,357 @@
+//! Command-line definitions (clap) and the glue from flags to the library: the shared
+//! arguments and helpers here, one module per command beside it. The science, the files'
+//! contents and the tables live in the library.
+
+mod cell;
+mod diagram;
+mod merge;
+mod resonance;
+mod run;
+mod trajectory;
+mod verdict;
+
+use anyhow::{Context, Result};
+use clap::{ArgGroup, Args, Parser, Subcommand, ValueEnum};
+use rubber_atlas::cf::AttrValue;
+use rubber_atlas::error::AtlasError;
+use rubber_atlas::trajectory::Start;
+use rubber_atlas::EllipsoidBody;
+
+use cell::CellArgs;
+use diagram::DiagramArgs;
+use merge::MergeArgs;
+use resonance::ResonanceArgs;
+use run::RunArgs;
+use trajectory::TrajectoryArgs;
+use verdict::VerdictArgs;
+
+/// `--version`: the package version and the git commit it was built from, marked `-dirty`
+/// when the sources differed from that commit.
+pub(crate) const VERSION: &str = concat!(
+    env!("CARGO_PKG_VERSION"),
+    " (",
+    env!("RUBBER_ATLAS_GIT_COMMIT"),
+    ")"
+);
+
+/// Atlases of the dynamics of a "rubber" ellipsoid of revolution rolling on a plane.
+#[derive(Debug, Parser)]
+#[command(
+    name = "rubber-atlas",
+    version = VERSION,
+    about,
+    long_about = None,
+    arg_required_else_help = true
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// The critical set of one body (paper §4): diagram type, permanent rotations with their
+    /// stability, equilibria, cusp, ε_min.
+    Diagram(DiagramArgs),
+    /// θ, ψ, φ, centre of mass and contact point over time, from the reduced or the full model.
+    Trajectory(TrajectoryArgs),
+    /// One cell (κ, ε): per component of the allowed set ω_θ, ω_ψ, the rotation number N, the
+    /// drift |Δζ| and radius R, bounded or not, status and error estimates.
+    Cell(CellArgs),
+    /// Builds the atlas of a scene (TOML) into an HDF5 file that opens in xarray, with
+    /// progress, resume after a crash, and shards for a cluster.
+    Run(RunArgs),
+    /// Joins the shard files of one scene (made with `run --shard I/N`) into one atlas.
+    Merge(MergeArgs),
+    /// The curves of the (κ, ε) plane on which a component's rotation number is P/Q, traced
+    /// by continuation with the cell solver; with --fold, the fold κ_max of the curve of
+    /// largest κ (N = P/Q, ∂N/∂ε = 0).
+    Resonance(ResonanceArgs),
+    /// The paper's boundedness hypothesis for one body over the whole (κ, ε) plane: its case,
+    /// whether it holds, κ_max, counterexamples on integer resonances and the high-energy
+    /// limit N∞(λ); with --boundaries, the β at which the verdict changes for one α.
+    Verdict(VerdictArgs),
+    /// Prints a completion script for a shell, e.g. `rubber-atlas completions bash >
+    /// /etc/bash_completion.d/rubber-atlas`.
+    Completions {
+        /// The shell.
+        #[arg(value_enum)]
+        shell: clap_complete::Shell,
+    },
+    /// Prints the manual page (roff), e.g. `rubber-atlas man > rubber-atlas.1; man
+    /// ./rubber-atlas.1`.
+    Man,
+}
+
+/// The size check of a command that may ask for more than the machine has.
+#[derive(Debug, Args)]
+pub struct Limits {
+    /// Run even where the estimated memory or disk exceeds what this machine has free.
+    #[arg(long)]
+    pub allow_large: bool,
+}
+
+impl Limits {
+    /// Refuses work whose estimated peak `memory` (over 80 % of what is available) or `disk`
+    /// for `out` (over what is free there) exceeds the machine, in one line with both
+    /// figures, the `remedy` and --allow-large; nothing with --allow-large.
+    fn check(
+        &self,
+        memory: f64,
+        disk: Option<f64>,
+        out: Option<&std::path::Path>,
+        remedy: &str,
+    ) -> Result<()> {
+        if self.allow_large {
+            return Ok(());
+        }
+        let mut short = Vec::new();
+        if let Some(free) = available_memory().filter(|&free| memory > 0.8 * free) {
+            short.push(format!(
+                "about {} of memory ({} available)",
+                show_bytes(memory),
+                show_bytes(free)
+            ));
+        }
+        if let (Some(disk), Some(out)) = (disk, out) {
+            if let Some(free) = free_disk(out).filter(|&free| disk > free) {
+                short.push(format!(
+                    "up to {} of disk ({} free there)",
+                    show_bytes(disk),
+                    show_bytes(free)
+                ));
+            }
+        }
+        if short.is_empty() {
+            return Ok(());
+        }
+        Err(AtlasError::Atlas {
+            path: out.map_or("the request".into(), |o| o.display().to_string()),
+            reason: format!(
+                "needs {}; {remedy}; --allow-large runs it anyway",
+                short.join(" and ")
+            ),
+        }
+        .into())
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum MethodArg {
+    /// Tanh-sinh quadrature between the turning points (fast).
+    Quadrature,
+    /// DOP853 over one θ-period with event location (the independent check).
+    Ode,
+}
+
+/// Where on the level set: an energy, or an initial state θ(0), θ̇(0).
+#[derive(Debug, Args)]
+#[command(group(ArgGroup::new("start").required(true).args(["energy", "theta0"])))]
+pub struct StartArgs {
+    /// Energy ε (`cell`: every component; `trajectory`: start at the lower turning point of
+    /// component --component with θ̇ = 0).
+    #[arg(long, allow_hyphen_values = true)]
+    pub energy: Option<f64>,
+    /// Initial inclination θ(0) (`cell`: only the component that holds it).
+    #[arg(long, allow_hyphen_values = true)]
+    pub theta0: Option<f64>,
+    /// Initial θ̇(0) (with --theta0) [default: 0].
+    #[arg(long, requires = "theta0", allow_hyphen_values = true)]
+    pub theta_dot0: Option<f64>,
+}
+
+impl StartArgs {
+    /// The checked start at θ(0) = `theta0` with this θ̇(0), at F2 = `kappa`.
+    fn at_theta0(&self, kappa: f64, theta0: f64) -> rubber_atlas::Result<Start> {
+        let start = Start {
+            kappa,
+            theta0,
+            theta_dot0: self.theta_dot0.unwrap_or(0.0),
+        };
+        start.check()?;
+        Ok(start)
+    }
+}
+
+/// α and β of the ellipsoid.
+#[derive(Debug, Args)]
+pub struct ShapeArgs {
+    /// α = a/b3: displacement of the centre of mass along the axis, 0 <= α < 1.
+    #[arg(long, allow_hyphen_values = true)]
+    pub alpha: f64,
+    /// β = b1/b3: < 1 prolate, > 1 oblate, 1 sphere.
+    #[arg(long, allow_hyphen_values = true)]
+    pub beta: f64,
+}
+
+/// The body (α, β, ν, η) and κ: what a level set of the reduced system needs besides ε.
+#[derive(Debug, Args)]
+pub struct LevelArgs {
+    #[command(flatten)]
+    pub shape: ShapeArgs,
+    /// ν = i3/i1, 0 < ν <= 2.
+    #[arg(long, allow_hyphen_values = true)]
+    pub nu: f64,
+    /// η = m b3²/i1 > 0.
+    #[arg(long, allow_hyphen_values = true)]
+    pub eta: f64,
+    /// κ, the value of the integral F2 = J ω3.
+    #[arg(long, allow_hyphen_values = true)]
+    pub kappa: f64,
+}
+
+impl LevelArgs {
+    /// The validated body.
+    fn body(&self) -> Result<EllipsoidBody> {
+        Ok(EllipsoidBody::ellipsoid(
+            self.shape.alpha,
+            self.shape.beta,
+            self.nu,
+            self.eta,
+        )?)
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ModelArg {
+    /// The reduced system `eqsys` with its quadratures.
+    Reduced,
+    /// The full redundant system `eqred` with the kinematics.
+    Full,
+}
+
+/// Runs one parsed command line.
+pub fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Diagram(args) => diagram::diagram(args),
+        Command::Trajectory(args) => trajectory::trajectory(args),
+        Command::Cell(args) => cell::cell(args),
+        Command::Run(args) => run::run_scene(args),
+        Command::Merge(args) => merge::merge(args),
+        Command::Resonance(args) => resonance::resonance(args),
+        Command::Verdict(args) => verdict::verdict(args),
+        Command::Completions { shell } => {
+            let mut command = <Cli as clap::CommandFactory>::command();
+            clap_complete::generate(shell, &mut command, "rubber-atlas", &mut std::io::stdout());
+            Ok(())
+        }
+        Command::Man => {
+            let command = <Cli as clap::CommandFactory>::command();
+            clap_mangen::Man::new(command)
+                .render(&mut std::io::stdout())
+                .context("cannot write the manual page")?;
+            Ok(())
+        }
+    }
+}
+
+/// The attributes a command adds to the atlases it writes: its command line, the time, and
+/// the CF `history`.
+pub(crate) fn invocation_attributes() -> Vec<(String, AttrValue)> {
+    let command = command_line();
+    vec![
+        ("command_line".into(), AttrValue::Text(command.clone())),
+        (
+            "created".into(),
+            AttrValue::Text(rubber_atlas::cf::utc_now()),
+        ),
+        (
+            "history".into(),
+            AttrValue::Text(rubber_atlas::cf::history(&command)),
+        ),
+    ]
+}
+
+/// The root attributes of a table: provenance (program, commit, history, command line)
+/// and `own`, the command's parameters (numbers as numbers).
+pub(crate) fn table_attributes(own: &[(&str, AttrValue)]) -> Vec<(String, AttrValue)> {
+    let command = command_line();
+    let mut attributes = rubber_atlas::store::provenance(&command);
+    attributes.push(("command_line".into(), AttrValue::Text(command)));
+    attributes.extend(own.iter().map(|(k, v)| (k.to_string(), v.clone())));
+    attributes
+}
+
+/// Refuses options that the chosen start would silently ignore (clap's `requires` cannot see
+/// this through the flattened start group).
+pub(crate) fn check_start(start: &StartArgs, component: Option<usize>) -> Result<()> {
+    let refuse = |reason: &str| -> Result<()> {
+        Err(AtlasError::Atlas {
+            path: "options".into(),
+            reason: reason.into(),
+        }
+        .into())
+    };
+    if start.theta_dot0.is_some() && start.theta0.is_none() {
+        return refuse("--theta-dot0 goes with --theta0 (with --energy the start is at rest at a turning point)");
+    }
+    if component.is_some() && start.energy.is_none() {
+        return refuse(
+            "--component goes with --energy (with --theta0 the start chooses the component)",
+        );
+    }
+    Ok(())
+}
+
+/// `text` as one word for a POSIX shell: as it is when it needs no quoting, else in single
+/// quotes (a quote inside as '\'').
+pub(crate) fn shell_quote(text: &str) -> String {
+    let plain = |c: char| c.is_ascii_alphanumeric() || "_-./=:,+@%".contains(c);
+    if !text.is_empty() && text.chars().all(plain) {
+        text.to_string()
+    } else {
+        format!("'{}'", text.replace('\'', "'\\''"))
+    }
+}
+
+/// The name a value has in the JSON output (`ok`, `libration`, `quadrature`), so that the
+/// text output uses the same words.
+pub(crate) fn json_name<T: serde::Serialize>(value: &T) -> String {
+    match serde_json::to_value(value) {
+        Ok(serde_json::Value::String(name)) => name,
+        Ok(other) => other.to_string(),
+        Err(_) => String::from("?"),
+    }
+}
+
+pub(crate) fn command_line() -> String {
+    std::env::args().collect::<Vec<_>>().join(" ")
+}
+
+/// Tables (`diagram`, `trajectory`, `resonance`).
+pub(crate) const TABLE_EXTENSIONS: [&str; 3] = ["csv", "h5", "hdf5"];
+/// Atlases (`run`, `merge`).
+pub(crate) const ATLAS_EXTENSIONS: [&str; 2] = ["h5", "hdf5"];
+
+/// Bytes as a person reads them, one format throughout: 1.5 GB, 310.0 MB.
+pub(crate) fn show_bytes(bytes: f64) -> String {
+    let units = [("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("kB", 1e3)];
+    match units.iter().find(|(_, size)| bytes >= *size) {
+        Some((name, size)) => format!("{:.1} {name}", bytes / size),
+        None => format!("{bytes:.0} B"),
+    }
+}
+
+/// Memory the kernel could give this process now (MemAvailable), if it says.
+pub(crate) fn available_memory() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024.0)
+}
+
+/// Free space for an unprivileged user in the folder that will hold `out`.
+pub(crate) fn free_disk(out: &std::path::Path) -> Option<f64> {
+    use std::os::unix::ffi::OsStrExt;
+    let dir = match out.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => std::path::Path::new("."),
+    };
+    let c_path = std::ffi::CString::new(dir.as_os_str().as_bytes()).ok()?;
+    // SAFETY: statvfs fills the zeroed struct from a valid NUL-terminated path.
+    let mut stat: libc::statvfs = unsafe { std::mem::zeroed() };
+    if unsafe { libc::statvfs(c_path.as_ptr(), &mut stat) } != 0 {
+        return None;
+    }
+    Some(stat.f_bavail as f64 * stat.f_frsize as f64)
+}

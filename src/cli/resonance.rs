@@ -1,0 +1,188 @@
+//! `rubber-atlas resonance`: resonance curves N = P/Q by continuation, or the fold κ_max.
+
+use super::*;
+use anyhow::Result;
+use clap::Args;
+use rubber_atlas::cf::AttrValue;
+use rubber_atlas::error::AtlasError;
+use rubber_atlas::resonance::{self, ResonanceOptions};
+use rubber_atlas::store::{check_output, write_table};
+use rubber_atlas::EllipsoidBody;
+use std::path::PathBuf;
+
+#[derive(Debug, Args)]
+pub struct ResonanceArgs {
+    #[command(flatten)]
+    pub shape: ShapeArgs,
+    /// ν = i3/i1, 0 < ν <= 2.
+    #[arg(long, allow_hyphen_values = true)]
+    pub nu: f64,
+    /// η = m b3²/i1 > 0.
+    #[arg(long, allow_hyphen_values = true)]
+    pub eta: f64,
+    /// The rotation number of the curves: P/Q (e.g. 0, 1, -1/7) or a decimal.
+    #[arg(long, value_name = "P/Q", allow_hyphen_values = true)]
+    pub rotation_number: String,
+    /// The window: smallest κ (> 0; N = 0 at κ = 0).
+    #[arg(long, default_value_t = 0.01, allow_hyphen_values = true)]
+    pub kappa_min: f64,
+    /// The window: largest κ.
+    #[arg(long, default_value_t = 2.0, allow_hyphen_values = true)]
+    pub kappa_max: f64,
+    /// The window: smallest ε [default: the lowest minimum of V over the window].
+    #[arg(long, allow_hyphen_values = true)]
+    pub energy_min: Option<f64>,
+    /// The window: largest ε.
+    #[arg(long, default_value_t = 5.0, allow_hyphen_values = true)]
+    pub energy_max: f64,
+    /// Rows of κ (and energies per row) of the seed scan; curves are also followed between
+    /// rows, but a closed curve that crosses no row is missed.
+    #[arg(long, default_value_t = 48)]
+    pub grid: usize,
+    /// Tolerance of the cell solver (N on the curve equals P/Q to this).
+    #[arg(long, default_value_t = 1e-10, allow_hyphen_values = true)]
+    pub tol: f64,
+    /// Print the fold of the curve of largest κ as JSON {"kappa_max": …, "energy": …}.
+    #[arg(long)]
+    pub fold: bool,
+    /// Print the curves as JSON.
+    #[arg(long, conflicts_with = "out")]
+    pub json: bool,
+    /// Write the curves to FILE (.csv, .h5 or .hdf5), one row per point.
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// Overwrite an existing --out file.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// P/Q or a decimal.
+pub(super) fn parse_rotation_number(text: &str) -> Result<f64> {
+    let bad = || AtlasError::Atlas {
+        path: format!("--rotation-number {text}"),
+        reason: "expected P/Q with whole numbers P and Q != 0, or a number".into(),
+    };
+    let value = match text.split_once('/') {
+        Some((p, q)) => {
+            let p: i64 = p.trim().parse().map_err(|_| bad())?;
+            let q: i64 = q.trim().parse().map_err(|_| bad())?;
+            if q == 0 {
+                return Err(bad().into());
+            }
+            p as f64 / q as f64
+        }
+        None => text.trim().parse::<f64>().map_err(|_| bad())?,
+    };
+    if !value.is_finite() {
+        return Err(bad().into());
+    }
+    Ok(value)
+}
+
+pub(super) fn resonance(args: ResonanceArgs) -> Result<()> {
+    if let Some(out) = &args.out {
+        check_output(out, args.force, &[], &TABLE_EXTENSIONS)?;
+    }
+    if args.fold && args.out.is_some() {
+        return Err(AtlasError::Atlas {
+            path: "resonance".into(),
+            reason: "--fold prints the fold as JSON; it does not go with --out".into(),
+        }
+        .into());
+    }
+    let body = EllipsoidBody::ellipsoid(args.shape.alpha, args.shape.beta, args.nu, args.eta)?;
+    let target = parse_rotation_number(&args.rotation_number)?;
+    let options = ResonanceOptions::window(
+        &body,
+        target,
+        (args.kappa_min, args.kappa_max),
+        args.energy_min,
+        args.energy_max,
+        args.grid,
+        args.tol,
+    );
+    let header = serde_json::json!({
+        "alpha": args.shape.alpha,
+        "beta": args.shape.beta,
+        "nu": args.nu,
+        "eta": args.eta,
+        "rotation_number": target,
+        "kappa_window": [options.kappa.0, options.kappa.1],
+        "energy_window": [options.energy.0, options.energy.1],
+        "tolerance": args.tol,
+    });
+    if args.fold {
+        let fold = resonance::fold(&body, &options)?;
+        let mut value = header;
+        match fold {
+            Some(f) => {
+                value["kappa_max"] = serde_json::json!(f.kappa_max);
+                value["energy"] = serde_json::json!(f.energy);
+                value["fold"] = serde_json::to_value(f)?;
+            }
+            None => {
+                value["kappa_max"] = serde_json::Value::Null;
+                value["energy"] = serde_json::Value::Null;
+                value["reason"] = serde_json::json!(
+                    "no N = P/Q curve in the window, or the curve of largest kappa leaves it \
+                     through kappa_max (widen --kappa-max)"
+                );
+            }
+        }
+        println!("{}", serde_json::to_string_pretty(&value)?);
+        return Ok(());
+    }
+    let curves = resonance::trace_curves(&body, &options)?;
+    if args.json {
+        let mut value = header;
+        value["curves"] = serde_json::to_value(&curves)?;
+        println!("{}", serde_json::to_string_pretty(&value)?);
+        return Ok(());
+    }
+    if let Some(out) = &args.out {
+        let mut table = rubber_atlas::table::resonance(&curves);
+        table.attributes.extend(table_attributes(&[
+            ("alpha", AttrValue::Number(args.shape.alpha)),
+            ("beta", AttrValue::Number(args.shape.beta)),
+            ("nu", AttrValue::Number(args.nu)),
+            ("eta", AttrValue::Number(args.eta)),
+            ("rotation_number", AttrValue::Number(target)),
+            ("tolerance", AttrValue::Number(args.tol)),
+            ("header_json", AttrValue::Text(header.to_string())),
+        ]));
+        write_table(out, &table)?;
+        println!(
+            "wrote {} curves ({} points) to {}",
+            curves.len(),
+            curves.iter().map(|c| c.points.len()).sum::<usize>(),
+            out.display()
+        );
+        return Ok(());
+    }
+    println!(
+        "N = {target} for alpha={} beta={} nu={} eta={}: {} curve(s) in kappa [{}, {}], energy [{:.6}, {}]",
+        args.shape.alpha, args.shape.beta, args.nu, args.eta, curves.len(),
+        options.kappa.0, options.kappa.1, options.energy.0, options.energy.1
+    );
+    for (i, c) in curves.iter().enumerate() {
+        let (kmin, kmax) = c
+            .points
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+                (a.min(p.kappa), b.max(p.kappa))
+            });
+        let (emin, emax) = c
+            .points
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+                (a.min(p.energy), b.max(p.energy))
+            });
+        println!(
+            "[{i}] {} points{}, well theta = {:.6}, kappa in [{kmin:.6}, {kmax:.6}], energy in [{emin:.6}, {emax:.6}]",
+            c.points.len(),
+            if c.closed { " (closed)" } else { "" },
+            c.points[0].well
+        );
+    }
+    Ok(())
+}

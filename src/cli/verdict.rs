@@ -1,0 +1,199 @@
+//! `rubber-atlas verdict`: the boundedness hypothesis for one body, or the β where its verdict
+//! changes along β.
+
+use anyhow::Result;
+use clap::Args;
+use rubber_atlas::error::AtlasError;
+use rubber_atlas::verdict::{self, VerdictOptions};
+use rubber_atlas::EllipsoidBody;
+
+#[derive(Debug, Args)]
+pub struct VerdictArgs {
+    /// α = a/b3: displacement of the centre of mass along the axis, 0 <= α < 1.
+    #[arg(long, allow_hyphen_values = true)]
+    pub alpha: f64,
+    /// β = b1/b3 (not with --boundaries).
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        required_unless_present = "boundaries",
+        conflicts_with = "boundaries"
+    )]
+    pub beta: Option<f64>,
+    /// ν = i3/i1, 0 < ν <= 2.
+    #[arg(long, allow_hyphen_values = true)]
+    pub nu: f64,
+    /// η = m b3²/i1 > 0.
+    #[arg(long, allow_hyphen_values = true)]
+    pub eta: f64,
+    /// The β at which the verdict changes along β at this α, each by root-finding.
+    #[arg(long)]
+    pub boundaries: bool,
+    /// Smallest β searched by --boundaries [default: 0.05].
+    #[arg(long, allow_hyphen_values = true)]
+    pub beta_min: Option<f64>,
+    /// Largest β searched by --boundaries [default: 50].
+    #[arg(long, allow_hyphen_values = true)]
+    pub beta_max: Option<f64>,
+    /// Log-spaced β of the scan behind --boundaries (the line β² = 1 + α is added)
+    /// [default: 48].
+    #[arg(long)]
+    pub scan: Option<usize>,
+    /// Tolerance of the cell solver (N at a counterexample equals the integer to this).
+    #[arg(long, default_value_t = 1e-10, allow_hyphen_values = true)]
+    pub tol: f64,
+    /// κ-lines of each kind and energies per line of the sampling (doubling it halves the
+    /// spacing).
+    #[arg(long, default_value_t = 64)]
+    pub resolution: usize,
+    /// Print one JSON object (SPEC §4 contract).
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub(super) fn verdict(args: VerdictArgs) -> Result<()> {
+    let options = VerdictOptions {
+        tol: args.tol,
+        resolution: args.resolution,
+        counterexamples: true,
+        coarse_first: false,
+    };
+    if !args.boundaries
+        && (args.beta_min.is_some() || args.beta_max.is_some() || args.scan.is_some())
+    {
+        return Err(AtlasError::Atlas {
+            path: "verdict".into(),
+            reason: "--beta-min, --beta-max and --scan go with --boundaries".into(),
+        }
+        .into());
+    }
+    if args.boundaries {
+        let defaults = verdict::BoundaryOptions::default();
+        let found = verdict::boundaries(
+            args.alpha,
+            args.nu,
+            args.eta,
+            &verdict::BoundaryOptions {
+                beta_min: args.beta_min.unwrap_or(defaults.beta_min),
+                beta_max: args.beta_max.unwrap_or(defaults.beta_max),
+                scan: args.scan.unwrap_or(defaults.scan),
+                verdict: options,
+            },
+        )?;
+        if args.json {
+            println!("{}", serde_json::to_string_pretty(&found)?);
+        } else {
+            println!(
+                "alpha = {} (nu = {}, eta = {}): the verdict along beta in [{}, {}]",
+                found.alpha, found.nu, found.eta, found.beta_range[0], found.beta_range[1]
+            );
+            let side = |c: verdict::Case, h: Option<bool>| match h {
+                None => "not covered".to_string(),
+                Some(h) => format!(
+                    "case {} {}",
+                    serde_json::to_value(c)
+                        .unwrap_or_default()
+                        .as_str()
+                        .unwrap_or("?"),
+                    if h { "holds" } else { "fails" }
+                ),
+            };
+            for b in &found.boundaries {
+                println!(
+                    "  beta = {:.10} +- {:.1e}: {} below, {} above ({})",
+                    b.beta,
+                    b.error,
+                    side(b.case_below, b.holds_below),
+                    side(b.case_above, b.holds_above),
+                    b.quantity
+                );
+            }
+        }
+        return Ok(());
+    }
+    let beta = args.beta.unwrap_or(1.0);
+    let body = EllipsoidBody::ellipsoid(args.alpha, beta, args.nu, args.eta)?;
+    let options = VerdictOptions {
+        coarse_first: true,
+        ..options
+    };
+    let v = verdict::verdict(&body, &options)?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&v)?);
+        return Ok(());
+    }
+    print_verdict(&v);
+    Ok(())
+}
+
+pub(super) fn print_verdict(v: &verdict::Verdict) {
+    use verdict::Case;
+    println!(
+        "ellipsoid alpha = {}, beta = {} (nu = {}, eta = {}): diagram type ({})",
+        v.alpha,
+        v.beta,
+        v.nu,
+        v.eta,
+        v.diagram_type.label()
+    );
+    let case = match v.case {
+        Case::One => "case 1 (beta^2 < 1 + alpha): bounded for every kappa != 0",
+        Case::Two => "case 2 (beta^2 > 1 + alpha, alpha > 0): bounded for kappa > kappa_max",
+        Case::NotCovered => {
+            "not covered by the hypothesis (alpha = 0 with beta >= 1, or beta^2 = 1 + alpha)"
+        }
+    };
+    println!("  hypothesis: {case}");
+    if let (Some(k), Some(e)) = (v.kappa_max, v.kappa_max_error) {
+        println!("  kappa_max = {k:.10} (+- {e:.1e}), the fold of the N = 0 curve beside sigma_u");
+    }
+    let h = &v.high_energy;
+    println!(
+        "  high energy: N_inf(lambda) ~ {:.6e} lambda at lambda -> 0; min {:.10} at lambda = {:.6}; max {:.10} at lambda = {:.6}",
+        h.slope,
+        h.n_min,
+        h.lambda_at_min,
+        h.n_max,
+        h.lambda_at_max
+    );
+    match v.holds {
+        None => match &v.evidence.undecided {
+            Some(why) => println!("  verdict: UNDECIDED ({why})"),
+            None => println!("  verdict: not covered"),
+        },
+        Some(true) => println!("  verdict: HOLDS (fail margin {:.3e})", v.fail_margin),
+        Some(false) => println!("  verdict: FAILS (fail margin {:.3e})", v.fail_margin),
+    }
+    if let Some(reason) = &v.evidence.limit_failure {
+        println!("  by the limit: {reason}");
+    }
+    for c in &v.counterexamples {
+        println!(
+            "  counterexample: N = {} at kappa = {:.12}, energy = {:.12} (N = {:.3e} +- {:.1e}, theta in [{:.6}, {:.6}], drift {:.6} per period)",
+            c.integer,
+            c.kappa,
+            c.energy,
+            c.rotation_number,
+            c.error_estimate,
+            c.theta_min,
+            c.theta_max,
+            c.drift
+        );
+    }
+    if v.holds.is_some() {
+        let e = &v.evidence;
+        println!(
+            "  evidence: {} kappa-lines from {:.3e} to {:.0e}, {} energies per line, {} tori solved, N in [{:.6}, {:.6}]",
+            e.kappa_lines,
+            e.kappa_range[0],
+            e.kappa_range[1],
+            e.energies_per_line,
+            e.components_solved,
+            e.rotation_number_range[0],
+            e.rotation_number_range[1]
+        );
+        for l in &e.limits {
+            println!("    {l}");
+        }
+    }
+}
