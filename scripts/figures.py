@@ -1,5 +1,6 @@
-"""The paper's figures, drawn from this program's own output (every number comes from a
-`rubber-atlas` command or an atlas it wrote):
+"""The paper's figures, drawn from this program's own output (every number comes from the
+package `rubber_atlas`, the same Rust code as the commands, or an atlas `rubber-atlas run`
+wrote):
 
 - ab:    regions of the diagram types (a)–(e) on the (α, β²) plane (`diagram` over a grid);
 - wvth:  where permanent rotations exist, ω0² ≥ 0, on the (β², θ) plane for fixed α (the θ0
@@ -31,7 +32,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from rubber_atlas import open_atlas, read_table  # noqa: E402
+import rubber_atlas as ra  # noqa: E402
+from rubber_atlas import open_atlas  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 BIN = os.environ.get("RUBBER_ATLAS_BIN", str(ROOT / "target" / "release" / "rubber-atlas"))
@@ -40,29 +42,23 @@ NU = ETA = 0.5
 BODIES = {"a": (0.5, 0.5), "b": (0.5, 1.1), "c": (0.5, 3.0), "d": (0.0, 0.5), "e": (0.0, 1.5)}
 
 
-def columns(path) -> dict[str, np.ndarray]:
-    """The columns of a table file as numpy arrays."""
-    return {name: v.values for name, v in read_table(path).variables.items()}
+def columns(table) -> dict[str, np.ndarray]:
+    """The columns of a table (a Dataset of the package) as numpy arrays."""
+    return {name: v.values for name, v in table.variables.items()}
 
 
 def run(*args: str) -> str:
     return subprocess.run([BIN, *map(str, args)], check=True, capture_output=True, text=True).stdout
 
 
-def body_args(alpha: float, beta: float) -> list[str]:
-    return ["--alpha", repr(alpha), "--beta", repr(beta), "--nu", repr(NU), "--eta", repr(ETA)]
-
-
 def diagram_json(alpha: float, beta: float) -> dict:
-    return json.loads(run("diagram", *body_args(alpha, beta), "--json"))
+    """The critical set's summary (`rubber-atlas diagram --json`)."""
+    return json.loads(ra.diagram(alpha, beta, NU, ETA).attrs["critical_set_json"])
 
 
 def diagram_curves(alpha: float, beta: float, kappa_max: float = 3.0):
     """The sampled fixed-point branches: list of (kappa, energy, stable) arrays per segment."""
-    with tempfile.TemporaryDirectory() as d:
-        path = Path(d) / "diagram.csv"
-        run("diagram", *body_args(alpha, beta), "--kappa-max", kappa_max, "--out", path)
-        cols = columns(path)
+    cols = columns(ra.diagram(alpha, beta, NU, ETA, kappa_max=kappa_max))
     out = []
     for seg in np.unique(cols["segment"]):
         m = cols["segment"] == seg
@@ -165,26 +161,20 @@ def phase_portrait(ax, alpha: float, beta: float, kappa: float, levels: int = 9)
     """(θ, θ̇) over one θ-period on every component of `levels` energies."""
     info = diagram_json(alpha, beta)
     eps_lo = min(e["energy"] for e in info["equilibria"]) if kappa == 0 else None
-    with tempfile.TemporaryDirectory() as d:
-        if eps_lo is None:
-            # The lowest energy with motion at this κ: the bottom of V, from a cell scan.
-            energies = np.linspace(0.3, 6.0, 200)
-            lowest = next(e for e in energies if json.loads(run("cell", *body_args(alpha, beta), "--kappa", kappa,
-                                                                 "--energy", repr(float(e)), "--json", "--tol",
-                                                                 "1e-6"))["components"])
-            eps_lo = lowest
-        for e in np.linspace(eps_lo + 0.02, eps_lo + 2.5, levels):
-            cell = json.loads(run("cell", *body_args(alpha, beta), "--kappa", kappa, "--energy", repr(float(e)),
-                                  "--json", "--tol", "1e-6"))
-            for i, c in enumerate(cell["components"]):
-                if c["motion"] == "fixed_point":
-                    continue
-                path = Path(d) / f"p{e:.4f}-{i}.csv"
-                run("trajectory", *body_args(alpha, beta), "--kappa", kappa, "--energy", repr(float(e)),
-                    "--component", i, "--periods", 1, "--samples", 300, "--out", path)
-                cols = columns(path)
-                theta = np.mod(cols["theta"], 2 * np.pi) if kappa == 0 else cols["theta"]
-                ax.plot(theta, cols["theta_dot"], ".", ms=0.8, color=plt.cm.viridis((e - eps_lo) / 2.6))
+    if eps_lo is None:
+        # The lowest energy with motion at this κ: the bottom of V, from a cell scan.
+        energies = np.linspace(0.3, 6.0, 200)
+        scan = ra.cells(alpha, beta, NU, ETA, kappa, energies, tol=1e-6, fields=["status"])
+        eps_lo = float(energies[np.argmax(scan.n_components.values > 0)])
+    for e in np.linspace(eps_lo + 0.02, eps_lo + 2.5, levels):
+        cell = ra.cells(alpha, beta, NU, ETA, kappa, e, tol=1e-6, fields=["motion"])
+        for i, c in enumerate(ra.components(cell)):
+            if c["motion"] == "fixed_point":
+                continue
+            cols = columns(ra.trajectory(alpha, beta, NU, ETA, kappa, float(e), component=i, periods=1,
+                                         samples=300))
+            theta = np.mod(cols["theta"], 2 * np.pi) if kappa == 0 else cols["theta"]
+            ax.plot(theta, cols["theta_dot"], ".", ms=0.8, color=plt.cm.viridis((e - eps_lo) / 2.6))
     ax.set_xlabel("θ")
     ax.set_ylabel("θ̇")
     ax.set_title(f"α = {alpha}, β = {beta}, κ = {kappa}")
@@ -207,14 +197,13 @@ def fig_res(out: Path, targets=("0", "1", "-1/2", "-1/7", "-2/3"), grid: int = 3
     draw_branches(right, alpha, beta, kappa_max=1.6)
     n0 = None
     for i, t in enumerate(targets):
-        data = json.loads(run("resonance", *body_args(alpha, beta), "--rotation-number", t, "--kappa-max", 1.6,
-                              "--energy-max", 4.5, "--grid", grid, "--json"))
-        for j, c in enumerate(data["curves"]):
-            k = [p["kappa"] for p in c["points"]]
-            e = [p["energy"] for p in c["points"]]
-            right.plot(k, e, color=f"C{i}", lw=1.2, label=f"N = {t}" if j == 0 else None)
+        curves = ra.resonance(alpha, beta, NU, ETA, t, kappa_max=1.6, energy_max=4.5, grid=grid)
+        for j in np.unique(curves.curve.values):
+            c = curves.where(curves.curve == j, drop=True)
+            right.plot(c.kappa, c.energy, color=f"C{i}", lw=1.2, label=f"N = {t}" if j == 0 else None)
             if t == "0" and n0 is None:
-                n0 = min(c["points"], key=lambda p: abs(p["kappa"] - 0.5))
+                p = int(np.argmin(np.abs(c.kappa.values - 0.5)))
+                n0 = {"kappa": float(c.kappa[p]), "energy": float(c.energy[p]), "component": int(c.component[p])}
     right.set_xlabel("κ")
     right.set_ylabel("ε")
     right.set_xlim(0, 1.6)
@@ -222,11 +211,8 @@ def fig_res(out: Path, targets=("0", "1", "-1/2", "-1/7", "-2/3"), grid: int = 3
     right.legend(fontsize=8)
     right.set_title("resonance curves over diagram (c)")
     if n0 is not None:
-        with tempfile.TemporaryDirectory() as d:
-            path = Path(d) / "n0.csv"
-            run("trajectory", *body_args(alpha, beta), "--kappa", repr(n0["kappa"]), "--energy", repr(n0["energy"]),
-                "--component", n0["component"], "--periods", 12, "--samples", 3000, "--out", path)
-            cols = columns(path)
+        cols = columns(ra.trajectory(alpha, beta, NU, ETA, n0["kappa"], n0["energy"], component=n0["component"],
+                                     periods=12, samples=3000))
         left.plot(cols["x_c"], cols["y_c"], "-", color="darkred", lw=1, label="centre of mass")
         left.plot(cols["x_p"], cols["y_p"], ":", color="darkblue", lw=1, label="contact point")
         left.set_aspect("equal")
@@ -240,17 +226,14 @@ def fig_xy(out: Path) -> Path:
     alpha, beta = BODIES["c"]
     fig, axes = plt.subplots(1, 2, figsize=(12, 5.5))
     cases = [(0.8, 0.4670288, 7, "(a) N = −1/7, κ = 0.8"), (1.0, 2.1, 40, "(b) quasi-periodic, κ = 1")]
-    with tempfile.TemporaryDirectory() as d:
-        for ax, (kappa, theta0, periods, title) in zip(axes, cases):
-            path = Path(d) / f"xy-{kappa}.csv"
-            run("trajectory", *body_args(alpha, beta), "--kappa", kappa, "--theta0", theta0, "--periods", periods,
-                "--samples", 200 * periods, "--out", path)
-            cols = columns(path)
-            ax.plot(cols["x_c"], cols["y_c"], "-", color="darkred", lw=0.8, label="centre of mass")
-            ax.plot(cols["x_p"], cols["y_p"], ":", color="darkblue", lw=0.8, label="contact point")
-            ax.set_aspect("equal")
-            ax.set_title(title)
-            ax.legend(fontsize=8)
+    for ax, (kappa, theta0, periods, title) in zip(axes, cases):
+        cols = columns(ra.trajectory(alpha, beta, NU, ETA, kappa, theta0=theta0, periods=periods,
+                                     samples=200 * periods))
+        ax.plot(cols["x_c"], cols["y_c"], "-", color="darkred", lw=0.8, label="centre of mass")
+        ax.plot(cols["x_p"], cols["y_p"], ":", color="darkblue", lw=0.8, label="contact point")
+        ax.set_aspect("equal")
+        ax.set_title(title)
+        ax.legend(fontsize=8)
     return save(fig, out / "xy.png")
 
 

@@ -1,4 +1,5 @@
-"""The paper's boundedness hypothesis (SPEC §4) over the (α, β) plane, from `rubber-atlas verdict`.
+"""The paper's boundedness hypothesis (SPEC §4) over the (α, β) plane, from the verdict of
+the package `rubber_atlas` (the code of `rubber-atlas verdict`).
 
 The hypothesis: paths are bounded (1) for β² < 1 + α at every κ ≠ 0; (2) for β² > 1 + α, α > 0,
 when κ > κ_max (the fold of the N = 0 curve beside σ_u). `rubber-atlas verdict` decides it for
@@ -7,10 +8,10 @@ included; `verdict --boundaries` gives, for one α, the β at which the verdict 
 root-finding on the fail margin (the quantity that decides it).
 
 This script, for given (ν, η):
-- runs `verdict --boundaries` at every α of a grid, whose scan gives the verdict of every
+- runs `ra.boundaries` (`verdict --boundaries`) at every α of a grid, whose scan gives the verdict of every
   body of an α × β grid (log-spaced β) and the boundary curves β(α);
 - repeats the boundaries (on a coarser grid) for other (ν, η), to show how the curves move;
-- confirms each failure region with one full-model trajectory (`trajectory --model full`)
+- confirms each failure region with one full-model trajectory (`ra.trajectory(model="full")`)
   started on a counterexample: its centre of mass must run away linearly, n·|Δζ| after n
   periods;
 - writes <out>.csv (the map), <out>-boundaries.csv, <out>-evidence.csv, <out>.h5 (all three)
@@ -22,10 +23,7 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
-import subprocess
 import sys
-import tempfile
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -33,28 +31,22 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+import rubber_atlas as ra
+
 ROOT = Path(__file__).resolve().parents[1]
-BIN = os.environ.get("RUBBER_ATLAS_BIN", str(ROOT / "target" / "release" / "rubber-atlas"))
 CATEGORIES = {"holds": 0, "fails": 1, "not covered": 2, "undecided": 3}
 
 
-def run(*args: str) -> str:
-    """The program's standard output; its one-line error message if it fails."""
-    p = subprocess.run([BIN, *args], capture_output=True, text=True)
-    if p.returncode != 0:
-        raise RuntimeError(f"rubber-atlas {' '.join(args)}: {p.stderr.strip()}")
-    return p.stdout
-
-
 def boundaries(alpha: float, nu: float, eta: float, scan: int, beta_min: float, beta_max: float) -> dict:
-    """`verdict --boundaries` at one α: {alpha, boundaries: [...], scan: [...]}."""
-    return json.loads(run("verdict", f"--alpha={alpha!r}", f"--nu={nu!r}", f"--eta={eta!r}", "--boundaries",
-                          f"--scan={scan}", f"--beta-min={beta_min!r}", f"--beta-max={beta_max!r}", "--json"))
+    """`verdict --boundaries` at one α (the package's, on rayon's pool, which the callers in
+    several threads share): {alpha, boundaries: [...], scan: [...]}."""
+    found = ra.boundaries(alpha, nu, eta, scan=scan, beta_min=beta_min, beta_max=beta_max)
+    return json.loads(found.attrs["boundaries_json"])
 
 
 def verdict(alpha: float, beta: float, nu: float, eta: float) -> dict:
-    return json.loads(run("verdict", f"--alpha={alpha!r}", f"--beta={beta!r}", f"--nu={nu!r}", f"--eta={eta!r}",
-                          "--json"))
+    """The verdict of one body, as `rubber-atlas verdict --json` prints it."""
+    return json.loads(ra.verdict(alpha, beta, nu, eta).verdict_json.item())
 
 
 def label(holds, case="1") -> str:
@@ -66,7 +58,7 @@ def label(holds, case="1") -> str:
 
 
 def sweep(alphas, nu, eta, scan, beta_min, beta_max, jobs):
-    """`verdict --boundaries` at every α, `jobs` processes at a time, in α order."""
+    """`verdict --boundaries` at every α, `jobs` at a time, in α order."""
     with ThreadPoolExecutor(max_workers=jobs) as pool:
         return list(pool.map(lambda a: boundaries(a, nu, eta, scan, beta_min, beta_max), alphas))
 
@@ -151,19 +143,13 @@ def confirm(alpha: float, beta: float, nu: float, eta: float, periods=(10, 20)) 
     if not v["counterexamples"]:
         return dict(alpha=alpha, beta=beta, confirmed=False, reason=v["evidence"].get("limit_failure") or "none")
     c = min(v["counterexamples"], key=lambda c: abs(np.log(c["kappa"])))
-    cell = json.loads(run("cell", f"--alpha={alpha!r}", f"--beta={beta!r}", f"--nu={nu!r}", f"--eta={eta!r}",
-                          f"--kappa={c['kappa']!r}", f"--energy={c['energy']!r}", "--method", "ode", "--json"))
-    comp = min(cell["components"], key=lambda x: abs(x["theta_min"] - c["theta_min"]))
+    cell = ra.cells(alpha, beta, nu, eta, c["kappa"], c["energy"], method="ode")
+    comp = min(ra.components(cell), key=lambda x: abs(x["theta_min"] - c["theta_min"]))
     distances = []
-    with tempfile.TemporaryDirectory() as tmp:
-        for n in periods:
-            out = Path(tmp) / f"t{n}.h5"
-            run("trajectory", f"--alpha={alpha!r}", f"--beta={beta!r}", f"--nu={nu!r}", f"--eta={eta!r}",
-                f"--kappa={c['kappa']!r}", f"--theta0={c['theta_min']!r}", f"--periods={n}", "--samples=4",
-                "--model", "full", "--out", str(out))
-            with h5py.File(out) as f:
-                x, y = f["x_c"][()], f["y_c"][()]
-            distances.append(float(np.hypot(x[-1] - x[0], y[-1] - y[0])))
+    for n in periods:
+        t = ra.trajectory(alpha, beta, nu, eta, c["kappa"], theta0=c["theta_min"], periods=n, samples=4, model="full")
+        x, y = t.x_c.values, t.y_c.values
+        distances.append(float(np.hypot(x[-1] - x[0], y[-1] - y[0])))
     expected = [n * c["drift"] for n in periods]
     linear = all(abs(d - e) <= 1e-5 * e for d, e in zip(distances, expected))
     return dict(alpha=alpha, beta=beta, case=v["case"], integer=c["integer"], kappa=c["kappa"], energy=c["energy"],
@@ -321,7 +307,7 @@ def main() -> None:
     write_csv(out.with_suffix(".csv"), rows)
     write_csv(out.parent / f"{out.name}-boundaries.csv", brows)
     write_csv(out.parent / f"{out.name}-evidence.csv", evidence)
-    attrs = dict(nu=args.nu, eta=args.eta, program=run("--version").strip(),
+    attrs = dict(nu=args.nu, eta=args.eta, program=f"rubber-atlas {ra.__version__} ({ra.git_commit})",
                  command_line=" ".join(sys.argv), seconds_map=main_seconds)
     write_h5(out.with_suffix(".h5"), dict(map=rows, boundaries=brows, evidence=evidence), attrs)
     plot(rows, brows, evidence, out.with_suffix(".png"), args.nu, args.eta)

@@ -367,6 +367,41 @@ fn verdicts(
         .collect()
 }
 
+/// The β at which the verdict changes along β at one α (`verdict --boundaries`), as the
+/// command's JSON, computed with the GIL released.
+#[pyfunction]
+#[pyo3(signature = (alpha, nu, eta, beta_min, beta_max, scan, tol, resolution, threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn boundaries(
+    py: Python<'_>,
+    alpha: f64,
+    nu: f64,
+    eta: f64,
+    beta_min: f64,
+    beta_max: f64,
+    scan: usize,
+    tol: f64,
+    resolution: usize,
+    threads: Option<usize>,
+) -> PyResult<String> {
+    let options = verdict::BoundaryOptions {
+        beta_min,
+        beta_max,
+        scan,
+        verdict: VerdictOptions {
+            tol,
+            resolution,
+            counterexamples: true,
+            coarse_first: false,
+        },
+    };
+    let found = in_pool(py, threads, || {
+        verdict::boundaries(alpha, nu, eta, &options)
+    })?
+    .map_err(value_error)?;
+    serde_json::to_string(&found).map_err(|e| bad(e.to_string()))
+}
+
 /// The long name, units and comment of a coordinate (`alpha`, …, `energy`, `component`).
 #[pyfunction]
 fn coordinate(name: &str) -> PyResult<(&'static str, &'static str, Option<&'static str>)> {
@@ -405,5 +440,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(trajectory, m)?)?;
     m.add_function(wrap_pyfunction!(resonance, m)?)?;
     m.add_function(wrap_pyfunction!(verdicts, m)?)?;
+    m.add_function(wrap_pyfunction!(boundaries, m)?)?;
     Ok(())
 }

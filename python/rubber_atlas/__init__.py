@@ -10,7 +10,7 @@ command, bit for bit; results are xarray objects with the files' names, units an
     atlas.rubber.components(alpha=0.5, beta=3.0, kappa=0.8, energy=2.5)
     atlas.rubber.plot_slice()                                    # a matplotlib Figure
     ra.trajectory(alpha=0.5, beta=3, nu=0.5, eta=0.5, kappa=0.8, energy=2.5, periods=3)
-    ra.diagram(alpha=0.5, beta=3), ra.resonance(...), ra.verdict(...)
+    ra.diagram(alpha=0.5, beta=3), ra.resonance(...), ra.verdict(...), ra.boundaries(...)
 
 Units are the paper's: length b3, mass m, time sqrt(b3/g) (stated in each variable's
 `comment`). The extension is built without HDF5: files are read and written by h5py and
@@ -22,6 +22,7 @@ from __future__ import annotations
 from . import _core
 from ._api import (
     FIELDS,
+    boundaries,
     cells,
     components,
     diagram,
@@ -40,6 +41,7 @@ git_commit = _core.git_commit
 __all__ = [
     "FIELDS",
     "RubberAccessor",
+    "boundaries",
     "cells",
     "components",
     "diagram",

@@ -380,3 +380,51 @@ def verdict(alpha, beta, nu, eta, *, tol: float = 1e-10, resolution: int = 64,
                         tolerance=float(tol), resolution=int(resolution))
     return xr.Dataset(data_vars, coords, attrs)
 
+
+
+def _flag(values, meanings: str) -> dict:
+    return {"units": "1", "flag_values": np.asarray(values, dtype=np.uint8), "flag_meanings": meanings}
+
+
+def boundaries(alpha: float, nu: float, eta: float, *, beta_min: float = 0.05, beta_max: float = 50.0,
+               scan: int = 48, tol: float = 1e-10, resolution: int = 64, threads: int | None = None) -> xr.Dataset:
+    """The β at which the verdict of the boundedness hypothesis changes along β at one α
+    (`rubber-atlas verdict --boundaries`), each by root-finding on a quantity that changes
+    sign there: along `boundary`, `beta` with its error bound, the `quantity`, and the case
+    and verdict on either side; along `scan`, the log-spaced bodies scanned first. The
+    whole `--json` object is `attrs["boundaries_json"]`."""
+    found = json.loads(_core.boundaries(float(alpha), float(nu), float(eta), float(beta_min), float(beta_max),
+                                        int(scan), float(tol), int(resolution), threads))
+    holds = lambda h: 255 if h is None else int(h)  # noqa: E731
+    holds_attrs = _flag([0, 1, 255], "fails holds no_value")
+    case_attrs = _flag([0, 1, 2], "case_1 case_2 not_covered")
+    b, sc = found["boundaries"], found["scan"]
+    data_vars = {
+        "boundary_beta": ("boundary", np.array([x["beta"] for x in b], dtype=float),
+                          {"long_name": "beta at which the verdict changes", **_coordinate_attrs("beta")}),
+        "boundary_error": ("boundary", np.array([x["error"] for x in b], dtype=float),
+                           {"long_name": "bound on the error of boundary_beta", "units": "1"}),
+        "quantity": ("boundary", np.array([x["quantity"] for x in b], dtype=object),
+                     {"long_name": "what changes sign at the boundary"}),
+        "case_below": ("boundary", np.array([_CASES[x["case_below"]] for x in b], dtype=np.uint8),
+                       {"long_name": "case below the boundary", **case_attrs}),
+        "holds_below": ("boundary", np.array([holds(x["holds_below"]) for x in b], dtype=np.uint8),
+                        {"long_name": "verdict below the boundary", **holds_attrs}),
+        "case_above": ("boundary", np.array([_CASES[x["case_above"]] for x in b], dtype=np.uint8),
+                       {"long_name": "case above the boundary", **case_attrs}),
+        "holds_above": ("boundary", np.array([holds(x["holds_above"]) for x in b], dtype=np.uint8),
+                        {"long_name": "verdict above the boundary", **holds_attrs}),
+        "scan_beta": ("scan", np.array([x["beta"] for x in sc], dtype=float),
+                      {"long_name": "beta of the scanned body", **_coordinate_attrs("beta")}),
+        "scan_case": ("scan", np.array([_CASES[x["case"]] for x in sc], dtype=np.uint8),
+                      {"long_name": "case of the scanned body", **case_attrs}),
+        "scan_holds": ("scan", np.array([holds(x["holds"]) for x in sc], dtype=np.uint8),
+                       {"long_name": "verdict of the scanned body", **holds_attrs}),
+    }
+    arguments = dict(alpha=alpha, nu=nu, eta=eta, beta_min=beta_min, beta_max=beta_max, scan=scan, tol=tol,
+                     resolution=resolution)
+    attrs = _root_attrs("boundaries", arguments, title="rubber-atlas boundaries of the boundedness hypothesis",
+                        alpha=float(alpha), nu=float(nu), eta=float(eta),
+                        beta_range=np.asarray(found["beta_range"], dtype=float), tolerance=float(tol),
+                        resolution=int(resolution), boundaries_json=json.dumps(found))
+    return xr.Dataset(data_vars, attrs=attrs)

@@ -291,3 +291,15 @@ def test_rayon_num_threads_is_honoured_when_threads_is_absent(tmp_path):
         assert after.returncode == 0, after.stderr
         threads[n] = int(after.stdout)
     assert threads[3] - threads[1] == 2, threads
+
+
+def test_boundaries_equal_the_command():
+    found = ra.boundaries(0.5, 0.5, 0.5, scan=6, resolution=16)
+    expected = json.loads(run("verdict", "--alpha", "0.5", "--nu", "0.5", "--eta", "0.5", "--boundaries", "--scan", "6",
+                              "--resolution", "16", "--json"))
+    assert json.loads(found.attrs["boundaries_json"]) == expected
+    assert found.sizes["boundary"] == len(expected["boundaries"]) > 0
+    np.testing.assert_array_equal(found.boundary_beta, [b["beta"] for b in expected["boundaries"]])
+    names = ra.flag_names(found.holds_below)
+    assert [names[int(h)] for h in found.holds_below] == [
+        {True: "holds", False: "fails", None: "no_value"}[b["holds_below"]] for b in expected["boundaries"]]
