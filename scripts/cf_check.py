@@ -45,7 +45,7 @@ def cfchecks(path: Path, folder: Path) -> list[str]:
         link.unlink()
     link.symlink_to(path.resolve())
     checker = cf.CFChecker(cfStandardNamesXML=str(names), cfAreaTypesXML=str(folder / "area-types.xml"),
-                           cfRegionNamesXML=str(folder / "regions.xml"), version=cf_1_11, silent=True)
+                           cfRegionNamesXML=str(folder / "regions.xml"), version=cf_1_11, silent=False)
     printed = io.StringIO()
     with contextlib.redirect_stdout(printed):
         try:
@@ -54,7 +54,7 @@ def cfchecks(path: Path, folder: Path) -> list[str]:
             pass
     totals = checker.get_total_counts()
     problems = [line.strip() for line in printed.getvalue().splitlines()
-                if line.startswith(("ERROR", "WARN", "FATAL"))]
+                if line.startswith(("ERROR:", "WARN:", "FATAL:"))]
     if (totals["FATAL"] + totals["ERROR"] + totals["WARN"]) and not problems:
         problems.append(f"cfchecks: {totals}")
     return [f"cfchecks: {p}" for p in problems]

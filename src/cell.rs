@@ -502,12 +502,13 @@ fn finish(component: &Component, raw: PeriodIntegrals, options: &CellOptions) ->
     let n = -raw.psi_advance / TAU;
     let rel_t = raw.period_error / t;
     let n_err = raw.psi_advance_error / TAU;
-    // A libration with ψ ≡ 0 (κ = 0) retraces its way out on the way back: Δζ = 0 exactly.
+    // A libration with ψ ≡ 0 (κ = 0) retraces its way out on the way back: Δζ = 0 exactly,
+    // whatever the rounding (quadrature) or truncation (ODE method) of its integral.
     let planar = component.kind == MotionKind::Libration
         && raw.psi_advance == 0.0
         && raw.psi_advance_error == 0.0;
     let (drift, drift_error, drift_vector) = match raw.drift {
-        Some(d) if planar && d.value == [0.0, 0.0] => (0.0, 0.0, d.value),
+        Some(_) if planar => (0.0, 0.0, [0.0, 0.0]),
         Some(d) => (d.value[0].hypot(d.value[1]), d.error, d.value),
         None => (f64::NAN, f64::NAN, [f64::NAN; 2]),
     };
@@ -530,9 +531,10 @@ fn finish(component: &Component, raw: PeriodIntegrals, options: &CellOptions) ->
         drift: drift_error,
         drift_radius: radius_error,
     };
-    let drift_ok = raw
-        .drift
-        .is_none_or(|d| d.error <= options.tol * d.scale.max(f64::MIN_POSITIVE));
+    let drift_ok = planar
+        || raw
+            .drift
+            .is_none_or(|d| d.error <= options.tol * d.scale.max(f64::MIN_POSITIVE));
     let ok = raw.converged && rel_t <= options.tol && n_err <= options.tol && drift_ok;
     ComponentResult {
         theta_min: component.theta_min(),

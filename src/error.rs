@@ -42,6 +42,9 @@ pub enum AtlasError {
     /// An atlas file, a shard or a resume journal that cannot be used as asked.
     #[error("{path}: {reason}")]
     Atlas { path: String, reason: String },
+    /// A request larger than this machine can hold (the caller may insist).
+    #[error("{reason}")]
+    TooLarge { reason: String },
     /// Another process is writing the same output.
     #[error("{path}: {reason}")]
     Busy { path: String, reason: String },

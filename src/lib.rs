@@ -43,6 +43,7 @@ pub mod critical;
 pub mod error;
 pub mod full;
 pub mod limits;
+pub mod machine;
 pub mod ode;
 pub mod period_ode;
 pub mod quadrature;

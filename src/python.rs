@@ -19,6 +19,10 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
+/// Cells per thread in a batch of `cells` (milliseconds of work): Ctrl-C is heard between
+/// batches.
+const BATCH_PER_THREAD: usize = 512;
+
 fn value_error(e: AtlasError) -> PyErr {
     PyValueError::new_err(e.to_string())
 }
@@ -45,24 +49,51 @@ fn parse_fields(names: Option<Vec<String>>) -> PyResult<Vec<Field>> {
     }
 }
 
-/// Runs `work` with `threads` threads (the global pool, which honours RAYON_NUM_THREADS,
-/// for None), with the GIL released.
+/// A count given from Python (`samples`, `component`, …), refused below `min` naming it.
+fn count(name: &str, value: i64, min: i64) -> PyResult<usize> {
+    if value < min {
+        return Err(bad(format!("invalid {name} = {value}: must be >= {min}")));
+    }
+    usize::try_from(value).map_err(|_| bad(format!("invalid {name} = {value}: too large")))
+}
+
+/// The pool of `threads` threads, capped at the machine's cores as the command line caps
+/// them (None: rayon's global pool, which honours RAYON_NUM_THREADS).
+fn pool(threads: Option<i64>) -> PyResult<Option<rayon::ThreadPool>> {
+    let Some(n) = threads else {
+        return Ok(None);
+    };
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let n = count("threads", n, 1)?.min(cores);
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(n)
+        .build()
+        .map(Some)
+        .map_err(|e| bad(e.to_string()))
+}
+
+/// The threads of `pool` (or of rayon's global pool).
+fn threads_of(pool: &Option<rayon::ThreadPool>) -> usize {
+    pool.as_ref()
+        .map_or_else(rayon::current_num_threads, |p| p.current_num_threads())
+}
+
+/// Runs `work` on `pool` (or rayon's global pool) with the GIL released.
 fn in_pool<T: Send>(
     py: Python<'_>,
-    threads: Option<usize>,
+    pool: &Option<rayon::ThreadPool>,
     work: impl FnOnce() -> T + Send,
-) -> PyResult<T> {
-    match threads {
-        Some(0) => Err(bad("threads must be >= 1".into())),
-        Some(n) => {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(n)
-                .build()
-                .map_err(|e| bad(e.to_string()))?;
-            Ok(py.detach(|| pool.install(work)))
-        }
-        None => Ok(py.detach(work)),
+) -> T {
+    match pool {
+        Some(pool) => py.detach(|| pool.install(work)),
+        None => py.detach(work),
     }
+}
+
+/// Refuses a request of about `bytes` of memory that the machine cannot hold, unless
+/// `allow_large`.
+fn check_memory(bytes: f64, allow_large: bool, remedy: &str) -> PyResult<()> {
+    crate::machine::check_memory(bytes, allow_large, remedy).map_err(value_error)
 }
 
 /// The metadata of the variables of `fields`, in file order: name, whether it has a value
@@ -98,7 +129,7 @@ fn variables(py: Python<'_>, fields: Option<Vec<String>>) -> PyResult<Bound<'_, 
 /// the values of every variable of `fields` as (name, flat array) pairs, in file order; a
 /// per-component variable has `COMPONENT_SLOTS` values per cell, slot fastest.
 #[pyfunction]
-#[pyo3(signature = (alpha, beta, nu, eta, kappa, energy, tol, method, resonance_tol, fields=None, threads=None))]
+#[pyo3(signature = (alpha, beta, nu, eta, kappa, energy, tol, method, resonance_tol, fields=None, threads=None, allow_large=false))]
 #[allow(clippy::too_many_arguments)]
 fn cells<'py>(
     py: Python<'py>,
@@ -112,7 +143,8 @@ fn cells<'py>(
     method: &str,
     resonance_tol: f64,
     fields: Option<Vec<String>>,
-    threads: Option<usize>,
+    threads: Option<i64>,
+    allow_large: bool,
 ) -> PyResult<Bound<'py, PyList>> {
     let arrays = [&alpha, &beta, &nu, &eta, &kappa, &energy];
     let slices = arrays
@@ -125,6 +157,16 @@ fn cells<'py>(
             "alpha, beta, nu, eta, kappa and energy must have one length".into(),
         ));
     }
+    let fields = parse_fields(fields)?;
+    let vars = atlas::variables(&fields);
+    // The points, the blocks and their concatenation: about twice the output per cell.
+    let per_cell: usize = vars.iter().map(|v| v.kind.bytes_per_cell()).sum();
+    check_memory(
+        n as f64 * (std::mem::size_of::<CellPoint>() + 2 * per_cell) as f64,
+        allow_large,
+        "give fewer cells at a time, or allow_large=True",
+    )?;
+    let pool = pool(threads)?;
     let points: Vec<CellPoint> = (0..n)
         .map(|i| CellPoint {
             alpha: slices[0][i],
@@ -135,7 +177,6 @@ fn cells<'py>(
             energy: slices[5][i],
         })
         .collect();
-    let fields = parse_fields(fields)?;
     let options = CellOptions {
         tol,
         method: match method {
@@ -150,11 +191,17 @@ fn cells<'py>(
         drift: fields.iter().any(|f| f.needs_drift()),
         resonance_tol,
     };
-    let vars = atlas::variables(&fields);
-    let block = in_pool(py, threads, || {
-        atlas::compute_cells(&points, &vars, &options)
-    })?
-    .map_err(value_error)?;
+    // In batches, between which Ctrl-C (KeyboardInterrupt) is heard; each cell is solved
+    // on its own, so the batches do not change a value.
+    let batch = (BATCH_PER_THREAD * threads_of(&pool)).max(1);
+    let mut blocks = Vec::with_capacity(n.div_ceil(batch));
+    for chunk in points.chunks(batch) {
+        let block = in_pool(py, &pool, || atlas::compute_cells(chunk, &vars, &options))
+            .map_err(value_error)?;
+        blocks.push(block);
+        py.check_signals()?;
+    }
+    let block = atlas::Block::concat(&vars, blocks);
     let list = PyList::empty(py);
     for (v, column) in vars.iter().zip(block.columns) {
         let array = match column {
@@ -210,16 +257,25 @@ fn body(alpha: f64, beta: f64, nu: f64, eta: f64) -> PyResult<EllipsoidBody> {
 /// The critical set of one body (paper §4): its fixed-point curves as a table, and its
 /// summary as JSON.
 #[pyfunction]
-#[pyo3(signature = (alpha, beta, nu, eta, samples, kappa_max))]
+#[pyo3(signature = (alpha, beta, nu, eta, samples, kappa_max, allow_large=false))]
+#[allow(clippy::too_many_arguments)]
 fn diagram(
     py: Python<'_>,
     alpha: f64,
     beta: f64,
     nu: f64,
     eta: f64,
-    samples: usize,
+    samples: i64,
     kappa_max: f64,
+    allow_large: bool,
 ) -> PyResult<(Bound<'_, PyDict>, String)> {
+    let samples = count("samples", samples, 1)?;
+    // As the command measured it: 245 bytes per sample at the peak.
+    check_memory(
+        300.0 * samples as f64,
+        allow_large,
+        "use fewer samples, or allow_large=True",
+    )?;
     let body = body(alpha, beta, nu, eta)?;
     let set = py
         .detach(|| CriticalSet::of(&body, samples, kappa_max))
@@ -231,7 +287,7 @@ fn diagram(
 /// A trajectory (the reduced model or the full one) as a table along `t`, with its start
 /// (κ, ε, θ(0), θ̇(0)).
 #[pyfunction]
-#[pyo3(signature = (alpha, beta, nu, eta, kappa, energy, component, theta0, theta_dot0, periods, t_end, samples, model, tol))]
+#[pyo3(signature = (alpha, beta, nu, eta, kappa, energy, component, theta0, theta_dot0, periods, t_end, samples, model, tol, allow_large=false))]
 #[allow(clippy::too_many_arguments)]
 fn trajectory<'py>(
     py: Python<'py>,
@@ -241,15 +297,24 @@ fn trajectory<'py>(
     eta: f64,
     kappa: f64,
     energy: Option<f64>,
-    component: usize,
+    component: i64,
     theta0: Option<f64>,
     theta_dot0: f64,
     periods: Option<f64>,
     t_end: Option<f64>,
-    samples: usize,
+    samples: i64,
     model: &str,
     tol: f64,
+    allow_large: bool,
 ) -> PyResult<(Bound<'py, PyDict>, [f64; 4])> {
+    let component = count("component", component, 0)?;
+    let samples = count("samples", samples, 1)?;
+    // As the command measured it: 135 bytes per sample at the peak.
+    check_memory(
+        160.0 * samples as f64,
+        allow_large,
+        "use fewer samples, or allow_large=True",
+    )?;
     let body = body(alpha, beta, nu, eta)?;
     let start = match (energy, theta0) {
         (Some(energy), None) => StartAt::Energy { energy, component },
@@ -300,9 +365,10 @@ fn resonance(
     kappa_max: f64,
     energy_min: Option<f64>,
     energy_max: f64,
-    grid: usize,
+    grid: i64,
     tol: f64,
 ) -> PyResult<(Bound<'_, PyDict>, f64)> {
+    let grid = count("grid", grid, 1)?;
     let body = body(alpha, beta, nu, eta)?;
     let options = ResonanceOptions::window(
         &body,
@@ -334,10 +400,12 @@ fn verdicts(
     nu: Vec<f64>,
     eta: Vec<f64>,
     tol: f64,
-    resolution: usize,
-    threads: Option<usize>,
+    resolution: i64,
+    threads: Option<i64>,
 ) -> PyResult<Vec<String>> {
     use rayon::prelude::*;
+    let resolution = count("resolution", resolution, 1)?;
+    let pool = pool(threads)?;
     let n = alpha.len();
     if [beta.len(), nu.len(), eta.len()].iter().any(|&m| m != n) {
         return Err(bad("alpha, beta, nu and eta must have one length".into()));
@@ -351,20 +419,23 @@ fn verdicts(
         counterexamples: true,
         coarse_first: true,
     };
-    let found = in_pool(py, threads, || {
-        bodies
-            .par_iter()
-            .with_max_len(1)
-            .map(|b| verdict::verdict(b, &options))
-            .collect::<Vec<_>>()
-    })?;
-    found
-        .into_iter()
-        .map(|v| {
+    // A body per thread at a time: Ctrl-C is heard between the batches.
+    let mut out = Vec::with_capacity(n);
+    for chunk in bodies.chunks(threads_of(&pool).max(1)) {
+        let found = in_pool(py, &pool, || {
+            chunk
+                .par_iter()
+                .with_max_len(1)
+                .map(|b| verdict::verdict(b, &options))
+                .collect::<Vec<_>>()
+        });
+        for v in found {
             let v = v.map_err(value_error)?;
-            serde_json::to_string(&v).map_err(|e| bad(e.to_string()))
-        })
-        .collect()
+            out.push(serde_json::to_string(&v).map_err(|e| bad(e.to_string()))?);
+        }
+        py.check_signals()?;
+    }
+    Ok(out)
 }
 
 /// The β at which the verdict changes along β at one α (`verdict --boundaries`), as the
@@ -379,11 +450,14 @@ fn boundaries(
     eta: f64,
     beta_min: f64,
     beta_max: f64,
-    scan: usize,
+    scan: i64,
     tol: f64,
-    resolution: usize,
-    threads: Option<usize>,
+    resolution: i64,
+    threads: Option<i64>,
 ) -> PyResult<String> {
+    let scan = count("scan", scan, 1)?;
+    let resolution = count("resolution", resolution, 1)?;
+    let pool = pool(threads)?;
     let options = verdict::BoundaryOptions {
         beta_min,
         beta_max,
@@ -395,10 +469,8 @@ fn boundaries(
             coarse_first: false,
         },
     };
-    let found = in_pool(py, threads, || {
-        verdict::boundaries(alpha, nu, eta, &options)
-    })?
-    .map_err(value_error)?;
+    let found = in_pool(py, &pool, || verdict::boundaries(alpha, nu, eta, &options))
+        .map_err(value_error)?;
     serde_json::to_string(&found).map_err(|e| bad(e.to_string()))
 }
 

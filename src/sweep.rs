@@ -457,6 +457,15 @@ pub fn merge(
                 ),
             ));
         }
+        if !file.coordinates_match(&scene) {
+            return Err(AtlasError::atlas(
+                path,
+                format!(
+                    "its coordinates are not those of shard {index}/{n} of the scene (its shard \
+                     attributes were changed?)"
+                ),
+            ));
+        }
         if *count.get_or_insert(n) != n {
             return Err(AtlasError::atlas(
                 path,

@@ -470,6 +470,25 @@ fn four_shards_merged_equal_a_single_run() {
     ]);
     assert_eq!(mixed.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&mixed.stderr).contains("same scene"));
+    // Shards whose shard_index attributes were swapped by hand: their coordinates give them
+    // away (the data would land in each other's place).
+    for (i, index) in [(0usize, 2i64), (1, 1)] {
+        let copy = dir.path().join(format!("swapped-{i}.h5"));
+        std::fs::copy(&shards[i], &copy).unwrap();
+        let f = hdf5::File::open_rw(&copy).unwrap();
+        f.attr("shard_index").unwrap().write_scalar(&index).unwrap();
+    }
+    let mut swapped = vec!["merge".to_string()];
+    for name in ["swapped-0.h5", "swapped-1.h5"] {
+        swapped.push(dir.path().join(name).to_str().unwrap().to_string());
+    }
+    for i in [2, 3] {
+        swapped.push(shards[i].to_str().unwrap().to_string());
+    }
+    swapped.extend(["--out".to_string(), r.to_string()]);
+    let o = Command::new(BIN).args(&swapped).output().unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("coordinates"));
     assert!(!refused.exists());
 }
 

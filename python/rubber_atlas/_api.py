@@ -54,11 +54,24 @@ def _coordinate_attrs(name: str) -> dict:
     return attrs
 
 
+def _check_input(name: str, value) -> None:
+    """Refuses inputs that would be read as something the user did not give."""
+    if value is None:
+        raise TypeError(f"{name} is None: give a number or an array of numbers")
+    if isinstance(value, np.ma.MaskedArray) and np.ma.is_masked(value):
+        raise ValueError(f"{name} has masked values: give only the cells to compute")
+    dtype = value.dtype if isinstance(value, (np.ndarray, xr.DataArray)) else np.asarray(value).dtype
+    if np.issubdtype(dtype, np.complexfloating):
+        raise TypeError(f"{name} is complex: give real numbers")
+
+
 def _broadcast(given: dict[str, object]) -> tuple[tuple[str, ...], list[np.ndarray], dict]:
     """Broadcasts the inputs together: DataArrays by their dimension names (xarray's rules),
     anything else by numpy's (dimensions `cell`, or `cell_0`, `cell_1`, … for several).
     Returns the dimensions, the arrays in that layout, and the coordinates of the result:
     each input over the dimensions it varies along (scalar where it is one number)."""
+    for name, v in given.items():
+        _check_input(name, v)
     if any(isinstance(v, xr.DataArray) for v in given.values()):
         arrays = {}
         for name, v in given.items():
@@ -71,8 +84,17 @@ def _broadcast(given: dict[str, object]) -> tuple[tuple[str, ...], list[np.ndarr
                     f"{name}: give every array input as an xarray.DataArray (with named "
                     "dimensions) when any is one, or none as one"
                 )
-        broadcast = xr.broadcast(*arrays.values())
+        try:
+            aligned = xr.align(*arrays.values(), join="exact")
+        except ValueError as e:
+            raise ValueError(f"the DataArray inputs' coordinates do not line up: {e}") from None
+        broadcast = xr.broadcast(*aligned)
         dims = broadcast[0].dims
+        for name in given:
+            # A dimension named after an input is that input's axis, or a mistake.
+            if name in dims and arrays[name].dims != (name,):
+                raise ValueError(f"the dimension {name!r} is named after the input {name}, which is not given "
+                                 f"along it: rename the dimension, or give {name} as a DataArray along {name!r}")
         layout = [b.transpose(*dims).values for b in broadcast]
         coords = {}
         for (name, source), full in zip(arrays.items(), layout):
@@ -106,6 +128,7 @@ def cells(
     fields: Iterable[str] | None = None,
     resonance_tol: float = 1e-9,
     threads: int | None = None,
+    allow_large: bool = False,
 ) -> xr.Dataset:
     """Solves cells (α, β, ν, η, κ, ε) given as numbers, numpy arrays or xarray DataArrays,
     broadcast together, in parallel in Rust with the GIL released (`threads` threads; by
@@ -115,7 +138,9 @@ def cells(
     `rubber-atlas cell` prints, bit for bit: `n_components` and `cell_status` per cell, and
     per cell and `component` the fields and their `<field>_error`, NaN (floats) or 255
     (flags, `no_value`) where a component does not exist. The inputs are coordinates.
-    Bad input raises ValueError naming the cell and the value."""
+    Bad input raises ValueError naming the cell and the value; a request larger than 80 % of
+    the memory available is refused unless `allow_large`. Ctrl-C stops it within
+    milliseconds (KeyboardInterrupt)."""
     given = {"alpha": alpha, "beta": beta, "nu": nu, "eta": eta, "kappa": kappa, "energy": energy}
     if isinstance(fields, str):
         fields = [fields]
@@ -124,7 +149,8 @@ def cells(
     shape = layout[0].shape
     flat = [np.ascontiguousarray(a, dtype=np.float64).reshape(-1) for a in layout]
     slots = _core.COMPONENT_SLOTS
-    computed = _core.cells(*flat, float(tol), str(method), float(resonance_tol), field_list, threads)
+    computed = _core.cells(*flat, float(tol), str(method), float(resonance_tol), field_list, threads,
+                           bool(allow_large))
     meta = {m["name"]: m for m in _core.variables(field_list)}
     data_vars = {}
     for name, values in computed:
@@ -168,15 +194,21 @@ def open_atlas(path: str | Path, **kwargs) -> xr.Dataset:
     if path.name.endswith(".partial.h5"):
         raise ValueError(f"{path}: an unfinished run's file; resume the run with --resume")
     kwargs.setdefault("engine", "h5netcdf")
-    ds = xr.open_dataset(path, **kwargs)
-    if ds.attrs.get("program") != "rubber-atlas":
+    try:
+        ds = xr.open_dataset(path, **kwargs)
+    except (OSError, ValueError) as e:
+        raise ValueError(f"{path}: not a rubber-atlas atlas: {e}") from None
+    if ds.attrs.get("program") != "rubber-atlas" or "scene" not in ds.attrs or "cell_status" not in ds:
         ds.close()
-        raise ValueError(f"{path}: not a rubber-atlas atlas (no program attribute)")
+        raise ValueError(f"{path}: not a rubber-atlas atlas (a file of `rubber-atlas run` or `merge` has the "
+                         "attributes program and scene and the variable cell_status)")
     return ds
 
 
 def flag_names(variable: xr.DataArray) -> dict[int, str]:
     """The CF flag meanings of a flag variable, as {value: name}."""
+    if "flag_values" not in variable.attrs:
+        raise ValueError(f"{variable.name} is not a flag variable (it has no flag_values)")
     values = np.atleast_1d(variable.attrs["flag_values"])
     names = variable.attrs["flag_meanings"].split()
     return {int(v): n for v, n in zip(values, names)}
@@ -201,6 +233,9 @@ def components(ds: xr.Dataset, alpha: float | None = None, beta: float | None = 
     index = {}
     for name, value in cell.items():
         if name not in ds.coords:
+            size = ds.sizes[name]
+            if not float(value).is_integer() or not 0 <= int(value) < size:
+                raise KeyError(f"{name} = {value} is not an index of the dimension {name} (0 … {size - 1})")
             index[name] = int(value)
             continue
         axis = ds[name].values
@@ -271,12 +306,13 @@ def read_table(path: str | Path) -> xr.Dataset:
 
 
 def diagram(alpha: float, beta: float, nu: float = 0.5, eta: float = 0.5, *, samples: int = 2000,
-            kappa_max: float = 3.0) -> xr.Dataset:
+            kappa_max: float = 3.0, allow_large: bool = False) -> xr.Dataset:
     """The critical set of one body (paper §4, Fig. `bif`): its fixed-point curves along
     `sample` (branch, θ0, κ, ε, stability, the radii ρ_c and ρ_p, N at the bottom of the
     well), as `rubber-atlas diagram --out` writes them; `attrs["critical_set_json"]` holds
     the summary (`diagram --json`). ν and η do not change the set; they are recorded."""
-    table, summary = _core.diagram(float(alpha), float(beta), float(nu), float(eta), int(samples), float(kappa_max))
+    table, summary = _core.diagram(float(alpha), float(beta), float(nu), float(eta), int(samples), float(kappa_max),
+                                   bool(allow_large))
     arguments = dict(alpha=alpha, beta=beta, nu=nu, eta=eta, samples=samples, kappa_max=kappa_max)
     attrs = _root_attrs("diagram", arguments,
                         alpha=float(alpha), beta=float(beta), nu=float(nu), eta=float(eta),
@@ -287,7 +323,7 @@ def diagram(alpha: float, beta: float, nu: float = 0.5, eta: float = 0.5, *, sam
 def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, energy: float | None = None, *,
                component: int = 0, theta0: float | None = None, theta_dot0: float = 0.0,
                periods: float | None = None, t_end: float | None = None, samples: int = 2000,
-               model: str = "reduced", tol: float = 1e-12) -> xr.Dataset:
+               model: str = "reduced", tol: float = 1e-12, allow_large: bool = False) -> xr.Dataset:
     """A trajectory along `t` (θ, θ̇, φ, ψ, the centre of mass and the contact point), as
     `rubber-atlas trajectory` writes it: from the lower turning point of `component` at
     `energy`, or from `theta0`, `theta_dot0`; for `periods` θ-periods or up to `t_end`;
@@ -297,7 +333,7 @@ def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, e
         None if energy is None else float(energy), int(component),
         None if theta0 is None else float(theta0), float(theta_dot0),
         None if periods is None else float(periods), None if t_end is None else float(t_end),
-        int(samples), str(model), float(tol))
+        int(samples), str(model), float(tol), bool(allow_large))
     arguments = dict(alpha=alpha, beta=beta, nu=nu, eta=eta, kappa=kappa, energy=energy, component=component,
                      theta0=theta0, theta_dot0=theta_dot0, periods=periods, t_end=t_end, samples=samples,
                      model=model, tol=tol)
@@ -369,7 +405,7 @@ def verdict(alpha, beta, nu, eta, *, tol: float = 1e-10, resolution: int = 64,
                         {"long_name": "fail margin: positive where N reaches an integer", **number}),
         "counterexamples": (dims, column(lambda v: len(v["counterexamples"]), np.int32),
                             {"long_name": "number of counterexamples found", **number}),
-        "verdict_json": (dims, column(lambda v: json.dumps(v), object),
+        "verdict_json": (dims, column(lambda v: json.dumps(v, ensure_ascii=True).encode(), np.bytes_),
                          {"long_name": "the verdict as `rubber-atlas verdict --json` prints it"}),
     }
     for name in given:
@@ -404,7 +440,7 @@ def boundaries(alpha: float, nu: float, eta: float, *, beta_min: float = 0.05, b
                           {"long_name": "beta at which the verdict changes", **_coordinate_attrs("beta")}),
         "boundary_error": ("boundary", np.array([x["error"] for x in b], dtype=float),
                            {"long_name": "bound on the error of boundary_beta", "units": "1"}),
-        "quantity": ("boundary", np.array([x["quantity"] for x in b], dtype=object),
+        "quantity": ("boundary", np.array([x["quantity"].encode("ascii", "replace") for x in b], dtype=np.bytes_),
                      {"long_name": "what changes sign at the boundary"}),
         "case_below": ("boundary", np.array([_CASES[x["case_below"]] for x in b], dtype=np.uint8),
                        {"long_name": "case below the boundary", **case_attrs}),

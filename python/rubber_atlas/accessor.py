@@ -45,6 +45,9 @@ class RubberAccessor:
         import matplotlib.pyplot as plt
 
         ds = self._ds
+        if not {"alpha", "beta"} <= set(ds.dims) or "cell_status" not in ds:
+            raise ValueError("plot_slice draws an atlas (dimensions alpha and beta, as open_atlas gives it); "
+                             f"this dataset has dimensions {list(ds.dims)}")
         cut = ds.isel(alpha=alpha_index, beta=beta_index)
         plane = [d for d in cut.cell_status.dims]
         if len(plane) != 2:

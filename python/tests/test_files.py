@@ -49,11 +49,13 @@ def files(make_scene, tmp_path_factory):
     out["trajectory (package)"] = d / "tp.nc"
     ra.trajectory(0.5, 3, 0.5, 0.5, 0.8, 2.5, periods=1, samples=20).to_netcdf(out["trajectory (package)"],
                                                                                engine="h5netcdf")
+    out["verdict (package)"] = d / "v.nc"
+    ra.verdict(0.5, 3.0, 0.5, 0.5, resolution=8).to_netcdf(out["verdict (package)"], engine="h5netcdf")
     return out
 
 
 KINDS = ["atlas", "shard", "merged", "compact", "trajectory", "diagram", "resonance", "cells (package)",
-         "trajectory (package)"]
+         "trajectory (package)", "verdict (package)"]
 
 
 @pytest.mark.parametrize("kind", KINDS)
@@ -73,6 +75,18 @@ def test_the_checkers_do_find_faults(files, tmp_path):
     problems = check(bad)
     assert any("units" in p for p in problems), problems
     assert any("flag_values" in p for p in problems), problems
+
+
+def test_open_atlas_refuses_what_is_not_an_atlas(files, tmp_path):
+    for kind in ("diagram", "trajectory", "cells (package)"):
+        with pytest.raises(ValueError, match="not a rubber-atlas atlas"):
+            ra.open_atlas(files[kind])
+    garbage = tmp_path / "g.h5"
+    garbage.write_bytes(b"not hdf5 at all")
+    with pytest.raises(ValueError, match="not a rubber-atlas atlas"):
+        ra.open_atlas(garbage)
+    with ra.open_atlas(files["shard"]) as shard:
+        assert shard.sizes["alpha"] == 1
 
 
 def test_tables_have_a_dimension_coordinate_and_numeric_attributes(files):

@@ -150,6 +150,66 @@ def test_bad_cells_raise_one_value_error_naming_the_value(kwargs, words):
         assert w in str(e.value), str(e.value)
 
 
+def test_inputs_that_would_be_misread_are_refused():
+    k = xr.DataArray([0.1, 0.5], dims="energy")
+    with pytest.raises(ValueError, match="named after the input energy"):
+        ra.cells(0.5, 3.0, 0.5, 0.5, k, 2.5)
+    a = xr.DataArray([0.1, 0.5], dims="x", coords={"x": [0, 1]})
+    b = xr.DataArray([2.0, 3.0], dims="x", coords={"x": [1, 2]})
+    with pytest.raises(ValueError, match="do not line up"):
+        ra.cells(0.5, 3.0, 0.5, 0.5, a, b)
+    with pytest.raises(TypeError, match="kappa is None"):
+        ra.cells(0.5, 3.0, 0.5, 0.5, None, 2.5)
+    with pytest.raises(TypeError, match="complex"):
+        ra.cells(0.5, 3.0, 0.5, 0.5, np.array([0.5 + 1j]), 2.5)
+    with pytest.raises(ValueError, match="masked"):
+        ra.cells(0.5, 3.0, 0.5, 0.5, np.ma.masked_array([0.5, 0.7], mask=[0, 1]), 2.5)
+    cells = ra.cells(0.5, 3.0, 0.5, 0.5, [0.5, 0.7], 2.5)
+    for index in (1.7, -1, 2):
+        with pytest.raises(KeyError, match="not an index"):
+            cells.rubber.components(cell=index)
+    with pytest.raises(ValueError, match="not a flag variable"):
+        cells.rubber.flags("theta_min")
+    with pytest.raises(ValueError, match="plot_slice draws an atlas"):
+        cells.rubber.plot_slice()
+
+
+def test_requests_beyond_the_machine_are_refused_and_threads_capped():
+    import rubber_atlas._core as core
+
+    for call, name in ((lambda: ra.trajectory(0.5, 3, 0.5, 0.5, 0.8, 2.5, periods=1, samples=10**13), "samples"),
+                       (lambda: ra.diagram(0.5, 3, samples=10**13), "samples")):
+        with pytest.raises(ValueError, match="allow_large"):
+            call()
+    with pytest.raises(ValueError, match="invalid threads = -1"):
+        ra.cells(0.5, 3, 0.5, 0.5, 0.5, 2.0, threads=-1)
+    with pytest.raises(ValueError, match="invalid component = -1"):
+        ra.trajectory(0.5, 3, 0.5, 0.5, 0.8, 2.5, component=-1, periods=1)
+    # A thread count beyond the cores is capped, as the command line caps it: it returns at once.
+    start = time.perf_counter()
+    ra.cells(0.5, 3, 0.5, 0.5, 0.8, 2.5, threads=10**6)
+    assert time.perf_counter() - start < 5
+    assert core.COMPONENT_SLOTS == 3
+
+
+def test_ctrl_c_stops_a_long_call_at_once(tmp_path):
+    import signal
+
+    code = ("import numpy as np, rubber_atlas as ra, sys; print('start', flush=True)\n"
+            "try:\n"
+            "    ra.cells(0.5, 3.0, 0.5, 0.5, np.linspace(0.05, 2, 400)[:, None], np.linspace(0.5, 4.5, 400), method='ode')\n"
+            "except KeyboardInterrupt:\n"
+            "    print('interrupted', flush=True); sys.exit(3)\n")
+    child = subprocess.Popen([sys.executable, "-c", code], cwd=tmp_path, stdout=subprocess.PIPE, text=True)
+    assert child.stdout.readline().strip() == "start"
+    time.sleep(1.0)
+    sent = time.perf_counter()
+    child.send_signal(signal.SIGINT)
+    out, _ = child.communicate(timeout=60)
+    assert child.returncode == 3 and "interrupted" in out
+    assert time.perf_counter() - sent < 2.0
+
+
 def test_bad_options_raise_value_errors():
     with pytest.raises(ValueError, match="omega"):
         ra.cells(0.5, 3, 0.5, 0.5, 0.5, 2.0, fields=["omega"])
@@ -244,7 +304,7 @@ def test_verdicts_equal_the_command():
     for i in range(2):
         expected = json.loads(run("verdict", "--alpha", float(alpha[i]), "--beta", float(beta[i]), "--nu", "0.5",
                                   "--eta", "0.5", "--resolution", "16", "--json"))
-        got = json.loads(str(found.verdict_json[i].item()))
+        got = json.loads(found.verdict_json[i].item())
         assert got == expected
         holds = int(found.holds[i])
         assert ({0: False, 1: True, 255: None}[holds]) == expected["holds"]

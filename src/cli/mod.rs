@@ -14,6 +14,7 @@ use anyhow::{Context, Result};
 use clap::{ArgGroup, Args, Parser, Subcommand, ValueEnum};
 use rubber_atlas::cf::AttrValue;
 use rubber_atlas::error::AtlasError;
+use rubber_atlas::machine::{available_memory, free_disk, show_bytes};
 use rubber_atlas::trajectory::Start;
 use rubber_atlas::EllipsoidBody;
 
@@ -322,36 +323,3 @@ pub(crate) fn command_line() -> String {
 pub(crate) const TABLE_EXTENSIONS: [&str; 3] = ["csv", "h5", "hdf5"];
 /// Atlases (`run`, `merge`).
 pub(crate) const ATLAS_EXTENSIONS: [&str; 2] = ["h5", "hdf5"];
-
-/// Bytes as a person reads them, one format throughout: 1.5 GB, 310.0 MB.
-pub(crate) fn show_bytes(bytes: f64) -> String {
-    let units = [("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("kB", 1e3)];
-    match units.iter().find(|(_, size)| bytes >= *size) {
-        Some((name, size)) => format!("{:.1} {name}", bytes / size),
-        None => format!("{bytes:.0} B"),
-    }
-}
-
-/// Memory the kernel could give this process now (MemAvailable), if it says.
-pub(crate) fn available_memory() -> Option<f64> {
-    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024.0)
-}
-
-/// Free space for an unprivileged user in the folder that will hold `out`.
-pub(crate) fn free_disk(out: &std::path::Path) -> Option<f64> {
-    use std::os::unix::ffi::OsStrExt;
-    let dir = match out.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => std::path::Path::new("."),
-    };
-    let c_path = std::ffi::CString::new(dir.as_os_str().as_bytes()).ok()?;
-    // SAFETY: statvfs fills the zeroed struct from a valid NUL-terminated path.
-    let mut stat: libc::statvfs = unsafe { std::mem::zeroed() };
-    if unsafe { libc::statvfs(c_path.as_ptr(), &mut stat) } != 0 {
-        return None;
-    }
-    Some(stat.f_bavail as f64 * stat.f_frsize as f64)
-}

@@ -250,6 +250,31 @@ impl AtlasFile {
             .ok()
     }
 
+    /// Whether the file's coordinates are those of its region of `scene`'s grid, value for
+    /// value: a shard file relabelled by hand (its shard attributes edited) is caught here.
+    pub fn coordinates_match(&self, scene: &Scene) -> bool {
+        let r = &self.region;
+        let [row, column] = scene.plane.axis_names();
+        let expected: [(&str, &[f64]); 4] = [
+            ("alpha", &scene.alpha.values[r.alpha.clone()]),
+            ("beta", &scene.beta.values[r.beta.clone()]),
+            (row, &scene.kappa.values[r.rows.clone()]),
+            (column, &scene.energy.values),
+        ];
+        expected.iter().all(|(name, want)| {
+            self.file
+                .dataset(name)
+                .and_then(|d| d.read_raw::<f64>())
+                .is_ok_and(|got| {
+                    got.len() == want.len()
+                        && got
+                            .iter()
+                            .zip(*want)
+                            .all(|(a, b)| a.to_bits() == b.to_bits())
+                })
+        })
+    }
+
     /// Writes a unit encoded by [`encode_unit`] (one chunk per variable) as HDF5 stores it.
     pub fn write_encoded(&self, unit: &Unit, encoded: &EncodedUnit) -> Result<()> {
         for ((v, d), bytes) in self
