@@ -508,14 +508,19 @@ fn merge_refuses_impossible_shard_attributes() {
     let outs = dir.path().join("out");
     std::fs::create_dir(&outs).unwrap();
     let out = outs.join("merged.h5");
-    for (name, value) in [
+    for (k, (name, value)) in [
         ("shard_index", 0i64),
         ("shard_index", 7),
         ("shard_index", -1),
         ("shard_count", 0),
         ("shard_count", 1 << 40),
-    ] {
-        let bad = dir.path().join("bad.h5");
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        // A file of its own each time: HDF5 locks a file it has open, and this process
+        // must never open one it may still hold.
+        let bad = dir.path().join(format!("bad-{k}.h5"));
         std::fs::copy(shard(2), &bad).unwrap();
         {
             let f = hdf5::File::open_rw(&bad).unwrap();
@@ -534,7 +539,7 @@ fn merge_refuses_impossible_shard_attributes() {
                 "--out",
                 out.to_str().unwrap(),
             ],
-            "bad.h5",
+            &format!("bad-{k}.h5"),
             Some(&out),
         );
     }
