@@ -45,8 +45,10 @@ fi
 # The package, built from this tree (no build isolation: maturin comes from requirements.txt)
 # and installed like any other, so that tests import it from site-packages.
 package_stamp="$venv/.package.sha"
-package_want="$(cd "$root" && find Cargo.toml Cargo.lock build.rs pyproject.toml src python/rubber_atlas \
-  -type f -not -name '*.pyc' -print0 | sort -z | xargs -0 sha256sum | sha256sum | cut -d' ' -f1)"
+# The sources, and the commit and dirty mark that build.rs bakes into git_commit.
+package_want="$(cd "$root" && { find Cargo.toml Cargo.lock build.rs pyproject.toml src python/rubber_atlas \
+  -type f -not -name '*.pyc' -print0 | sort -z | xargs -0 sha256sum; git rev-parse HEAD 2>/dev/null || true; \
+  git status --porcelain --untracked-files=no 2>/dev/null || true; } | sha256sum | cut -d' ' -f1)"
 if [ "$(cat "$package_stamp" 2>/dev/null || true)" != "$package_want" ] \
   || ! "$venv/bin/python" -c "import rubber_atlas" >/dev/null 2>&1; then
   echo "setup: building and installing the Python package rubber_atlas into .venv (maturin, release)"

@@ -22,7 +22,8 @@ pub const COMPONENT_SLOTS: usize = 3;
 const UNIT_CELLS: usize = 4096;
 
 /// A cell's status (`cell_status`): motion, no motion, the solver failed on it, or it was
-/// never computed in this file (a shard's cells of other shards: the file's fill value).
+/// never computed (the file's fill value for units not yet written: a finished file, whole
+/// or shard, computes every cell it holds).
 pub mod cell_status {
     pub const OK: u8 = 0;
     pub const NO_MOTION: u8 = 1;
@@ -768,17 +769,10 @@ pub struct CellPoint {
 /// Cells computed in this many at a time per rayon task.
 const POINTS_PER_TASK: usize = 64;
 
-/// Computes `points`, each with its own body, on the current rayon pool, into one block laid
-/// out as the atlas file lays out a row (the Python package's `cells`). Each cell is solved
-/// as `rubber-atlas cell` and `run` solve it, so the values are the same bit for bit. Every
-/// point is checked first: a bad one is refused, naming its index and value.
-pub fn compute_cells(
-    points: &[CellPoint],
-    variables: &[Variable],
-    options: &crate::cell::CellOptions,
-) -> Result<Block> {
-    options.validate()?;
-    let bodies = points
+/// The bodies of `points`, each point checked: a bad one is refused, naming its index and
+/// value.
+pub fn cell_bodies(points: &[CellPoint]) -> Result<Vec<crate::EllipsoidBody>> {
+    points
         .iter()
         .enumerate()
         .map(|(i, p)| {
@@ -792,7 +786,19 @@ pub fn compute_cells(
                 .map_err(at)?;
             crate::EllipsoidBody::ellipsoid(p.alpha, p.beta, p.nu, p.eta).map_err(at)
         })
-        .collect::<Result<Vec<_>>>()?;
+        .collect()
+}
+
+/// Computes `points` with their `bodies` ([`cell_bodies`]) on the current rayon pool, into
+/// one block laid out as the atlas file lays out a row (the Python package's `cells`). Each
+/// cell is solved as `rubber-atlas cell` and `run` solve it, so the values are the same bit
+/// for bit.
+pub fn compute_cells(
+    points: &[CellPoint],
+    bodies: &[crate::EllipsoidBody],
+    variables: &[Variable],
+    options: &crate::cell::CellOptions,
+) -> Block {
     let blocks: Vec<Block> = points
         .par_chunks(POINTS_PER_TASK)
         .zip(bodies.par_chunks(POINTS_PER_TASK))
@@ -818,7 +824,7 @@ pub fn compute_cells(
             block
         })
         .collect();
-    Ok(Block::concat(variables, blocks))
+    Block::concat(variables, blocks)
 }
 
 /// One cell of `block`: `solve` gives its components; `(kappa, energy)` are its κ and ε,

@@ -191,13 +191,16 @@ fn cells<'py>(
         drift: fields.iter().any(|f| f.needs_drift()),
         resonance_tol,
     };
+    options.validate().map_err(value_error)?;
+    let bodies = atlas::cell_bodies(&points).map_err(value_error)?;
     // In batches, between which Ctrl-C (KeyboardInterrupt) is heard; each cell is solved
     // on its own, so the batches do not change a value.
     let batch = (BATCH_PER_THREAD * threads_of(&pool)).max(1);
     let mut blocks = Vec::with_capacity(n.div_ceil(batch));
-    for chunk in points.chunks(batch) {
-        let block = in_pool(py, &pool, || atlas::compute_cells(chunk, &vars, &options))
-            .map_err(value_error)?;
+    for (chunk, chunk_bodies) in points.chunks(batch).zip(bodies.chunks(batch)) {
+        let block = in_pool(py, &pool, || {
+            atlas::compute_cells(chunk, chunk_bodies, &vars, &options)
+        });
         blocks.push(block);
         py.check_signals()?;
     }

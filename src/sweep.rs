@@ -251,7 +251,13 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
     request.shard.check_against(scene.shape())?;
     // Held until the file is in place and the journal gone.
     let _claim = crate::store::OutputLock::acquire(out)?;
-    let fingerprint = scene.fingerprint();
+    // The journal belongs to this scene, build and shard: a unit kept for one shard is
+    // chunked for that shard's file, and never taken by a run of another shard or the
+    // whole grid into the same output.
+    let fingerprint = crate::scene::fnv1a(
+        scene.fingerprint(),
+        format!("shard {}", request.shard).as_bytes(),
+    );
     if out.exists() && request.update && output_is_current(out, scene, request.shard) {
         return Ok(Summary {
             up_to_date: true,

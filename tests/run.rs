@@ -492,9 +492,9 @@ fn four_shards_merged_equal_a_single_run() {
     assert!(!refused.exists());
 }
 
-/// Issue 14 item 4: a shard file holds just its region of the grid (a range of its longest
-/// axis), every cell of it computed and equal to a single run's, so that xarray combines
-/// the shards by their coordinates.
+/// Issue 14 item 4: a shard file holds just its box of the grid (here half of the α values),
+/// every cell of it computed and equal to a single run's, so that xarray combines the
+/// shards by their coordinates.
 #[test]
 fn a_shard_file_holds_just_its_region_equal_to_a_single_run() {
     use rubber_atlas::atlas::cell_status;

@@ -97,9 +97,12 @@ def _broadcast(given: dict[str, object]) -> tuple[tuple[str, ...], list[np.ndarr
                                  f"along it: rename the dimension, or give {name} as a DataArray along {name!r}")
         layout = [b.transpose(*dims).values for b in broadcast]
         coords = {}
-        for (name, source), full in zip(arrays.items(), layout):
-            if name in dims:
-                continue
+        for name, source in arrays.items():
+            if name in dims and name in source.coords and not np.array_equal(
+                    np.asarray(source.coords[name].values, dtype=np.float64), source.values):
+                # The values computed at would differ from the labels shown.
+                raise ValueError(f"{name}: the DataArray's {name!r} coordinate differs from its values; "
+                                 "give the values as the coordinate, or none")
             coords[name] = (source.dims, source.values) if source.ndim else ((), source.values)
         for b in broadcast:
             for cname, c in b.coords.items():

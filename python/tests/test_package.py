@@ -158,6 +158,16 @@ def test_inputs_that_would_be_misread_are_refused():
     b = xr.DataArray([2.0, 3.0], dims="x", coords={"x": [1, 2]})
     with pytest.raises(ValueError, match="do not line up"):
         ra.cells(0.5, 3.0, 0.5, 0.5, a, b)
+    labelled = xr.DataArray([0.5, 0.8], dims="kappa", coords={"kappa": [1.0, 1.5]})
+    with pytest.raises(ValueError, match="coordinate differs from its values"):
+        ra.cells(0.5, 3.0, 0.5, 0.5, labelled, 2.5)
+    # Along its own dimension without a coordinate: its values become the coordinate.
+    bare = ra.cells(0.5, 3.0, 0.5, 0.5, xr.DataArray([0.5, 0.8], dims="kappa"), 2.5)
+    assert list(bare.kappa.values) == [0.5, 0.8] and bare.kappa.attrs["units"] == "1"
+    with pytest.raises(ValueError, match="cell 600: invalid energy = NaN"):
+        energies = np.full(700, 2.5)
+        energies[600] = np.nan
+        ra.cells(0.5, 3.0, 0.5, 0.5, 0.8, energies, threads=1)
     with pytest.raises(TypeError, match="kappa is None"):
         ra.cells(0.5, 3.0, 0.5, 0.5, None, 2.5)
     with pytest.raises(TypeError, match="complex"):
@@ -300,6 +310,9 @@ def test_verdicts_equal_the_command():
     alpha = xr.DataArray([0.5, 0.2], dims="body")
     beta = xr.DataArray([0.5, 3.0], dims="body")
     found = ra.verdict(alpha, beta, 0.5, 0.5, resolution=16)
+    # A body axis with its own name.
+    along = ra.verdict(xr.DataArray([0.5], dims="alpha"), 0.5, 0.5, 0.5, resolution=8)
+    assert along.holds.dims == ("alpha",) and float(along.alpha[0]) == 0.5
     assert found.holds.dims == ("body",) and found.holds.dtype == np.uint8
     for i in range(2):
         expected = json.loads(run("verdict", "--alpha", float(alpha[i]), "--beta", float(beta[i]), "--nu", "0.5",

@@ -113,7 +113,7 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
         &format!(
             "the run has {:.3e} cells: {}use fewer kappa or energy points",
             need.cells,
-            shards_to_fit(&need)
+            shards_to_fit(&scene, threads)
         ),
     )?;
     // The global pool, so that the run's serial parts (file creation, writing) stay on the
@@ -171,15 +171,28 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
     Ok(())
 }
 
-/// The shards a run would need for its largest slice to fit in half the available memory,
-/// as a phrase for the refusal ("" when one machine would do).
-pub(super) fn shards_to_fit(need: &sweep::Footprint) -> String {
-    let shards = available_memory().map_or(1.0, |free| (need.memory_bytes / (0.5 * free)).ceil());
-    if shards > 1.0 {
-        format!("split it with --shard I/N (N >= {shards:.0}) across machines, or ")
-    } else {
-        String::new()
-    }
+/// The smallest shard count that tiles the grid and whose shards each fit in half the
+/// available memory, as a phrase for the refusal ("" when none does, or one machine would).
+pub(super) fn shards_to_fit(scene: &Scene, threads: usize) -> String {
+    let Some(free) = available_memory() else {
+        return String::new();
+    };
+    let shape = scene.shape();
+    let most: usize = rubber_atlas::atlas::Region::positions(shape)
+        .iter()
+        .product();
+    (2..=most.min(1 << 20))
+        .map(|count| Shard { index: 1, count })
+        .find(|s| {
+            s.check_against(shape).is_ok()
+                && sweep::footprint(scene, *s, threads).memory_bytes <= 0.5 * free
+        })
+        .map_or_else(String::new, |s| {
+            format!(
+                "split it with --shard I/{} across machines (the fewest shards that fit), or ",
+                s.count
+            )
+        })
 }
 
 pub(super) fn print_summary(summary: &sweep::Summary, out: &std::path::Path, threads: usize) {

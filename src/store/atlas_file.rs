@@ -1,7 +1,8 @@
 //! The atlas file (SPEC §3.2): one HDF5 file per scene with the coordinates `alpha, beta,
 //! kappa, energy, component` as HDF5 dimension scales attached to every variable (so that
-//! xarray's h5netcdf engine shows named dimensions), CF-style attributes, and variables
-//! chunked one (α, β) slice per chunk and compressed.
+//! xarray's h5netcdf engine shows named dimensions), CF attributes, and variables chunked
+//! one work unit (whole κ-rows of one (α, β) slice) per chunk and compressed. A file holds
+//! a region of the scene's grid: all of it, or a shard's box.
 
 use super::h5::{attach_scale, describe, set_scale, text_attr, write_attr};
 use crate::atlas::{Block, Column, Kind, Region, Unit, Variable, COMPONENT_SLOTS, FLAG_FILL};
@@ -132,8 +133,8 @@ impl AtlasFile {
                     .shape([na, nb, nk, ne])
                     .create(v.name)?
             } else if per_cell {
-                // Where no unit was written (another shard's cells), `cell_status` reads
-                // `not_computed`, never `ok`; `n_components` reads 0.
+                // Where no unit was written yet, `cell_status` reads `not_computed`, never
+                // `ok`; `n_components` reads 0.
                 let fill = if v.name == "cell_status" {
                     crate::atlas::cell_status::NOT_COMPUTED
                 } else {
