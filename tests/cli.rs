@@ -710,7 +710,7 @@ fn requests_beyond_any_machine_are_refused_within_a_second() {
         Some(&out.join("none")),
     );
     for (args, needle) in [
-        (&run_scene[..], "--shard I/N"),
+        (&run_scene[..], "--shard I/"),
         (&diagram[..], "fewer --samples"),
         (&trajectory[..], "fewer --samples"),
     ] {

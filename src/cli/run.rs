@@ -172,7 +172,8 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
 }
 
 /// The smallest shard count that tiles the grid and whose shards each fit in half the
-/// available memory, as a phrase for the refusal ("" when none does, or one machine would).
+/// available memory, as a phrase for the refusal (the general advice when no count up to
+/// 2^20 does; "" when the machine's memory is unknown).
 pub(super) fn shards_to_fit(scene: &Scene, threads: usize) -> String {
     let Some(free) = available_memory() else {
         return String::new();
@@ -187,12 +188,15 @@ pub(super) fn shards_to_fit(scene: &Scene, threads: usize) -> String {
             s.check_against(shape).is_ok()
                 && sweep::footprint(scene, *s, threads).memory_bytes <= 0.5 * free
         })
-        .map_or_else(String::new, |s| {
-            format!(
-                "split it with --shard I/{} across machines (the fewest shards that fit), or ",
-                s.count
-            )
-        })
+        .map_or_else(
+            || "split it with --shard I/N across machines, or ".to_string(),
+            |s| {
+                format!(
+                    "split it with --shard I/{} across machines (the fewest shards that fit), or ",
+                    s.count
+                )
+            },
+        )
 }
 
 pub(super) fn print_summary(summary: &sweep::Summary, out: &std::path::Path, threads: usize) {
