@@ -35,17 +35,36 @@ pub fn free_disk(out: &std::path::Path) -> Option<f64> {
     Some(stat.f_bavail as f64 * stat.f_frsize as f64)
 }
 
+/// What is short when a request needs `bytes` of memory: over 80 % of what the kernel
+/// could give now, as "about X of memory (Y available)"; None when it fits or the kernel
+/// does not say.
+pub fn memory_short(bytes: f64) -> Option<String> {
+    let free = available_memory().filter(|&free| bytes > 0.8 * free)?;
+    Some(format!(
+        "about {} of memory ({} available)",
+        show_bytes(bytes),
+        show_bytes(free)
+    ))
+}
+
+/// What is short when writing `bytes` beside `out`: more than the free disk there, as "up to
+/// X of disk (Y free there)"; None when it fits or the file system does not say.
+pub fn disk_short(bytes: f64, out: &std::path::Path) -> Option<String> {
+    let free = free_disk(out).filter(|&free| bytes > free)?;
+    Some(format!(
+        "up to {} of disk ({} free there)",
+        show_bytes(bytes),
+        show_bytes(free)
+    ))
+}
+
 /// Refuses a request that needs `bytes` of memory when that is over 80 % of what the kernel
 /// could give now (unless `allow_large`): the one line says how much, what is available, and
 /// `remedy`.
 pub fn check_memory(bytes: f64, allow_large: bool, remedy: &str) -> crate::Result<()> {
-    match available_memory() {
-        Some(free) if !allow_large && bytes > 0.8 * free => Err(crate::AtlasError::TooLarge {
-            reason: format!(
-                "needs about {} of memory ({} available): {remedy}",
-                show_bytes(bytes),
-                show_bytes(free)
-            ),
+    match memory_short(bytes) {
+        Some(short) if !allow_large => Err(crate::AtlasError::TooLarge {
+            reason: format!("needs {short}: {remedy}"),
         }),
         _ => Ok(()),
     }

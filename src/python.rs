@@ -494,10 +494,11 @@ fn provenance(call: &str) -> Vec<(String, String)> {
         crate::cf::CONVENTIONS.to_string(),
     )];
     out.extend(
-        crate::store::provenance(call)
+        crate::store::program_attributes()
             .into_iter()
             .map(|(k, v)| (k, v.display())),
     );
+    out.push(("history".to_string(), crate::cf::history(call)));
     out
 }
 

@@ -298,9 +298,9 @@ fn write_hdf5(path: &Path, table: &Table) -> std::result::Result<(), String> {
         .map_err(|e| e.to_string())
 }
 
-/// The root attributes of a table written by a command: the program, its commit, and the
-/// CF `history` of `command_line`.
-pub fn provenance(command_line: &str) -> Vec<(String, AttrValue)> {
+/// The root attributes naming what made a file: the program, its version and its git
+/// commit (every atlas, table and Python result carries them).
+pub fn program_attributes() -> Vec<(String, AttrValue)> {
     vec![
         ("program".into(), AttrValue::Text("rubber-atlas".into())),
         (
@@ -311,6 +311,5 @@ pub fn provenance(command_line: &str) -> Vec<(String, AttrValue)> {
             "git_commit".into(),
             AttrValue::Text(env!("RUBBER_ATLAS_GIT_COMMIT").into()),
         ),
-        ("history".into(), AttrValue::Text(cf::history(command_line))),
     ]
 }

@@ -143,14 +143,12 @@ fn temporary_path(out: &Path) -> PathBuf {
 /// The root attributes every atlas file carries: provenance and the scene.
 fn scene_attributes(scene: &Scene, shard: Shard, units: usize) -> Vec<(String, AttrValue)> {
     let text = |s: &str| AttrValue::Text(s.to_string());
-    vec![
-        (
-            "title".into(),
-            text(&format!("rubber-atlas atlas of scene {}", scene.name)),
-        ),
-        ("program".into(), text("rubber-atlas")),
-        ("program_version".into(), text(env!("CARGO_PKG_VERSION"))),
-        ("git_commit".into(), text(env!("RUBBER_ATLAS_GIT_COMMIT"))),
+    let mut attributes = vec![(
+        "title".into(),
+        text(&format!("rubber-atlas atlas of scene {}", scene.name)),
+    )];
+    attributes.extend(crate::store::program_attributes());
+    attributes.extend([
         ("scene_name".into(), text(&scene.name)),
         ("scene".into(), text(&scene.text)),
         (
@@ -174,7 +172,8 @@ fn scene_attributes(scene: &Scene, shard: Shard, units: usize) -> Vec<(String, A
         ("shard_index".into(), AttrValue::Integer(shard.index as i64)),
         ("shard_count".into(), AttrValue::Integer(shard.count as i64)),
         ("unit_count".into(), AttrValue::Integer(units as i64)),
-    ]
+    ]);
+    attributes
 }
 
 fn borrowed(attributes: &[(String, AttrValue)]) -> Vec<(&str, AttrValue)> {

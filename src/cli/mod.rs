@@ -14,7 +14,7 @@ use anyhow::{Context, Result};
 use clap::{ArgGroup, Args, Parser, Subcommand, ValueEnum};
 use rubber_atlas::cf::AttrValue;
 use rubber_atlas::error::AtlasError;
-use rubber_atlas::machine::{available_memory, free_disk, show_bytes};
+use rubber_atlas::machine::{disk_short, memory_short};
 use rubber_atlas::trajectory::Start;
 use rubber_atlas::EllipsoidBody;
 
@@ -106,23 +106,10 @@ impl Limits {
         if self.allow_large {
             return Ok(());
         }
-        let mut short = Vec::new();
-        if let Some(free) = available_memory().filter(|&free| memory > 0.8 * free) {
-            short.push(format!(
-                "about {} of memory ({} available)",
-                show_bytes(memory),
-                show_bytes(free)
-            ));
-        }
-        if let (Some(disk), Some(out)) = (disk, out) {
-            if let Some(free) = free_disk(out).filter(|&free| disk > free) {
-                short.push(format!(
-                    "up to {} of disk ({} free there)",
-                    show_bytes(disk),
-                    show_bytes(free)
-                ));
-            }
-        }
+        let short: Vec<String> = memory_short(memory)
+            .into_iter()
+            .chain(disk.zip(out).and_then(|(disk, out)| disk_short(disk, out)))
+            .collect();
         if short.is_empty() {
             return Ok(());
         }
@@ -263,12 +250,11 @@ pub(crate) fn invocation_attributes() -> Vec<(String, AttrValue)> {
     ]
 }
 
-/// The root attributes of a table: provenance (program, commit, history, command line)
-/// and `own`, the command's parameters (numbers as numbers).
+/// The root attributes of a table: the program and its commit, the command's invocation
+/// ([`invocation_attributes`]) and `own`, the command's parameters (numbers as numbers).
 pub(crate) fn table_attributes(own: &[(&str, AttrValue)]) -> Vec<(String, AttrValue)> {
-    let command = command_line();
-    let mut attributes = rubber_atlas::store::provenance(&command);
-    attributes.push(("command_line".into(), AttrValue::Text(command)));
+    let mut attributes = rubber_atlas::store::program_attributes();
+    attributes.extend(invocation_attributes());
     attributes.extend(own.iter().map(|(k, v)| (k.to_string(), v.clone())));
     attributes
 }

@@ -175,7 +175,7 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
 /// available memory, as a phrase for the refusal (the general advice when no count up to
 /// 2^20 does; "" when the machine's memory is unknown).
 pub(super) fn shards_to_fit(scene: &Scene, threads: usize) -> String {
-    let Some(free) = available_memory() else {
+    let Some(free) = rubber_atlas::machine::available_memory() else {
         return String::new();
     };
     let shape = scene.shape();
