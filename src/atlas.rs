@@ -2,20 +2,25 @@
 //! slice), computes them with rayon one κ-row at a time, and lays the results out as the
 //! dense per-cell and per-component arrays of the atlas file (SPEC §3.2).
 
+use crate::body::Ellipsoid;
 #[cfg(test)]
 use crate::cell::CellOptions;
-use crate::cell::{solve_high_energy_limit, solve_level, CellResult, ComponentResult, Status};
+use crate::cell::{
+    high_energy_families, solve_high_energy_limit, solve_level, CellResult, ComponentResult, Status,
+};
 use crate::cf::{self, Units};
 use crate::error::{AtlasError, Result};
+use crate::family::{Census, ComponentAxis, Family};
 use crate::scene::{Field, Plane, Scene};
 use crate::torus::{EffectivePotential, MotionKind};
+use crate::EllipsoidBody;
 use rayon::prelude::*;
 use std::ops::Range;
 
-/// Component slots per cell. {V ≤ ε} has one component per well of V, and V has at most two
-/// minima for an ellipsoid of revolution (paper §4: σ_s0 and σ_sπ of type (c); θ* and its
-/// mirror at κ = 0); the third slot is a margin. A cell with more components is marked
-/// `failed` and keeps its first three.
+/// Component slots per cell in the θ_min layout before the census trims them. {V ≤ ε} has
+/// one component per well of V, and V has at most two minima for an ellipsoid of revolution
+/// (paper §4: σ_s0 and σ_sπ of type (c); θ* and its mirror at κ = 0); the third slot is a
+/// margin. A cell with more components is marked `failed` and keeps its first three.
 pub const COMPONENT_SLOTS: usize = 3;
 
 /// Cells per work unit, about: the unit of resume and of sharding.
@@ -78,10 +83,7 @@ pub fn coordinate(name: &str) -> Option<(&'static str, Units)> {
             "energy, the value of the reduced energy integral",
             cf::ENERGY,
         ),
-        "component" => (
-            "component of the allowed set, in increasing theta_min",
-            cf::NUMBER,
-        ),
+        "component" => ("component (torus family, or rank in theta_min)", cf::NUMBER),
         _ => return None,
     })
 }
@@ -106,8 +108,9 @@ impl Kind {
         matches!(self, Kind::CellFlag | Kind::CellValue)
     }
 
-    /// Bytes per cell of a variable of this kind, uncompressed.
-    pub fn bytes_per_cell(self) -> usize {
+    /// Bytes per cell of a variable of this kind with `slots` component slots,
+    /// uncompressed.
+    pub fn bytes_per_cell(self, slots: usize) -> usize {
         let value = match self {
             Kind::Value | Kind::CellValue => 8,
             Kind::Flag | Kind::CellFlag => 1,
@@ -115,7 +118,16 @@ impl Kind {
         if self.per_cell() {
             value
         } else {
-            value * COMPONENT_SLOTS
+            value * slots
+        }
+    }
+
+    /// Values per cell with `slots` component slots.
+    pub fn values_per_cell(self, slots: usize) -> usize {
+        if self.per_cell() {
+            1
+        } else {
+            slots
         }
     }
 }
@@ -223,6 +235,12 @@ pub fn variables(fields: &[Field]) -> Vec<Variable> {
             flags: Some((&cell_status::VALUES, cell_status::MEANINGS)),
             value: |_| 0.0,
         },
+        flag(
+            "family",
+            "torus family",
+            (&Family::VALUES, Family::MEANINGS),
+            |c| f64::from(c.family.code()),
+        ),
     ];
     for &field in fields {
         let (var, error): (Variable, Option<Variable>) = match field {
@@ -387,10 +405,10 @@ pub enum Column {
 }
 
 impl Column {
-    fn new(kind: Kind, len: usize) -> Column {
+    fn new(kind: Kind, len: usize, slots: usize) -> Column {
         match kind {
-            Kind::Value => Column::F64(vec![f64::NAN; len * COMPONENT_SLOTS]),
-            Kind::Flag => Column::U8(vec![FLAG_FILL; len * COMPONENT_SLOTS]),
+            Kind::Value => Column::F64(vec![f64::NAN; len * slots]),
+            Kind::Flag => Column::U8(vec![FLAG_FILL; len * slots]),
             Kind::CellFlag => Column::U8(vec![0; len]),
             Kind::CellValue => Column::F64(vec![f64::NAN; len]),
         }
@@ -410,33 +428,32 @@ impl Column {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Block {
     pub cells: usize,
+    /// Component slots per cell.
+    pub slots: usize,
     pub columns: Vec<Column>,
 }
 
 impl Block {
-    /// A block of `cells` cells with every value at its fill.
-    pub fn empty(variables: &[Variable], cells: usize) -> Block {
+    /// A block of `cells` cells with `slots` component slots, every value at its fill.
+    pub fn empty(variables: &[Variable], cells: usize, slots: usize) -> Block {
         Block {
             cells,
+            slots,
             columns: variables
                 .iter()
-                .map(|v| Column::new(v.kind, cells))
+                .map(|v| Column::new(v.kind, cells, slots))
                 .collect(),
         }
     }
 
     /// The blocks one after the other (allocated once: growing by appends would leave the
     /// heap fragmented with slice-sized holes).
-    pub fn concat(variables: &[Variable], blocks: Vec<Block>) -> Block {
+    pub fn concat(variables: &[Variable], slots: usize, blocks: Vec<Block>) -> Block {
         let cells: usize = blocks.iter().map(|b| b.cells).sum();
         let mut columns: Vec<Column> = variables
             .iter()
             .map(|v| {
-                let n = if v.kind.per_cell() {
-                    cells
-                } else {
-                    cells * COMPONENT_SLOTS
-                };
+                let n = cells * v.kind.values_per_cell(slots);
                 match v.kind {
                     Kind::Value | Kind::CellValue => Column::F64(Vec::with_capacity(n)),
                     Kind::Flag | Kind::CellFlag => Column::U8(Vec::with_capacity(n)),
@@ -444,11 +461,38 @@ impl Block {
             })
             .collect();
         for b in blocks {
+            debug_assert_eq!(b.slots, slots);
             for (a, c) in columns.iter_mut().zip(b.columns) {
                 a.append(c);
             }
         }
-        Block { cells, columns }
+        Block {
+            cells,
+            slots,
+            columns,
+        }
+    }
+
+    /// The block with only the component slots `keep` (in that order).
+    pub fn select_slots(self, variables: &[Variable], keep: &[usize]) -> Block {
+        let slots = self.slots;
+        let pick = |len: usize| {
+            (0..len / slots).flat_map(move |cell| keep.iter().map(move |&k| cell * slots + k))
+        };
+        let columns = variables
+            .iter()
+            .zip(self.columns)
+            .map(|(v, column)| match (v.kind.per_cell(), column) {
+                (true, c) => c,
+                (false, Column::F64(x)) => Column::F64(pick(x.len()).map(|i| x[i]).collect()),
+                (false, Column::U8(x)) => Column::U8(pick(x.len()).map(|i| x[i]).collect()),
+            })
+            .collect();
+        Block {
+            cells: self.cells,
+            slots: keep.len(),
+            columns,
+        }
     }
 
     /// The u8 values of the variable `name`, if it is among `variables`.
@@ -688,71 +732,126 @@ impl std::fmt::Display for Shard {
     }
 }
 
+/// How one cell of a scene's grid is solved: at its level of V, or (s = 0 of the compact
+/// plane) in the high-energy limit at its λ.
+enum CellLevel<'p, 'b> {
+    Level(&'p EffectivePotential<'b, Ellipsoid>, f64),
+    HighEnergy(f64),
+}
+
+/// Visits the cells of κ-row `row` of a scene's slice with body `body`, column by column:
+/// `visit(column, (κ, ε), level)`. Every cell's κ and ε are formed here alone, for the
+/// census and the computation alike.
+fn visit_row(
+    scene: &Scene,
+    body: &EllipsoidBody,
+    row: usize,
+    mut visit: impl FnMut(usize, (f64, f64), CellLevel<'_, '_>),
+) {
+    let row_value = scene.kappa.values[row];
+    let columns = &scene.energy.values;
+    match scene.plane {
+        Plane::KappaEnergy | Plane::KappaExcess => {
+            let potential = EffectivePotential::new(body, row_value);
+            // The excess energy is measured from the bottom of V at this κ.
+            let base = match scene.plane {
+                Plane::KappaExcess => potential.lowest_minimum().unwrap_or(f64::NAN),
+                _ => 0.0,
+            };
+            for (j, &column) in columns.iter().enumerate() {
+                let energy = if scene.plane == Plane::KappaExcess {
+                    base + column
+                } else {
+                    column
+                };
+                visit(j, (row_value, energy), CellLevel::Level(&potential, energy));
+            }
+        }
+        Plane::Compact => {
+            // κ = λ/s, ε = 1/s²: every cell has its own κ; s = 0 is ε = ∞.
+            for (j, &s) in columns.iter().enumerate() {
+                if s == 0.0 {
+                    visit(
+                        j,
+                        (f64::INFINITY, f64::INFINITY),
+                        CellLevel::HighEnergy(row_value),
+                    );
+                } else {
+                    let (kappa, energy) = (row_value / s, 1.0 / (s * s));
+                    let potential = EffectivePotential::new(body, kappa);
+                    visit(j, (kappa, energy), CellLevel::Level(&potential, energy));
+                }
+            }
+        }
+    }
+}
+
+/// What the whole grid of `scene` holds (the families and the most components of a cell),
+/// from V's critical points alone, rows shared out by rayon: enough to lay out the
+/// component axis before any cell is computed. The same for every shard of the grid.
+pub fn census(scene: &Scene) -> Census {
+    let [na, nb, nk, _] = scene.shape();
+    (0..na * nb * nk)
+        .into_par_iter()
+        .with_max_len(1)
+        .map(|i| {
+            let (slice, row) = (i / nk, i % nk);
+            let body = scene.body(slice / nb, slice % nb);
+            let mut census = Census::default();
+            visit_row(scene, &body, row, |_, _, level| {
+                census.add(&match level {
+                    CellLevel::Level(potential, energy) => {
+                        potential.families(energy).unwrap_or_default()
+                    }
+                    CellLevel::HighEnergy(lambda) => high_energy_families(&body, lambda),
+                });
+            });
+            census
+        })
+        .reduce(Census::default, Census::merge)
+}
+
+/// The component axis of `scene`'s file: its layout over the families and counts its
+/// [`census`] finds.
+pub fn component_axis(scene: &Scene) -> ComponentAxis {
+    ComponentAxis::of(scene.layout, &census(scene))
+}
+
 /// Computes the κ-rows `rows` (in that order) of slice (ia, ib), rows shared out by rayon one
-/// at a time (rows differ several-fold in cost); `progress` is called with the number of
-/// cells after each row. Every cell is computed on its own, so the values do not depend on
-/// the number of threads or on which rows are computed together.
+/// at a time (rows differ several-fold in cost), into the slots of `axis`; `progress` is
+/// called with the number of cells after each row. Every cell is computed on its own, so
+/// the values do not depend on the number of threads or on which rows are computed
+/// together.
 pub fn compute_rows(
     scene: &Scene,
     variables: &[Variable],
+    axis: &ComponentAxis,
     alpha_index: usize,
     beta_index: usize,
     rows: &[usize],
     progress: &(dyn Fn(usize) + Sync),
 ) -> Block {
     let body = scene.body(alpha_index, beta_index);
-    let columns = &scene.energy.values;
+    let columns = scene.energy.values.len();
     let options = &scene.options;
     let blocks: Vec<Block> = rows
         .par_iter()
         .with_max_len(1)
         .map(|&row| {
-            let row_value = scene.kappa.values[row];
-            let mut block = Block::empty(variables, columns.len());
-            match scene.plane {
-                Plane::KappaEnergy | Plane::KappaExcess => {
-                    let potential = EffectivePotential::new(&body, row_value);
-                    // The excess energy is measured from the bottom of V at this κ.
-                    let base = match scene.plane {
-                        Plane::KappaExcess => potential.lowest_minimum().unwrap_or(f64::NAN),
-                        _ => 0.0,
-                    };
-                    for (j, &column) in columns.iter().enumerate() {
-                        let energy = if scene.plane == Plane::KappaExcess {
-                            base + column
-                        } else {
-                            column
-                        };
-                        fill_cell(&mut block, variables, j, (row_value, energy), || {
-                            solve_level(&potential, energy, options)
-                        });
+            let mut block = Block::empty(variables, columns, axis.len());
+            visit_row(scene, &body, row, |j, point, level| {
+                fill_cell(&mut block, variables, axis, j, point, || match level {
+                    CellLevel::Level(potential, energy) => solve_level(potential, energy, options),
+                    CellLevel::HighEnergy(lambda) => {
+                        solve_high_energy_limit(&body, lambda, options)
                     }
-                }
-                Plane::Compact => {
-                    // κ = λ/s, ε = 1/s²: every cell has its own κ; s = 0 is ε = ∞.
-                    for (j, &s) in columns.iter().enumerate() {
-                        if s == 0.0 {
-                            fill_cell(
-                                &mut block,
-                                variables,
-                                j,
-                                (f64::INFINITY, f64::INFINITY),
-                                || solve_high_energy_limit(&body, row_value, options),
-                            );
-                        } else {
-                            let (kappa, energy) = (row_value / s, 1.0 / (s * s));
-                            fill_cell(&mut block, variables, j, (kappa, energy), || {
-                                solve_level(&EffectivePotential::new(&body, kappa), energy, options)
-                            });
-                        }
-                    }
-                }
-            }
-            progress(columns.len());
+                });
+            });
+            progress(columns);
             block
         })
         .collect();
-    Block::concat(variables, blocks)
+    Block::concat(variables, axis.len(), blocks)
 }
 
 /// One cell given by all its numbers: the body (α, β, ν, η) and the level (κ, ε).
@@ -797,13 +896,14 @@ pub fn compute_cells(
     points: &[CellPoint],
     bodies: &[crate::EllipsoidBody],
     variables: &[Variable],
+    axis: &ComponentAxis,
     options: &crate::cell::CellOptions,
 ) -> Block {
     let blocks: Vec<Block> = points
         .par_chunks(POINTS_PER_TASK)
         .zip(bodies.par_chunks(POINTS_PER_TASK))
         .map(|(points, bodies)| {
-            let mut block = Block::empty(variables, points.len());
+            let mut block = Block::empty(variables, points.len(), axis.len());
             // Consecutive cells of one body and κ (a row of a grid) share V's critical
             // points, as the cells of an atlas row do: found once.
             let mut row: Option<(usize, EffectivePotential<'_, _>)> = None;
@@ -817,21 +917,25 @@ pub fn compute_cells(
                     row = Some((j, EffectivePotential::new(body, p.kappa)));
                 }
                 let potential = &row.as_ref().expect("set above").1;
-                fill_cell(&mut block, variables, j, (p.kappa, p.energy), || {
+                fill_cell(&mut block, variables, axis, j, (p.kappa, p.energy), || {
                     solve_level(potential, p.energy, options)
                 });
             }
             block
         })
         .collect();
-    Block::concat(variables, blocks)
+    Block::concat(variables, axis.len(), blocks)
 }
 
-/// One cell of `block`: `solve` gives its components; `(kappa, energy)` are its κ and ε,
-/// written where they are auxiliary coordinates.
+/// One cell of `block`: `solve` gives its components, laid out in the slots of `axis`;
+/// `(kappa, energy)` are its κ and ε, written where they are auxiliary coordinates. The cell
+/// is marked `failed` (keeping what fits) where a component has no slot, or where two
+/// components of one family meet away from κ = 0; at κ = 0 the mirror images of one family
+/// (the body leaning either way) share its slot, the one at larger θ kept.
 fn fill_cell(
     block: &mut Block,
     variables: &[Variable],
+    axis: &ComponentAxis,
     cell: usize,
     (kappa, energy): (f64, f64),
     solve: impl FnOnce() -> Result<CellResult>,
@@ -839,12 +943,23 @@ fn fill_cell(
     // A panic in the solver is a bug, but one cell must not end a run of millions: it is
     // recorded as a failed cell.
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(solve));
-    let (status, components) = match result {
+    let (mut status, components) = match result {
         Ok(Ok(c)) if c.status == Status::NoMotion => (cell_status::NO_MOTION, Vec::new()),
-        Ok(Ok(c)) if c.components.len() > COMPONENT_SLOTS => (cell_status::FAILED, c.components),
         Ok(Ok(c)) => (cell_status::OK, c.components),
         Ok(Err(_)) | Err(_) => (cell_status::FAILED, Vec::new()),
     };
+    let mut placed: Vec<(usize, &ComponentResult)> = Vec::with_capacity(components.len());
+    for (index, c) in components.iter().enumerate() {
+        match axis.slot(index, c.family) {
+            Some(slot) => match placed.iter_mut().find(|(s, _)| *s == slot) {
+                Some(twin) if kappa == 0.0 => twin.1 = c,
+                Some(_) => status = cell_status::FAILED,
+                None => placed.push((slot, c)),
+            },
+            None => status = cell_status::FAILED,
+        }
+    }
+    let slots = axis.len();
     for (var, column) in variables.iter().zip(block.columns.iter_mut()) {
         match (var.kind, column) {
             (Kind::CellFlag, Column::U8(v)) => {
@@ -858,14 +973,14 @@ fn fill_cell(
                 v[cell] = if var.name == "kappa" { kappa } else { energy };
             }
             (Kind::Value, Column::F64(v)) => {
-                for (slot, c) in components.iter().take(COMPONENT_SLOTS).enumerate() {
-                    v[cell * COMPONENT_SLOTS + slot] = (var.value)(c);
+                for &(slot, c) in &placed {
+                    v[cell * slots + slot] = (var.value)(c);
                 }
             }
             (Kind::Flag, Column::U8(v)) => {
-                for (slot, c) in components.iter().take(COMPONENT_SLOTS).enumerate() {
+                for &(slot, c) in &placed {
                     let x = (var.value)(c);
-                    v[cell * COMPONENT_SLOTS + slot] = if x.is_nan() { FLAG_FILL } else { x as u8 };
+                    v[cell * slots + slot] = if x.is_nan() { FLAG_FILL } else { x as u8 };
                 }
             }
             _ => unreachable!("a column matches its variable's kind"),
@@ -882,11 +997,12 @@ mod tests {
         let body = crate::EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 0.5).unwrap();
         let potential = EffectivePotential::new(&body, 0.8);
         let variables = variables(&Field::ALL);
-        let mut block = Block::empty(&variables, 3);
+        let axis = ComponentAxis::full(crate::family::Layout::ThetaMin, COMPONENT_SLOTS);
+        let mut block = Block::empty(&variables, 3, axis.len());
         let options = CellOptions::default();
         // A NaN energy makes the solver return an error; the cells around it are solved.
         for (cell, energy) in [2.5, f64::NAN, 0.1].into_iter().enumerate() {
-            fill_cell(&mut block, &variables, cell, (0.8, energy), || {
+            fill_cell(&mut block, &variables, &axis, cell, (0.8, energy), || {
                 solve_level(&potential, energy, &options)
             });
         }

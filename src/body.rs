@@ -153,6 +153,12 @@ pub trait Shape: Send + Sync {
         c2 - c1 * a.cos
     }
 
+    /// Whether the body is its own mirror image in its equatorial plane (U(π − θ) = U(θ)):
+    /// then V has a critical point at θ = π/2 for every κ.
+    fn symmetric_about_equator(&self) -> bool {
+        false
+    }
+
     /// The smallest angular scale (in radians) on which U, B and J vary: numerical rules
     /// need steps below it before their convergence tests can be trusted.
     fn angular_feature_scale(&self) -> f64 {
@@ -248,6 +254,11 @@ impl Ellipsoid {
 }
 
 impl Shape for Ellipsoid {
+    /// α = 0: the centre of mass at the geometric centre.
+    fn symmetric_about_equator(&self) -> bool {
+        self.alpha == 0.0
+    }
+
     /// χ1 = −β²/Z, χ2 = −cosθ/Z − α (paper §3, remark after `r`, in units of b3).
     fn chi(&self, theta: f64) -> (f64, f64) {
         let z = self.centre_height(theta);

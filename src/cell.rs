@@ -5,6 +5,7 @@
 
 use crate::body::{Body, Shape};
 use crate::error::{AtlasError, Result};
+use crate::family::Family;
 use crate::period_ode;
 use crate::torus::{
     Component, CriticalKind, CriticalPoint, EffectivePotential, MotionKind, PeriodIntegrals,
@@ -124,6 +125,8 @@ pub struct ComponentResult {
     pub bounded: Option<bool>,
     /// Libration, fixed point or rotation (rolling over the top at κ = 0).
     pub motion: MotionKind,
+    /// The family of tori the component belongs to (by the wells of V it encloses).
+    pub family: Family,
     /// How to read the values.
     pub status: Status,
     /// Estimated absolute error of the rotation number N (the headline value).
@@ -203,6 +206,7 @@ pub fn solve_high_energy_limit<S: Shape>(
         } else {
             MotionKind::Libration
         },
+        family: high_energy_families(body, lambda)[0],
         status: Status::HighEnergyLimit,
         error_estimate: n.error,
         errors: ErrorEstimates {
@@ -216,6 +220,19 @@ pub fn solve_high_energy_limit<S: Shape>(
         drift_vector: [f64::NAN; 2],
         work: 0,
     }]))
+}
+
+/// The families of the cell at ε = ∞ with λ = κ/√ε fixed (see [`solve_high_energy_limit`]):
+/// none beyond λ = √2, rolling over the top at λ = 0 (κ = 0), else the single well of V at
+/// κ → ∞ ([`crate::limits::high_energy_family`]).
+pub fn high_energy_families<S: Shape>(body: &Body<S>, lambda: f64) -> Vec<Family> {
+    if !(0.0..=std::f64::consts::SQRT_2).contains(&lambda) {
+        Vec::new()
+    } else if lambda == 0.0 {
+        vec![Family::OverTheTop]
+    } else {
+        vec![crate::limits::high_energy_family(body)]
+    }
 }
 
 /// One cell, found from scratch (for many cells at one (body, κ), build the
@@ -547,6 +564,7 @@ fn finish(component: &Component, raw: PeriodIntegrals, options: &CellOptions) ->
         drift_radius,
         bounded,
         motion: component.kind,
+        family: component.family,
         status: if ok {
             Status::Ok
         } else {
@@ -581,6 +599,7 @@ fn unresolved(component: &Component) -> ComponentResult {
         drift_radius: f64::NAN,
         bounded: None,
         motion: component.kind,
+        family: component.family,
         status: Status::ToleranceNotReached,
         error_estimate: f64::INFINITY,
         errors: unknown,
@@ -663,6 +682,7 @@ fn on_separatrix<S: Shape>(
         // The motion tends to the unstable permanent rotation (a circle) or equilibrium.
         bounded: options.drift.then_some(true),
         motion: component.kind,
+        family: component.family,
         status: Status::Separatrix,
         error_estimate: 0.0,
         errors: ErrorEstimates {
@@ -722,6 +742,7 @@ fn fixed_point<S: Shape>(
         // A permanent rotation runs round a circle: bounded unless the circle is a line.
         bounded: options.drift.then_some(radius.is_finite()),
         motion: MotionKind::FixedPoint,
+        family: component.family,
         status: Status::FixedPoint,
         error_estimate: rel * n.abs(),
         errors: ErrorEstimates {

@@ -17,6 +17,8 @@
 //! - [`limits`]: the edges of the (κ, ε) plane — the high-energy limit N∞(λ), the bottom of
 //!   each well, κ → 0 and the separatrices.
 //! - [`torus`]: one level set (κ, ε): its components, turning points, period and precession.
+//! - [`family`]: the families of tori (the wells a component encloses) and the layouts of an
+//!   atlas's component axis.
 //! - [`trajectory`]: time histories from either model; [`ode`] wraps the DOP853 integrator.
 //! - [`resonance`]: curves N = p/q by continuation, and the fold κ_max.
 //! - [`verdict`]: the boundedness hypothesis for one body over the whole (κ, ε) plane, and
@@ -41,6 +43,7 @@ pub mod cell;
 pub mod cf;
 pub mod critical;
 pub mod error;
+pub mod family;
 pub mod full;
 pub mod limits;
 pub mod machine;

@@ -195,6 +195,22 @@ fn turning_cosine(lambda: f64) -> f64 {
         .sqrt()
 }
 
+/// The family of the tori at large κ (and of the high-energy limit at λ > 0, where κ = λ√ε
+/// → ∞): there the κ²/(2 sin²θ) term makes V a single well round θ = π/2, on the side U
+/// descends to (U′(π/2) < 0: θ > π/2, the well of σ_sπ for α > 0), or at π/2 itself for a
+/// body symmetric about its equator. The tori above a saddle belong to this family too.
+pub fn high_energy_family<S: Shape>(body: &Body<S>) -> crate::family::Family {
+    use crate::family::Family;
+    let slope = body.shape.potential_prime_at(Angle::new(FRAC_PI_2));
+    if body.shape.symmetric_about_equator() || slope == 0.0 {
+        Family::WellEquator
+    } else if slope < 0.0 {
+        Family::WellPi
+    } else {
+        Family::Well0
+    }
+}
+
 /// N∞(λ): the rotation number in the limit ε → ∞ at fixed λ = κ/√ε, for 0 ≤ λ ≤ √2 (the
 /// allowed set is sinθ ≥ λ/√2), to the absolute accuracy `tol`.
 pub fn high_energy_rotation_number<S: Shape>(

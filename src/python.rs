@@ -8,6 +8,7 @@ use crate::atlas::{self, CellPoint, Column, Kind, COMPONENT_SLOTS};
 use crate::cell::{CellOptions, Method};
 use crate::critical::CriticalSet;
 use crate::error::AtlasError;
+use crate::family::{ComponentAxis, Layout};
 use crate::resonance::{trace_curves, ResonanceOptions};
 use crate::scene::Field;
 use crate::table::{Table, Values};
@@ -126,10 +127,12 @@ fn variables(py: Python<'_>, fields: Option<Vec<String>>) -> PyResult<Bound<'_, 
 }
 
 /// Solves cells given by six equal-length arrays, in parallel with the GIL released. Returns
-/// the values of every variable of `fields` as (name, flat array) pairs, in file order; a
-/// per-component variable has `COMPONENT_SLOTS` values per cell, slot fastest.
+/// a dict: `columns`, the values of every variable of `fields` as (name, flat array) pairs
+/// in file order (a per-component variable has one value per cell and component slot, slot
+/// fastest); `component`, the labels of the slots (the families present, or the ranks in
+/// θ_min up to the most components of a cell: no slot is empty in every cell); `layout`.
 #[pyfunction]
-#[pyo3(signature = (alpha, beta, nu, eta, kappa, energy, tol, method, resonance_tol, fields=None, threads=None, allow_large=false))]
+#[pyo3(signature = (alpha, beta, nu, eta, kappa, energy, tol, method, resonance_tol, fields=None, threads=None, allow_large=false, layout="family"))]
 #[allow(clippy::too_many_arguments)]
 fn cells<'py>(
     py: Python<'py>,
@@ -145,7 +148,10 @@ fn cells<'py>(
     fields: Option<Vec<String>>,
     threads: Option<i64>,
     allow_large: bool,
-) -> PyResult<Bound<'py, PyList>> {
+    layout: &str,
+) -> PyResult<Bound<'py, PyDict>> {
+    let layout = Layout::from_name(layout)
+        .ok_or_else(|| bad(format!("layout {layout:?}: use {}", Layout::NAMES)))?;
     let arrays = [&alpha, &beta, &nu, &eta, &kappa, &energy];
     let slices = arrays
         .iter()
@@ -160,7 +166,9 @@ fn cells<'py>(
     let fields = parse_fields(fields)?;
     let vars = atlas::variables(&fields);
     // The points, the blocks and their concatenation: about twice the output per cell.
-    let per_cell: usize = vars.iter().map(|v| v.kind.bytes_per_cell()).sum();
+    // Room for every slot of the layout while computing; the empty ones are dropped after.
+    let room = ComponentAxis::full(layout, COMPONENT_SLOTS);
+    let per_cell: usize = vars.iter().map(|v| v.kind.bytes_per_cell(room.len())).sum();
     check_memory(
         n as f64 * (std::mem::size_of::<CellPoint>() + 2 * per_cell) as f64,
         allow_large,
@@ -199,12 +207,35 @@ fn cells<'py>(
     let mut blocks = Vec::with_capacity(n.div_ceil(batch));
     for (chunk, chunk_bodies) in points.chunks(batch).zip(bodies.chunks(batch)) {
         let block = in_pool(py, &pool, || {
-            atlas::compute_cells(chunk, chunk_bodies, &vars, &options)
+            atlas::compute_cells(chunk, chunk_bodies, &vars, &room, &options)
         });
         blocks.push(block);
         py.check_signals()?;
     }
-    let block = atlas::Block::concat(&vars, blocks);
+    let block = atlas::Block::concat(&vars, room.len(), blocks);
+    // The slots some cell holds.
+    let family = block
+        .flags(&vars, "family")
+        .expect("family is always written");
+    let used: Vec<usize> = (0..room.len())
+        .filter(|&k| {
+            family
+                .iter()
+                .skip(k)
+                .step_by(room.len())
+                .any(|&f| f != atlas::FLAG_FILL)
+        })
+        .collect();
+    let axis = if used.is_empty() {
+        // No motion anywhere: one empty slot, as in a file.
+        ComponentAxis::of(layout, &Default::default())
+    } else {
+        ComponentAxis {
+            layout,
+            labels: used.iter().map(|&k| room.labels[k]).collect(),
+        }
+    };
+    let block = block.select_slots(&vars, if used.is_empty() { &[0] } else { &used });
     let list = PyList::empty(py);
     for (v, column) in vars.iter().zip(block.columns) {
         let array = match column {
@@ -213,7 +244,15 @@ fn cells<'py>(
         };
         list.append((v.name, array))?;
     }
-    Ok(list)
+    let out = PyDict::new(py);
+    out.set_item("columns", list)?;
+    out.set_item("component", axis.labels.clone())?;
+    out.set_item("layout", layout.name())?;
+    if let Some((values, meanings)) = axis.flag_attributes() {
+        out.set_item("flag_values", values)?;
+        out.set_item("flag_meanings", meanings)?;
+    }
+    Ok(out)
 }
 
 /// A table as a dict: `dimension`, `columns` (dicts of name, values, long_name, units,

@@ -4,6 +4,7 @@
 
 use crate::cell::{CellOptions, Method};
 use crate::error::{AtlasError, Result};
+use crate::family::Layout;
 use crate::EllipsoidBody;
 use std::path::Path;
 use toml::{Table, Value};
@@ -179,6 +180,9 @@ pub struct Scene {
     pub options: CellOptions,
     /// The outputs asked for, in file order; `status` is always among them.
     pub fields: Vec<Field>,
+    /// How the component axis is laid out (`[outputs] layout`): by torus family (the
+    /// default) or by increasing θ_min.
+    pub layout: Layout,
     /// The scene file's text, kept verbatim in the atlas for provenance and for resume and
     /// merge to check that they continue the same scene.
     pub text: String,
@@ -569,6 +573,7 @@ impl Scene {
         }
 
         let mut fields: Vec<Field> = Field::ALL.to_vec();
+        let mut layout = Layout::default();
         if let Some(v) = root.get("outputs") {
             let Value::Table(outputs) = v else {
                 return Err(reader.error(
@@ -576,7 +581,24 @@ impl Scene {
                     format!("expected a table, found {}", v.type_str()),
                 ));
             };
-            reader.only_keys(outputs, "outputs", &["fields"])?;
+            reader.only_keys(outputs, "outputs", &["fields", "layout"])?;
+            match outputs.get("layout") {
+                None => {}
+                Some(Value::String(name)) => {
+                    layout = Layout::from_name(name).ok_or_else(|| {
+                        reader.error(
+                            "outputs.layout",
+                            format!("unknown layout {name:?} (use {})", Layout::NAMES),
+                        )
+                    })?;
+                }
+                Some(v) => {
+                    return Err(reader.error(
+                        "outputs.layout",
+                        format!("expected a string, found {}", v.type_str()),
+                    ))
+                }
+            }
             match outputs.get("fields") {
                 None => {}
                 Some(Value::Array(items)) => {
@@ -630,6 +652,7 @@ impl Scene {
             plane,
             options,
             fields,
+            layout,
             text: text.to_string(),
         })
     }

@@ -5,8 +5,10 @@
 
 use crate::atlas::{
     self, compute_rows, status_flag, Block, Region, Shard, Unit, Variable, COMPONENT_SLOTS,
+    FLAG_FILL,
 };
 use crate::error::{AtlasError, Result};
+use crate::family::ComponentAxis;
 use crate::scene::Scene;
 use crate::store::atlas_file::{encode_unit, AtlasFile, AttrValue, EncodedUnit};
 use crate::store::journal::Journal;
@@ -102,11 +104,9 @@ impl Summary {
                 self.cells_by_status[usize::from(s.min(2))] += 1;
             }
         }
-        if let Some(n) = block.flags(variables, "n_components") {
-            self.components += n
-                .iter()
-                .map(|&k| u64::from(k).min(COMPONENT_SLOTS as u64))
-                .sum::<u64>();
+        // The components stored (at κ = 0 mirror images of one family share a slot).
+        if let Some(family) = block.flags(variables, "family") {
+            self.components += family.iter().filter(|&&f| f != FLAG_FILL).count() as u64;
         }
         if let Some(status) = block.flags(variables, "status") {
             for &s in status {
@@ -214,9 +214,11 @@ pub fn footprint(scene: &Scene, shard: Shard, threads: usize) -> Footprint {
         None => total,
     };
     let unit_cells = rows * ne;
+    // The component axis before its census: at most every slot of the layout.
+    let slots = ComponentAxis::full(scene.layout, COMPONENT_SLOTS).len();
     let bytes_per_cell = atlas::scene_variables(scene)
         .iter()
-        .map(|v| v.kind.bytes_per_cell())
+        .map(|v| v.kind.bytes_per_cell(slots))
         .sum::<usize>() as f64;
     let cells = share * unit_cells;
     let slice_run = share.min(per_slice) * unit_cells;
@@ -230,9 +232,9 @@ pub fn footprint(scene: &Scene, shard: Shard, threads: usize) -> Footprint {
 
 /// Whether `out` is an atlas made from `scene` (its text and this build: the fingerprint)
 /// for this shard, and whole ([`AtlasFile::is_whole`]).
-fn output_is_current(out: &Path, scene: &Scene, shard: Shard) -> bool {
+fn output_is_current(out: &Path, scene: &Scene, shard: Shard, axis: &ComponentAxis) -> bool {
     let region = shard.region(scene.shape());
-    let Ok(file) = AtlasFile::open(out, &region, &atlas::scene_variables(scene)) else {
+    let Ok(file) = AtlasFile::open(out, &region, &atlas::scene_variables(scene), axis) else {
         return false;
     };
     file.text_attribute("scene_fingerprint").as_deref()
@@ -257,7 +259,9 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
         scene.fingerprint(),
         format!("shard {}", request.shard).as_bytes(),
     );
-    if out.exists() && request.update && output_is_current(out, scene, request.shard) {
+    // The component axis, from the whole grid's critical points: the same for every shard.
+    let axis = atlas::component_axis(scene);
+    if out.exists() && request.update && output_is_current(out, scene, request.shard, &axis) {
         return Ok(Summary {
             up_to_date: true,
             seconds: started.elapsed().as_secs_f64(),
@@ -332,7 +336,14 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
     attributes.extend(request.attributes.iter().cloned());
     let advance = |cells: usize| progress.advance(cells as u64);
     let written = (|| -> Result<()> {
-        let file = AtlasFile::create(&tmp, scene, &region, &variables, &borrowed(&attributes))?;
+        let file = AtlasFile::create(
+            &tmp,
+            scene,
+            &region,
+            &variables,
+            &axis,
+            &borrowed(&attributes),
+        )?;
         let mut first = 0;
         for run in slice_runs(mine) {
             let run_done = &done[first..first + run.len()];
@@ -360,6 +371,7 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
                     let block = compute_rows(
                         scene,
                         &variables,
+                        &axis,
                         u.alpha_index,
                         u.beta_index,
                         &rows,
@@ -444,6 +456,7 @@ pub fn merge(
     let shape = scene.shape();
     let all_units = atlas::units(shape);
     let fingerprint = format!("{:016x}", scene.fingerprint());
+    let axis = AtlasFile::read_axis(first)?;
     let mut by_index: Vec<Option<(PathBuf, AtlasFile)>> = Vec::new();
     let mut count = None;
     for path in shards {
@@ -452,7 +465,7 @@ pub fn merge(
         shard
             .check_against(shape)
             .map_err(|e| AtlasError::atlas(path, e))?;
-        let file = AtlasFile::open(path, &shard.region(shape), &variables)?;
+        let file = AtlasFile::open(path, &shard.region(shape), &variables, &axis)?;
         if file.text_attribute("scene_fingerprint").as_deref() != Some(fingerprint.as_str()) {
             return Err(AtlasError::atlas(
                 path,
@@ -538,7 +551,14 @@ pub fn merge(
     };
     let n = by_index.len();
     let written = (|| -> Result<()> {
-        let file = AtlasFile::create(&tmp, &scene, &whole, &variables, &borrowed(&attributes))?;
+        let file = AtlasFile::create(
+            &tmp,
+            &scene,
+            &whole,
+            &variables,
+            &axis,
+            &borrowed(&attributes),
+        )?;
         for (i, shard) in by_index.iter().enumerate() {
             let (_, source) = shard.as_ref().unwrap();
             let shard = Shard {

@@ -14,12 +14,53 @@
 
 use crate::body::{Angle, Body, Reduction, Shape};
 use crate::error::{AtlasError, Result};
+use crate::family::{self, Family, Side};
 use crate::quadrature::{spectral_antiderivative, IntervalNode, TanhSinhLevel, FINEST_LEVEL};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 mod cosine;
 
 const EPS: f64 = f64::EPSILON;
+
+/// How close to ±π/2 a minimum of U on the κ = 0 circle of a body symmetric about its
+/// equator is taken as lying on the equator (its minima there are at ±π/2 exactly, or a
+/// pair θ*, π − θ* that meets there only for a degenerate body).
+const EQUATOR_WINDOW: f64 = 1e-6;
+
+/// The nodes of V round the θ-axis at one ε ([`EffectivePotential::levels`]).
+enum Levels {
+    /// κ = 0 and ε above the top of U: the whole circle.
+    OverTheTop(Vec<Option<CriticalPoint>>),
+    /// Otherwise.
+    Nodes(Vec<Option<CriticalPoint>>),
+}
+
+/// V at a node (+∞ at a pole).
+fn node_value(n: &Option<CriticalPoint>) -> f64 {
+    n.map_or(f64::INFINITY, |p| p.value)
+}
+
+/// The maximal runs `(first, last)` of consecutive nodes at or below ε: one per component
+/// of {V ≤ ε}, in order.
+fn node_runs(nodes: &[Option<CriticalPoint>], energy: f64) -> Vec<(usize, usize)> {
+    let inside = |i: usize| node_value(&nodes[i]) <= energy;
+    let mut runs = Vec::new();
+    let mut start = inside(0).then_some(0);
+    for i in 0..nodes.len() - 1 {
+        if inside(i) == inside(i + 1) {
+            continue;
+        }
+        if inside(i) {
+            runs.push((start.take().unwrap_or(i), i));
+        } else {
+            start = Some(i + 1);
+        }
+    }
+    if let Some(first) = start {
+        runs.push((first, nodes.len() - 1));
+    }
+    runs
+}
 
 /// A point of the θ-axis, kept with its distance to the pole θ = π so that sin θ and cos θ
 /// have full relative precision near both poles. On the κ = 0 circle θ is the lifted angle.
@@ -126,6 +167,8 @@ pub struct Component {
     pub upper: Site,
     /// Libration, fixed point or rotation.
     pub kind: MotionKind,
+    /// The family of tori it belongs to (by the wells it encloses).
+    pub family: Family,
     /// The critical points strictly inside, in order (lifted on the κ = 0 circle).
     pub interior: Vec<CriticalPoint>,
     /// The critical points at or just outside the lower and the upper end (none at a pole).
@@ -495,6 +538,62 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
     /// the motion lives on the circle and a component may straddle θ = 0 (then θ_min < 0) or
     /// be the whole circle (rolling over the top, [`MotionKind::Rotation`]).
     pub fn components(&self, energy: f64) -> Result<Vec<Component>> {
+        let nodes = match self.levels(energy)? {
+            Levels::OverTheTop(nodes) => {
+                let (first, last) = (nodes[0].unwrap(), nodes[nodes.len() - 1].unwrap());
+                return Ok(vec![Component {
+                    lower: first.site,
+                    upper: last.site,
+                    kind: MotionKind::Rotation,
+                    family: Family::OverTheTop,
+                    interior: nodes[1..nodes.len() - 1]
+                        .iter()
+                        .flatten()
+                        .copied()
+                        .collect(),
+                    neighbours: [None, None],
+                }]);
+            }
+            Levels::Nodes(nodes) => nodes,
+        };
+        let last_node = nodes.len() - 1;
+        Ok(node_runs(&nodes, energy)
+            .into_iter()
+            .map(|(first, last)| {
+                // A run that starts or ends at a node reaches the top of the circle itself
+                // (κ = 0, a separatrix); otherwise its ends are crossings of V = ε.
+                let lower = if first == 0 {
+                    nodes[0].unwrap().site
+                } else {
+                    self.turning_point(&nodes[first - 1], &nodes[first], energy)
+                };
+                let upper = if last == last_node {
+                    nodes[last].unwrap().site
+                } else {
+                    self.turning_point(&nodes[last], &nodes[last + 1], energy)
+                };
+                self.make_component(&nodes, lower, first, upper, last, energy)
+            })
+            .collect())
+    }
+
+    /// The families of the components of {V ≤ ε}, in θ_min order, without their turning
+    /// points: as [`EffectivePotential::components`] labels them, at a fraction of its cost.
+    pub fn families(&self, energy: f64) -> Result<Vec<Family>> {
+        Ok(match self.levels(energy)? {
+            Levels::OverTheTop(_) => vec![Family::OverTheTop],
+            Levels::Nodes(nodes) => node_runs(&nodes, energy)
+                .into_iter()
+                .map(|(first, last)| self.family_of_run(&nodes[first..=last]))
+                .collect(),
+        })
+    }
+
+    /// The nodes that cut the θ-axis into pieces where V is monotone: the critical points
+    /// between the two poles (κ ≠ 0, `None` at each pole), or around the circle starting
+    /// and ending at the highest one (κ = 0, lifted so that components round θ = 0
+    /// straddle it). Errors for a non-finite ε and for ε below the bottom of V.
+    fn levels(&self, energy: f64) -> Result<Levels> {
         if !energy.is_finite() {
             return Err(AtlasError::InvalidParameter {
                 name: "energy",
@@ -502,8 +601,6 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 reason: "must be finite",
             });
         }
-        // Nodes: the critical points between the two poles (κ ≠ 0), or around the circle
-        // starting and ending at the highest one (κ = 0); V is monotone between nodes.
         let mut nodes: Vec<Option<CriticalPoint>> = Vec::with_capacity(self.critical.len() + 2);
         if self.kappa != 0.0 {
             nodes.push(None);
@@ -538,47 +635,73 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             );
             nodes.push(Some(lift(peak, shift + TAU)));
             if energy > peak.value {
-                let (first, last) = (nodes[0].unwrap(), nodes[nodes.len() - 1].unwrap());
-                return Ok(vec![Component {
-                    lower: first.site,
-                    upper: last.site,
-                    kind: MotionKind::Rotation,
-                    interior: nodes[1..nodes.len() - 1]
-                        .iter()
-                        .flatten()
-                        .copied()
-                        .collect(),
-                    neighbours: [None, None],
-                }]);
+                return Ok(Levels::OverTheTop(nodes));
             }
         }
-        let value = |n: &Option<CriticalPoint>| n.map_or(f64::INFINITY, |p| p.value);
-        let minimum = nodes.iter().map(value).fold(f64::INFINITY, f64::min);
+        let minimum = nodes.iter().map(node_value).fold(f64::INFINITY, f64::min);
         if energy < minimum {
             return Err(AtlasError::NoMotion { energy, minimum });
         }
-        let inside = |i: usize| value(&nodes[i]) <= energy;
-        let mut comps = Vec::new();
-        let mut start: Option<(Site, usize)> = inside(0).then(|| (nodes[0].unwrap().site, 0));
-        for i in 0..nodes.len() - 1 {
-            if inside(i) == inside(i + 1) {
-                continue;
+        Ok(Levels::Nodes(nodes))
+    }
+
+    /// The family of the component whose interior holds the nodes `run` (all at or below
+    /// ε): named by the side of the equator its minima lie on; a component round wells on
+    /// both sides (above a saddle) belongs to the family of the well V keeps at large κ
+    /// ([`crate::limits::high_energy_family`]). A run without a minimum (a degenerate
+    /// tangency) is named by its lowest node.
+    fn family_of_run(&self, run: &[Option<CriticalPoint>]) -> Family {
+        let outer = crate::limits::high_energy_family(self.body);
+        let points = run.iter().flatten();
+        let minima = points.clone().filter(|p| p.kind == CriticalKind::Minimum);
+        family::of_sides(minima.map(|p| self.side(p)), outer)
+            .or_else(|| {
+                let lowest = points.min_by(|a, b| a.value.total_cmp(&b.value))?;
+                family::of_sides([self.side(lowest)], outer)
+            })
+            .expect("a run holds at least one node")
+    }
+
+    /// Which side of the equator a minimum of V lies on. For κ ≠ 0, the single minimum of a
+    /// body symmetric about its equator lies at π/2 exactly (by symmetry, whatever its
+    /// rounding); a minimum rounded onto π/2 of another body lies on the side V descends
+    /// to there. On the κ = 0 circle, by the distance from θ = 0 (the lifted angle taken to
+    /// (−π, π]).
+    fn side(&self, p: &CriticalPoint) -> Side {
+        let symmetric = self.body.shape.symmetric_about_equator();
+        if self.kappa != 0.0 {
+            let minima = self
+                .critical
+                .iter()
+                .filter(|c| c.kind == CriticalKind::Minimum)
+                .count();
+            if symmetric && minima == 1 {
+                return Side::Equator;
             }
-            let crossing = self.turning_point(&nodes[i], &nodes[i + 1], energy);
-            if inside(i) {
-                let (lower, first) = start.take().unwrap_or((nodes[i].unwrap().site, i));
-                comps.push(self.make_component(&nodes, lower, first, crossing, i, energy));
-            } else {
-                start = Some((crossing, i + 1));
-            }
+            return match p.site.theta.total_cmp(&FRAC_PI_2) {
+                std::cmp::Ordering::Less => Side::Upper,
+                std::cmp::Ordering::Greater => Side::Lower,
+                std::cmp::Ordering::Equal => {
+                    let slope = self.slope(Angle::new(FRAC_PI_2));
+                    if slope > 0.0 {
+                        Side::Upper
+                    } else if slope < 0.0 {
+                        Side::Lower
+                    } else {
+                        Side::Equator
+                    }
+                }
+            };
         }
-        if let Some((lower, first)) = start {
-            // Only on the circle: the level reaches the top itself (a separatrix).
-            let last = nodes.len() - 1;
-            let upper = nodes[last].unwrap().site;
-            comps.push(self.make_component(&nodes, lower, first, upper, last, energy));
+        let wrapped = (p.site.theta + PI).rem_euclid(TAU) - PI;
+        let from_equator = wrapped.abs() - FRAC_PI_2;
+        if symmetric && from_equator.abs() <= EQUATOR_WINDOW {
+            Side::Equator
+        } else if from_equator < 0.0 {
+            Side::Upper
+        } else {
+            Side::Lower
         }
-        Ok(comps)
     }
 
     /// The component between `lower` and `upper`, whose interior holds nodes first..=last
@@ -611,6 +734,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             .filter(|p| p.site.theta >= lower.theta && p.site.theta <= upper.theta)
             .copied()
             .collect();
+        let family = self.family_of_run(&nodes[first..=last]);
         let at_minimum = closed.len() == 1
             && closed[0].kind == CriticalKind::Minimum
             && energy - closed[0].value <= 4.0 * EPS * closed[0].scale;
@@ -620,6 +744,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 lower: m.site,
                 upper: m.site,
                 kind: MotionKind::FixedPoint,
+                family,
                 interior: vec![m],
                 neighbours,
             };
@@ -628,6 +753,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             lower,
             upper,
             kind: MotionKind::Libration,
+            family,
             interior,
             neighbours,
         }

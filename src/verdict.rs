@@ -116,6 +116,11 @@ pub struct Counterexample {
     /// |Δζ| over one θ-period, and its error estimate: the drift per period.
     pub drift: f64,
     pub drift_error: f64,
+    /// The family of the torus it lies on.
+    pub family: crate::family::Family,
+    /// Its index among the cell's components in increasing θ_min (as `cell --json` lists
+    /// them and `trajectory --component` takes it).
+    pub component: usize,
 }
 
 /// What a verdict rests on.
@@ -295,7 +300,7 @@ impl Sampler<'_> {
     /// family's `shape` and ε lies in gap `gap`.
     fn offset(&self, kappa: f64, energy: f64, of: &Sample, k: f64) -> Option<f64> {
         self.solve(kappa, energy, of, false)
-            .map(|r| r.rotation_number - k)
+            .map(|(_, r)| r.rotation_number - k)
     }
 
     fn solve(
@@ -304,7 +309,7 @@ impl Sampler<'_> {
         energy: f64,
         of: &Sample,
         drift: bool,
-    ) -> Option<crate::cell::ComponentResult> {
+    ) -> Option<(usize, crate::cell::ComponentResult)> {
         let potential = EffectivePotential::new(self.body, kappa);
         let minima = potential.minimum_sites();
         let levels = potential.separatrix_levels();
@@ -317,12 +322,12 @@ impl Sampler<'_> {
         }
         let theta = *minima.get(of.well)?;
         let components = potential.components(energy).ok()?;
-        let c = components.iter().find(|c| {
+        let (index, c) = components.iter().enumerate().find(|(_, c)| {
             c.kind != MotionKind::Rotation && c.minimum().map(|m| m.site.theta) == Some(theta)
         })?;
         let options = CellOptions { drift, ..self.cell };
         let r = solve_component(&potential, energy, c, &options).ok()?;
-        (r.status != Status::Separatrix && r.rotation_number.is_finite()).then_some(r)
+        (r.status != Status::Separatrix && r.rotation_number.is_finite()).then_some((index, r))
     }
 }
 
@@ -808,6 +813,7 @@ fn fail_margin(
         let at = |kappa: f64, energy: f64| -> f64 {
             sampler
                 .solve(kappa, energy, s, false)
+                .map(|(_, r)| r)
                 .filter(|r| (r.rotation_number).abs() > r.error_estimate.max(tol).max(SIGN_FLOOR))
                 .map_or(f64::NEG_INFINITY, |r| {
                     sign * r.rotation_number * energy.sqrt() / kappa
@@ -1054,7 +1060,7 @@ fn refine(sampler: &Sampler<'_>, c: &Candidate) -> Option<Counterexample> {
             at(t)?
         }
     };
-    let r = sampler.solve(kappa, energy, &c.a, true)?;
+    let (component, r) = sampler.solve(kappa, energy, &c.a, true)?;
     // Only a value the solver vouches for: status ok (every error within the tolerance),
     // and N on the integer within that tolerance.
     if r.status != Status::Ok || (r.rotation_number - k).abs() > sampler.cell.tol + r.error_estimate
@@ -1074,6 +1080,8 @@ fn refine(sampler: &Sampler<'_>, c: &Candidate) -> Option<Counterexample> {
         error_estimate: r.error_estimate,
         drift: r.drift,
         drift_error: r.errors.drift,
+        family: r.family,
+        component,
     })
 }
 

@@ -293,6 +293,9 @@ fn cell_json_has_the_contract_keys_and_both_methods_agree() {
     let comps = v["components"].as_array().unwrap();
     assert_eq!(comps.len(), 2);
     assert!(comps[0]["theta_min"].as_f64() < comps[1]["theta_min"].as_f64());
+    // Each names its family of tori: the well of σ_s0 (θ < π/2), then that of σ_sπ.
+    assert_eq!(comps[0]["family"], "well_0");
+    assert_eq!(comps[1]["family"], "well_pi");
     for c in comps {
         for key in [
             "theta_min",
@@ -759,6 +762,45 @@ fn version_completions_manual_threads_and_names_follow_the_conventions() {
     assert!(
         man.status.success() && page.contains(".TH rubber-atlas") && page.contains("completions")
     );
+    // Every page the program's page refers to exists: printed by name, or written to a
+    // folder with the program's page.
+    let pages = tempfile::tempdir().unwrap();
+    let o = run(&["man", "--dir", pages.path().to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(pages.path().join("rubber-atlas.1").is_file());
+    let mut referred = 0;
+    for word in page.split(|c: char| c.is_whitespace()) {
+        let Some(name) = word
+            .strip_prefix("rubber\\-atlas\\-")
+            .and_then(|w| w.strip_suffix("(1)"))
+        else {
+            continue;
+        };
+        referred += 1;
+        let file = pages.path().join(format!("rubber-atlas-{name}.1"));
+        let text = std::fs::read_to_string(&file).unwrap_or_else(|_| panic!("{file:?}"));
+        assert!(
+            text.contains(&format!(".TH rubber-atlas-{name} 1")),
+            "{name}"
+        );
+        let o = run(&["man", name]);
+        assert_eq!(String::from_utf8_lossy(&o.stdout), text, "{name}");
+    }
+    assert!(referred >= 9, "{referred}");
+    let o = run(&["man", "nope"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(stderr(&o).lines().count(), 1, "{}", stderr(&o));
+    // `run --help` shows the scene format.
+    let help = String::from_utf8_lossy(&run(&["run", "--help"]).stdout).into_owned();
+    for key in [
+        "[body]",
+        "[axes]",
+        "excess_energy",
+        "layout",
+        "docs/scenes.md",
+    ] {
+        assert!(help.contains(key), "{key}: {help}");
+    }
     // The text output uses the JSON's words.
     let mut cell = vec!["cell"];
     cell.extend(BODY);
@@ -794,4 +836,45 @@ fn version_completions_manual_threads_and_names_follow_the_conventions() {
         .unwrap();
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(String::from_utf8_lossy(&o.stdout).contains("on 1 thread(s)"));
+}
+
+#[test]
+fn a_run_without_out_writes_beside_its_scene_from_any_folder() {
+    // Issue 20: `run my.toml` from outside the repository used to fail on "atlas/".
+    let scenes = tempfile::tempdir().unwrap();
+    let elsewhere = tempfile::tempdir().unwrap();
+    let scene = scenes.path().join("mine.toml");
+    std::fs::write(
+        &scene,
+        "name = \"beside\"\n[body]\nnu = 0.5\neta = 0.5\n[axes]\nalpha = [0.3, 0.5]\nbeta = [3.0]\n\
+         kappa = { start = 0.0, stop = 1.0, num = 4 }\nenergy = { start = 1.0, stop = 3.0, num = 4 }\n",
+    )
+    .unwrap();
+    let bin = env!("CARGO_BIN_EXE_rubber-atlas");
+    let o = Command::new(bin)
+        .current_dir(elsewhere.path())
+        .args(["run", scene.to_str().unwrap(), "--quiet"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(scenes.path().join("beside.h5").is_file());
+    assert_eq!(std::fs::read_dir(elsewhere.path()).unwrap().count(), 0);
+    // A relative scene path: the output beside it, relative to the working folder; shards
+    // likewise.
+    let o = Command::new(bin)
+        .current_dir(scenes.path())
+        .args(["run", "mine.toml", "--shard", "1/2", "--print-out"])
+        .output()
+        .unwrap();
+    assert_eq!(
+        String::from_utf8_lossy(&o.stdout).trim(),
+        "beside.shard-1-of-2.h5"
+    );
+    let o = Command::new(bin)
+        .current_dir(elsewhere.path())
+        .args(["run", "../x/atlas/s.toml", "--print-out"])
+        .output()
+        .unwrap();
+    // (The scene is read first: a missing one is refused in one line.)
+    assert_eq!(o.status.code(), Some(2));
 }

@@ -55,6 +55,15 @@ fn read5(f: &hdf5::File, name: &str) -> ndarray::Array5<f64> {
         .unwrap()
 }
 
+/// The slot of the component axis (family layout, the default) that holds `family`.
+fn slot(f: &hdf5::File, family: rubber_atlas::family::Family) -> usize {
+    let labels = f.dataset("component").unwrap().read_raw::<u8>().unwrap();
+    labels
+        .iter()
+        .position(|&c| c == family.code())
+        .unwrap_or_else(|| panic!("no slot for {family} in {labels:?}"))
+}
+
 fn text_attr(d: &hdf5::Dataset, name: &str) -> String {
     d.attr(name)
         .unwrap()
@@ -161,8 +170,12 @@ fn excess_energy_plane_starts_at_the_bottom_of_every_row() {
                     },
                 )
                 .unwrap();
-                let first = cell.components[0].rotation_number;
-                assert_eq!(n[[0, ib, ik, ie, 0]].to_bits(), first.to_bits());
+                let first = &cell.components[0];
+                let k = slot(&f, first.family);
+                assert_eq!(
+                    n[[0, ib, ik, ie, k]].to_bits(),
+                    first.rotation_number.to_bits()
+                );
             }
         }
     }
@@ -198,18 +211,28 @@ fn compact_plane_reaches_infinite_energy_exactly() {
             // s = 0: ε = ∞, the high-energy limit N∞(λ), with its own status.
             assert!(kappa[[0, ib, il, 0]].is_infinite() && energy[[0, ib, il, 0]].is_infinite());
             let limit = high_energy_rotation_number(&body, lambda, 1e-10).unwrap();
-            assert_eq!(n[[0, ib, il, 0, 0]], limit.value);
-            assert_eq!(err[[0, ib, il, 0, 0]], limit.error);
-            assert_eq!(status[[0, ib, il, 0, 0]], 4, "high_energy_limit");
+            // At κ = λ√ε → ∞ V is one well round π/2, on the side U descends to: σ_sπ's.
+            let top = slot(&f, rubber_atlas::family::Family::WellPi);
+            assert_eq!(n[[0, ib, il, 0, top]], limit.value);
+            assert_eq!(err[[0, ib, il, 0, top]], limit.error);
+            assert_eq!(status[[0, ib, il, 0, top]], 4, "high_energy_limit");
             for (is, &s) in ss.iter().enumerate().skip(1) {
                 let (k, e) = (lambda / s, 1.0 / (s * s));
                 assert_eq!((kappa[[0, ib, il, is]], energy[[0, ib, il, is]]), (k, e));
                 match solve_cell(&body, k, e, &options) {
                     Ok(c) if !c.components.is_empty() => {
-                        let first = c.components[0].rotation_number;
-                        assert_eq!(n[[0, ib, il, is, 0]].to_bits(), first.to_bits());
+                        for comp in &c.components {
+                            let k = slot(&f, comp.family);
+                            assert_eq!(
+                                n[[0, ib, il, is, k]].to_bits(),
+                                comp.rotation_number.to_bits()
+                            );
+                        }
                     }
-                    _ => assert!(n[[0, ib, il, is, 0]].is_nan()),
+                    _ => assert!(n
+                        .slice(ndarray::s![0, ib, il, is, ..])
+                        .iter()
+                        .all(|x| x.is_nan())),
                 }
             }
             // Along λ fixed, s → 0 converges to the limit (s = 0.1 is ε = 100).

@@ -61,6 +61,7 @@ pub enum Command {
     Cell(CellArgs),
     /// Builds the atlas of a scene (TOML) into an HDF5 file that opens in xarray, with
     /// progress, resume after a crash, and shards for a cluster.
+    #[command(after_long_help = run::SCENE_FORMAT)]
     Run(RunArgs),
     /// Joins the shard files of one scene (made with `run --shard I/N`) into one atlas.
     Merge(MergeArgs),
@@ -79,9 +80,17 @@ pub enum Command {
         #[arg(value_enum)]
         shell: clap_complete::Shell,
     },
-    /// Prints the manual page (roff), e.g. `rubber-atlas man > rubber-atlas.1; man
-    /// ./rubber-atlas.1`.
-    Man,
+    /// Prints a manual page (roff): the program's, or a command's, e.g. `rubber-atlas man run
+    /// > rubber-atlas-run.1; man ./rubber-atlas-run.1`; with --dir, writes every page there.
+    Man {
+        /// The command whose page to print (the program's page without it).
+        #[arg(value_name = "COMMAND")]
+        command: Option<String>,
+        /// Write rubber-atlas.1 and rubber-atlas-<command>.1 for every command into this
+        /// folder instead (e.g. /usr/local/share/man/man1).
+        #[arg(long, value_name = "DIR", conflicts_with = "command")]
+        dir: Option<std::path::PathBuf>,
+    },
 }
 
 /// The size check of a command that may ask for more than the machine has.
@@ -223,14 +232,59 @@ pub fn run(cli: Cli) -> Result<()> {
             clap_complete::generate(shell, &mut command, "rubber-atlas", &mut std::io::stdout());
             Ok(())
         }
-        Command::Man => {
-            let command = <Cli as clap::CommandFactory>::command();
-            clap_mangen::Man::new(command)
-                .render(&mut std::io::stdout())
-                .context("cannot write the manual page")?;
-            Ok(())
-        }
+        Command::Man { command, dir } => man(command.as_deref(), dir.as_deref()),
     }
+}
+
+/// The manual pages: the program's (`rubber-atlas(1)`) and one per command
+/// (`rubber-atlas-run(1)`, …, which the program's page lists), printed or written to `dir`.
+fn man(name: Option<&str>, dir: Option<&std::path::Path>) -> Result<()> {
+    let mut program = <Cli as clap::CommandFactory>::command();
+    program.build();
+    // A command's page is named and titled as the program's page refers to it.
+    // (clap names a command with a &'static str: the few page names are leaked, once.)
+    let page_of = |c: &clap::Command| {
+        let title: &'static str =
+            Box::leak(format!("rubber-atlas-{}", c.get_name()).into_boxed_str());
+        let usage = format!("rubber-atlas {}", c.get_name());
+        clap_mangen::Man::new(c.clone().name(title).bin_name(usage)).title(title)
+    };
+    let commands: Vec<&clap::Command> = program.get_subcommands().collect();
+    if let Some(dir) = dir {
+        let write = |file: String, page: clap_mangen::Man| -> Result<()> {
+            let path = dir.join(file);
+            let mut out = std::fs::File::create(&path)
+                .with_context(|| format!("cannot write {}", path.display()))?;
+            page.render(&mut out)
+                .with_context(|| format!("cannot write {}", path.display()))
+        };
+        write(
+            "rubber-atlas.1".into(),
+            clap_mangen::Man::new(program.clone()),
+        )?;
+        for c in &commands {
+            write(format!("rubber-atlas-{}.1", c.get_name()), page_of(c))?;
+        }
+        return Ok(());
+    }
+    let page = match name {
+        None => clap_mangen::Man::new(program.clone()),
+        Some(name) => {
+            let c = commands
+                .iter()
+                .find(|c| c.get_name() == name)
+                .ok_or_else(|| {
+                    let names: Vec<&str> = commands.iter().map(|c| c.get_name()).collect();
+                    anyhow::Error::new(rubber_atlas::AtlasError::Atlas {
+                        path: format!("man {name}"),
+                        reason: format!("no such command (commands: {})", names.join(", ")),
+                    })
+                })?;
+            page_of(c)
+        }
+    };
+    page.render(&mut std::io::stdout())
+        .context("cannot write the manual page")
 }
 
 /// The attributes a command adds to the atlases it writes: its command line, the time, and

@@ -12,12 +12,39 @@ use rubber_atlas::store::check_output;
 use rubber_atlas::sweep::{self, RunRequest};
 use std::path::PathBuf;
 
+/// The scene format, shown by `run --help` (and in docs/scenes.md at more length).
+pub const SCENE_FORMAT: &str = "\
+Scene files (TOML):
+  name = \"paper-c\"                 # the default output: paper-c.h5 beside the scene
+  [body]
+  nu = 0.5                         # i3 / i1, 0 < nu <= 2
+  eta = 0.5                        # m b3^2 / i1 > 0
+  [axes]                           # each axis: a list, or { start, stop, num [, spacing = \"log\"] }
+  alpha = [0.5]                    # -1 < alpha < 1
+  beta = [3.0]                     # beta > 0
+  kappa = { start = 0.0, stop = 2.0, num = 201 }
+  energy = { start = 0.5, stop = 4.5, num = 201 }
+  [solver]
+  tolerance = 1e-10                # 1e-15 ... 0.1
+  method = \"quadrature\"           # or \"ode\"
+  resonance_tol = 1e-9             # |N - round(N)| counted as an integer resonance
+  [outputs]
+  fields = [\"rotation_number\", \"drift_radius\", \"bounded\"]   # default: all
+  layout = \"family\"               # component axis: one torus family per slot, or \"theta_min\"
+
+The plane is one of: kappa with energy; kappa with excess_energy (energy measured from the
+bottom of V at each kappa); lambda with s (kappa = lambda / s, energy = 1 / s^2; s = 0 is
+the high-energy limit). Fields: theta_min, theta_max, period, omega_theta, omega_psi,
+rotation_number, drift, drift_radius, bounded, motion, status, error_estimate. Examples:
+atlas/*.toml in the repository; every key: docs/scenes.md.";
+
 #[derive(Debug, Args)]
 pub struct RunArgs {
-    /// The scene file (TOML; see atlas/*.toml).
+    /// The scene file (TOML; the format is below).
     #[arg(value_name = "SCENE")]
     pub scene: PathBuf,
-    /// Output file [default: atlas/<name>.h5; with --shard I/N atlas/<name>.shard-I-of-N.h5].
+    /// Output file [default: <name>.h5 in the scene's folder; with --shard I/N
+    /// <name>.shard-I-of-N.h5 there].
     #[arg(long, value_name = "PATH")]
     pub out: Option<PathBuf>,
     /// Worker threads [default: RAYON_NUM_THREADS if set, else every core].
@@ -57,15 +84,14 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
     // A shard count that does not tile the grid is refused at once (also by --print-out,
     // which submit.sh calls before anything is queued).
     shard.check_against(scene.shape())?;
+    // By default beside the scene, so that a run works from any folder.
     let out = args.out.clone().unwrap_or_else(|| {
-        if shard == Shard::WHOLE {
-            PathBuf::from(format!("atlas/{}.h5", scene.name))
+        let folder = args.scene.parent().unwrap_or(std::path::Path::new(""));
+        folder.join(if shard == Shard::WHOLE {
+            format!("{}.h5", scene.name)
         } else {
-            PathBuf::from(format!(
-                "atlas/{}.shard-{}-of-{}.h5",
-                scene.name, shard.index, shard.count
-            ))
-        }
+            format!("{}.shard-{}-of-{}.h5", scene.name, shard.index, shard.count)
+        })
     });
     if args.print_out {
         println!("{}", out.display());

@@ -1,13 +1,14 @@
-//! The atlas file (SPEC §3.2): one HDF5 file per scene with the coordinates `alpha, beta,
+//! The atlas file (docs/files.md): one HDF5 file per scene with the coordinates `alpha, beta,
 //! kappa, energy, component` as HDF5 dimension scales attached to every variable (so that
 //! xarray's h5netcdf engine shows named dimensions), CF attributes, and variables chunked
 //! one work unit (whole κ-rows of one (α, β) slice) per chunk and compressed. A file holds
 //! a region of the scene's grid: all of it, or a shard's box.
 
 use super::h5::{attach_scale, describe, set_scale, text_attr, write_attr};
-use crate::atlas::{Block, Column, Kind, Region, Unit, Variable, COMPONENT_SLOTS, FLAG_FILL};
+use crate::atlas::{Block, Column, Kind, Region, Unit, Variable, FLAG_FILL};
 use crate::cf;
 use crate::error::{AtlasError, Result};
+use crate::family::ComponentAxis;
 use crate::scene::{Plane, Scene};
 use hdf5::types::VarLenUnicode;
 use ndarray::s;
@@ -29,6 +30,7 @@ pub struct AtlasFile {
     datasets: Vec<hdf5::Dataset>,
     variables: Vec<Variable>,
     region: Region,
+    axis: ComponentAxis,
 }
 
 impl AtlasFile {
@@ -40,9 +42,10 @@ impl AtlasFile {
         scene: &Scene,
         region: &Region,
         variables: &[Variable],
+        axis: &ComponentAxis,
         attributes: &[(&str, AttrValue)],
     ) -> Result<AtlasFile> {
-        Self::create_inner(path, scene, region, variables, attributes)
+        Self::create_inner(path, scene, region, variables, axis, attributes)
             .map_err(|e| AtlasError::atlas(path, e))
     }
 
@@ -51,10 +54,12 @@ impl AtlasFile {
         scene: &Scene,
         region: &Region,
         variables: &[Variable],
+        axis: &ComponentAxis,
         attributes: &[(&str, AttrValue)],
     ) -> hdf5::Result<AtlasFile> {
         let file = hdf5::File::create_excl(path)?;
         text_attr(&file, "Conventions", cf::CONVENTIONS)?;
+        text_attr(&file, "component_layout", axis.layout.name())?;
         for (name, value) in attributes {
             write_attr(&file, name, value)?;
         }
@@ -108,15 +113,34 @@ impl AtlasFile {
             let (long_name, units) = known(name);
             describe(&d, long_name, units)?;
         }
-        let slots: Vec<i32> = (0..COMPONENT_SLOTS as i32).collect();
-        let d = file
-            .new_dataset_builder()
-            .with_data(&slots)
-            .create("component")?;
-        let (long_name, units) = known("component");
-        describe(&d, long_name, units)?;
+        // By family: the families' codes (u8 flags); by θ_min: the ranks 0, 1, … (int32).
+        let d = match axis.flag_attributes() {
+            Some((values, meanings)) => {
+                let d = file
+                    .new_dataset_builder()
+                    .with_data(&axis.labels)
+                    .create("component")?;
+                describe(&d, "torus family", cf::NUMBER)?;
+                super::h5::flags(&d, (&values, &meanings))?;
+                d
+            }
+            None => {
+                let ranks: Vec<i32> = axis.labels.iter().map(|&k| i32::from(k)).collect();
+                let d = file
+                    .new_dataset_builder()
+                    .with_data(&ranks)
+                    .create("component")?;
+                describe(
+                    &d,
+                    "rank of the component in increasing theta_min",
+                    cf::NUMBER,
+                )?;
+                d
+            }
+        };
         set_scale(&d, "component")?;
         scales.push(d);
+        let slots = axis.len();
 
         let shape = scene.shape();
         let [na, nb, nk, ne] = region.shape();
@@ -149,19 +173,19 @@ impl AtlasFile {
                     .create(v.name)?
             } else if v.kind == Kind::Value {
                 file.new_dataset::<f64>()
-                    .chunk([1, 1, rows, ne, COMPONENT_SLOTS])
+                    .chunk([1, 1, rows, ne, slots])
                     .shuffle()
                     .deflate(DEFLATE_LEVEL)
                     .fill_value(f64::NAN)
-                    .shape([na, nb, nk, ne, COMPONENT_SLOTS])
+                    .shape([na, nb, nk, ne, slots])
                     .create(v.name)?
             } else {
                 file.new_dataset::<u8>()
-                    .chunk([1, 1, rows, ne, COMPONENT_SLOTS])
+                    .chunk([1, 1, rows, ne, slots])
                     .shuffle()
                     .deflate(DEFLATE_LEVEL)
                     .fill_value(FLAG_FILL)
-                    .shape([na, nb, nk, ne, COMPONENT_SLOTS])
+                    .shape([na, nb, nk, ne, slots])
                     .create(v.name)?
             };
             describe(&d, v.long_name, v.units)?;
@@ -195,12 +219,18 @@ impl AtlasFile {
             datasets,
             variables: variables.to_vec(),
             region: region.clone(),
+            axis: axis.clone(),
         })
     }
 
     /// Opens an existing atlas file of the part `region` of the scene's grid for reading;
-    /// `variables` are those its scene asks for.
-    pub fn open(path: &Path, region: &Region, variables: &[Variable]) -> Result<AtlasFile> {
+    /// `variables` are those its scene asks for, `axis` its component axis.
+    pub fn open(
+        path: &Path,
+        region: &Region,
+        variables: &[Variable],
+        axis: &ComponentAxis,
+    ) -> Result<AtlasFile> {
         let inner = || -> hdf5::Result<AtlasFile> {
             let file = hdf5::File::open(path)?;
             let datasets = variables
@@ -213,7 +243,29 @@ impl AtlasFile {
                 datasets,
                 variables: variables.to_vec(),
                 region: region.clone(),
+                axis: axis.clone(),
             })
+        };
+        inner().map_err(|e| AtlasError::atlas(path, e))
+    }
+
+    /// The component axis an atlas file at `path` was written with (its `component_layout`
+    /// and `component` coordinate).
+    pub fn read_axis(path: &Path) -> Result<ComponentAxis> {
+        let inner = || -> hdf5::Result<ComponentAxis> {
+            let file = hdf5::File::open(path)?;
+            let layout = file
+                .attr("component_layout")
+                .and_then(|a| a.read_scalar::<VarLenUnicode>())
+                .ok()
+                .and_then(|name| crate::family::Layout::from_name(name.as_str()))
+                .ok_or("has no component_layout attribute of a known layout (made by an older version?)")?;
+            let labels = file.dataset("component")?.read_raw::<i64>()?;
+            let labels = labels
+                .into_iter()
+                .map(|k| u8::try_from(k).map_err(|_| "a component label beyond 255"))
+                .collect::<std::result::Result<Vec<u8>, _>>()?;
+            Ok(ComponentAxis { layout, labels })
         };
         inner().map_err(|e| AtlasError::atlas(path, e))
     }
@@ -224,7 +276,7 @@ impl AtlasFile {
         self.variables.iter().zip(&self.datasets).all(|(v, d)| {
             let mut shape = self.region.shape().to_vec();
             if !v.kind.per_cell() {
-                shape.push(COMPONENT_SLOTS);
+                shape.push(self.axis.len());
             }
             d.shape() == shape
                 && match v.kind {
@@ -252,8 +304,19 @@ impl AtlasFile {
     }
 
     /// Whether the file's coordinates are those of its region of `scene`'s grid, value for
-    /// value: a shard file relabelled by hand (its shard attributes edited) is caught here.
+    /// value, and its component axis the one it was opened with: a shard file relabelled by
+    /// hand (its shard attributes edited) is caught here.
     pub fn coordinates_match(&self, scene: &Scene) -> bool {
+        let layout = self.text_attribute("component_layout");
+        let labels = self
+            .file
+            .dataset("component")
+            .and_then(|d| d.read_raw::<i64>())
+            .ok();
+        let want: Vec<i64> = self.axis.labels.iter().map(|&k| i64::from(k)).collect();
+        if layout.as_deref() != Some(self.axis.layout.name()) || labels != Some(want) {
+            return false;
+        }
         let r = &self.region;
         let [row, column] = scene.plane.axis_names();
         let expected: [(&str, &[f64]); 4] = [
@@ -350,6 +413,7 @@ impl AtlasFile {
             }
             Ok(Block {
                 cells: unit.rows.len() * self.region.columns,
+                slots: self.axis.len(),
                 columns,
             })
         };
@@ -400,11 +464,7 @@ pub fn encode_unit(
         .iter()
         .zip(&block.columns)
         .map(|(v, column)| {
-            let width = if v.kind.per_cell() {
-                1
-            } else {
-                COMPONENT_SLOTS
-            };
+            let width = v.kind.values_per_cell(block.slots);
             chunk_bytes(column, 0, block.cells * width, chunk_cells * width)
         })
         .collect();
