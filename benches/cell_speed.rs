@@ -1,8 +1,8 @@
-//! Speed of the cell solver on the standard slice of SPEC §5: α = 0.5, β = 3, ν = η = 0.5,
+//! Speed of the cell solver on the standard slice of docs/accuracy.md: α = 0.5, β = 3, ν = η = 0.5,
 //! κ ∈ [0, 2] × ε ∈ [0.5, 4.5] on 256 × 256 cells, tol 1e-10, rows of fixed κ shared out by
 //! rayon one row at a time (rows differ in cost several-fold: with rayon's default splitting
 //! one thread idles at the end, 200k/s instead of 245k/s). Two output sets: all outputs (the
-//! SPEC's figure) and N alone (T, ω_θ, ω_ψ, N without the drift integrals, what a scene that
+//! the figure of docs/accuracy.md) and N alone (T, ω_θ, ω_ψ, N without the drift integrals, what a scene that
 //! asks for no drift computes, and what the NumPy comparison script computes). Prints
 //! cell-components per second for 1 and 2 threads, the median and the best of seven runs of
 //! each, interleaved in one process so that the ratio is meaningful on a shared machine (other

@@ -1,4 +1,4 @@
-//! `rubber-atlas run` as a user runs it, on the standard slice of SPEC §5 (atlas/standard-slice.toml:
+//! `rubber-atlas run` as a user runs it, on the standard slice of docs/accuracy.md (atlas/standard-slice.toml:
 //! α = 0.5, β = 3, κ × ε on 256 × 256 cells, all outputs, tol 1e-10):
 //! - cells per second on 1 and on 2 threads (median of 5 runs each, interleaved so that
 //!   other load on a shared machine hits both alike), and their ratio (target ≥ 1.8);

@@ -1,4 +1,4 @@
-"""The paper's boundedness hypothesis (SPEC §4) over the (α, β) plane, from the verdict of
+"""The paper's boundedness hypothesis (docs/hypothesis.md) over the (α, β) plane, from the verdict of
 the package `rubber_atlas` (the code of `rubber-atlas verdict`).
 
 The hypothesis: paths are bounded (1) for β² < 1 + α at every κ ≠ 0; (2) for β² > 1 + α, α > 0,

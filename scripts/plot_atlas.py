@@ -1,9 +1,10 @@
 """Draws an atlas (`rubber-atlas run`) slice: for the first (α, β) of the file, the rotation
-number N of each component over the (κ, ε) plane with the resonance curves N = p/q (|q| ≤ 7)
-as contours, and the drift radius R of component 0: the path on the plane circles with radius
-R, which blows up on the integer resonances N ∈ ℤ (unbounded paths).
+number N of each torus family over the plane of the scene with the resonance curves N = p/q
+(|q| ≤ 7) as contours, and the drift radius R (the largest over the tori of each cell): the
+path on the plane circles with radius R, which blows up on the integer resonances N ∈ ℤ
+(unbounded paths).
 
-    .venv/bin/python scripts/plot_atlas.py atlas/demo.h5 --out atlas/out/demo.png
+    .venv/bin/python scripts/plot_atlas.py atlas/out/demo.h5 --out atlas/out/demo.png
 """
 from __future__ import annotations
 

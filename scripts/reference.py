@@ -1,7 +1,7 @@
 """An independent high-precision reference for one cell of rubber-atlas: every component of
 {V ≤ ε}, its turning points, T and N = −Δψ/2π, by mpmath at 50 significant digits.
 
-It shares no code with the Rust solver, only the formulas of SPEC §1.2–1.3. Points near a pole
+It shares no code with the Rust solver, only the formulas of docs/model.md–1.3. Points near a pole
 are held in the pole's chart (θ or π − θ), so that turning points at 1e-100 from a pole keep
 their digits; the critical points of V are the roots of g = sin³θ V′, found by a scan that is
 uniform in the middle and logarithmic towards both poles, where g′ and g are both scanned so
@@ -64,7 +64,7 @@ class Cell:
         with mpmath.workdps(digits):
             self.alpha, self.beta, self.nu, self.eta, self.kappa = map(mpmath.mpf, (alpha, beta, nu, eta, kappa))
 
-    # Shape functions of SPEC §1.2 at (sin θ, cos θ).
+    # Shape functions of docs/model.md at (sin θ, cos θ).
     def _z(self, s, c):
         return mpmath.sqrt(self.beta**2 * s * s + c * c)
 

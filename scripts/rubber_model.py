@@ -1,6 +1,6 @@
-"""The reduced model of SPEC §1 in plain Python, for scripts that check or race rubber-atlas.
+"""The reduced model of docs/model.md in plain Python, for scripts that check or race rubber-atlas.
 
-Three layers share the formulas of SPEC §1.2–1.3 (Z, U, B, J, V, ψ̇):
+Three layers share the formulas of docs/model.md–1.3 (Z, U, B, J, V, ψ̇):
 - `HighPrecision`: T and N = −Δψ/2π of the component nearest a given θ, from the mpmath
   reference of `reference.py` at 40 significant digits — an independent reference for the
   hard cells (near a separatrix, a pole or a minimum), where an ODE run is least reliable.
@@ -21,7 +21,7 @@ from reference import Cell
 
 
 class Body:
-    """The ellipsoid of SPEC §1.2: α, β, ν, η."""
+    """The ellipsoid of docs/model.md: α, β, ν, η."""
 
     def __init__(self, alpha: float, beta: float, nu: float = 0.5, eta: float = 0.5):
         self.alpha, self.beta, self.nu, self.eta = alpha, beta, nu, eta

@@ -1,5 +1,5 @@
 """Speed of rubber-atlas's cell solver against what a researcher writes by hand, measured side
-by side in one run on the standard slice of SPEC §5 (α = 0.5, β = 3, ν = η = 0.5,
+by side in one run on the standard slice of docs/accuracy.md (α = 0.5, β = 3, ν = η = 0.5,
 κ ∈ [0, 2] × ε ∈ [0.5, 4.5] on 256 × 256 cells):
 
 - rubber-atlas: `cargo bench --bench cell_speed`, with error control at tol 1e-10, 1 and 2

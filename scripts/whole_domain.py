@@ -105,7 +105,7 @@ def sample(seed: int, count: int) -> list[Case]:
     while len(cases) < count:
         alpha = rng.choice([0.0, 0.999999, rng.uniform(0, 1), rng.uniform(0, 1), rng.uniform(0, 1)])
         beta = rng.choice([_loguniform(rng, 1e-3, 1e3), _loguniform(rng, 0.3, 3), math.sqrt(1 + alpha)])
-        # A quarter are mirror images θ → π − θ (α < 0, valid by SPEC §1.2), whose
+        # A quarter are mirror images θ → π − θ (α < 0, valid by docs/model.md), whose
         # cancellations sit at θ = 0 instead of π.
         if rng.random() < 0.25:
             alpha = -alpha

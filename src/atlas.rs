@@ -1,6 +1,6 @@
 //! The grid driver: splits a scene's grid into work units (blocks of κ-rows of one (α, β)
 //! slice), computes them with rayon one κ-row at a time, and lays the results out as the
-//! dense per-cell and per-component arrays of the atlas file (SPEC §3.2).
+//! dense per-cell and per-component arrays of the atlas file (docs/files.md).
 
 use crate::body::Ellipsoid;
 #[cfg(test)]

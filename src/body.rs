@@ -12,7 +12,7 @@ use nalgebra::Vector3;
 
 /// An angle θ given by its sine and cosine, both to full relative precision. Near θ = π a
 /// double holds θ only to an absolute 4e-16, so callers build the pair from π − θ there
-/// (SPEC §2.3); on the κ = 0 circle θ may be any real number.
+/// (docs/accuracy.md); on the κ = 0 circle θ may be any real number.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Angle {
     /// sin θ.
@@ -312,7 +312,7 @@ impl Shape for Ellipsoid {
         self.potential_second_at(Angle::new(theta))
     }
 
-    /// |r|² = (β⁴ sin²θ + (cosθ + αZ)²) / Z² (SPEC §1.2; the paper's `eqsysell` prints
+    /// |r|² = (β⁴ sin²θ + (cosθ + αZ)²) / Z² (docs/model.md; the paper's `eqsysell` prints
     /// (αZ − cosθ)², a misprint).
     #[inline]
     fn contact_distance_sq(&self, theta: f64) -> f64 {

@@ -1,4 +1,4 @@
-//! One cell (α, β, ν, η, κ, ε) of the atlas (SPEC §2): for every component of the allowed
+//! One cell (α, β, ν, η, κ, ε) of the atlas (docs/model.md): for every component of the allowed
 //! set, ω_θ, ω_ψ, the rotation number N, the drift |Δζ| and radius R, whether the motion
 //! stays bounded, a status and error estimates — by quadrature ([`crate::torus`]) or, as an
 //! independent check, by integrating one period of the reduced system ([`crate::period_ode`]).
@@ -699,7 +699,7 @@ fn on_separatrix<S: Shape>(
 }
 
 /// The linearised limits at a fixed point θ0: ω_θ = √(V″/B), ψ̇(θ0), N = −ψ̇/ω_θ; the centre
-/// of mass runs round its circle of radius ρ_c = U tanθ0 (SPEC §1.5), so R = ρ_c and
+/// of mass runs round its circle of radius ρ_c = U tanθ0 (docs/model.md), so R = ρ_c and
 /// |Δζ| = 2 ρ_c |sin(Δψ/2)|.
 fn fixed_point<S: Shape>(
     potential: &EffectivePotential<'_, S>,

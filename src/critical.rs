@@ -1,10 +1,10 @@
-//! The critical set of the integral map for the ellipsoid (paper §4, SPEC §1.5): the diagram
+//! The critical set of the integral map for the ellipsoid (paper §4, docs/model.md): the diagram
 //! type on the (α, β²) plane, the branches of permanent rotations σ_s0, σ_u, σ_sπ (`s1`) and,
 //! for α = 0, the equator σ_π/2 (`s2`), the equilibria σ0, σπ (`s0`) and θ* (`thz`), the cusp
 //! of type (c), and ε_min, the energy needed to roll over the top at κ = 0.
 //!
 //! Several of the paper's printed formulas carry misprints; the corrected forms used here are
-//! those of SPEC §1.5, and the tests check each against a direct numerical search.
+//! those of docs/model.md, and the tests check each against a direct numerical search.
 
 use crate::body::{EllipsoidBody, Shape};
 use crate::error::{AtlasError, Result};
@@ -13,7 +13,7 @@ use crate::torus::bisect;
 use serde::Serialize;
 use std::f64::consts::{FRAC_PI_2, PI};
 
-/// The five types of bifurcation diagram of paper Fig. `ab` (SPEC §1.5), plus the degenerate
+/// The five types of bifurcation diagram of paper Fig. `ab` (docs/model.md), plus the degenerate
 /// and boundary cases.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -213,7 +213,7 @@ pub fn inclined_equilibrium(alpha: f64, beta: f64) -> Option<f64> {
 }
 
 /// ε_min = max of U on the circle: 1 + α if β² < 1 + α, else U(θ*) = β √((β² − 1 + α²)/(β² − 1))
-/// (SPEC §1.5; the paper prints (1 + α² − β²)/(1 − β²) under the root).
+/// (docs/model.md; the paper prints (1 + α² − β²)/(1 − β²) under the root).
 pub fn energy_min(alpha: f64, beta: f64) -> f64 {
     let b2 = beta * beta;
     if b2 <= 1.0 + alpha.abs() {

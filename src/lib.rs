@@ -2,7 +2,9 @@
 //!
 //! Dense atlases of the dynamics of a "rubber" body of revolution (no slipping, no spinning
 //! about the vertical) rolling on a plane, after Kilin & Pivovarova, *Bifurcation analysis of
-//! the problem of a "rubber" ellipsoid of revolution rolling on a plane* (`shared/paper.tex`).
+//! the problem of a "rubber" ellipsoid of revolution rolling on a plane*: the equation labels
+//! in these docs (`eqsys`, `s1`, `dpsi`, …) are that paper's; docs/model.md states the model
+//! as this crate computes it.
 //!
 //! The crate follows the pipeline of the computation:
 //!
@@ -34,8 +36,8 @@
 //!
 //! Units are the paper's: length b3, mass m, time √(b3/g). The paper's misprints (in B(θ), the
 //! velocity of the centre of mass, θ*, ε_min, the stability of the equator, the type (c)
-//! boundary) are corrected as in SPEC §1; each correction is pinned by a test against the full
-//! equations or a direct numerical search.
+//! boundary) are corrected as in docs/model.md; each correction is pinned by a test against the
+//! full equations or a direct numerical search.
 
 pub mod atlas;
 pub mod body;

@@ -1,4 +1,4 @@
-//! The limits that bound the (κ, ε) plane (SPEC §4): the high-energy limit N∞(λ) of the
+//! The limits that bound the (κ, ε) plane (docs/hypothesis.md): the high-energy limit N∞(λ) of the
 //! rotation number at fixed λ = κ/√ε, the linearised N at the bottom of each well (stable
 //! permanent rotations, `s1`), and the known limits at κ → 0 and at a separatrix. The
 //! verdict on the boundedness hypothesis ([`crate::verdict`]) closes the plane with them.
@@ -30,7 +30,7 @@ pub struct Estimate {
     pub error: f64,
 }
 
-/// The rotation number tends to these at κ → 0 (SPEC §4): a libration that passes near the
+/// The rotation number tends to these at κ → 0 (docs/hypothesis.md): a libration that passes near the
 /// pole θ = 0 only winds ψ by −π per passage (N → +1/2), one near θ = π only by +π
 /// (N → −1/2), and one that passes near both (a κ = 0 rotation over the top, ε > ε_min) has
 /// the two passages cancel, N = O(κ) → 0. They are the κ → 0 edge of the plane the verdict
@@ -262,7 +262,7 @@ pub fn high_energy_slope<S: Shape>(body: &Body<S>, tol: f64) -> Estimate {
 }
 
 /// The high-energy limit of one body: the slope of N∞ at λ → 0 and its extrema over
-/// 0 < λ < √2 (SPEC §4 contract `high_energy`).
+/// 0 < λ < √2 (docs/hypothesis.md contract `high_energy`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct HighEnergyLimit {
     /// lim N∞(λ)/λ as λ → 0.

@@ -255,6 +255,57 @@ fn cells<'py>(
     Ok(out)
 }
 
+/// The bottom of V (its deepest minimum) at each (α, β, ν, η, κ) of five equal-length
+/// arrays, in parallel with the GIL released: the origin of the `excess_energy` axis, as an
+/// atlas's `kappa`/`excess_energy` plane measures it. A bad cell is refused, naming its index.
+#[pyfunction]
+#[pyo3(signature = (alpha, beta, nu, eta, kappa, threads=None))]
+fn bottoms<'py>(
+    py: Python<'py>,
+    alpha: PyReadonlyArray1<'py, f64>,
+    beta: PyReadonlyArray1<'py, f64>,
+    nu: PyReadonlyArray1<'py, f64>,
+    eta: PyReadonlyArray1<'py, f64>,
+    kappa: PyReadonlyArray1<'py, f64>,
+    threads: Option<i64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let slices = [&alpha, &beta, &nu, &eta, &kappa]
+        .iter()
+        .map(|a| a.as_slice().map_err(|e| bad(e.to_string())))
+        .collect::<PyResult<Vec<&[f64]>>>()?;
+    let n = slices[0].len();
+    if slices.iter().any(|s| s.len() != n) {
+        return Err(bad(
+            "alpha, beta, nu, eta and kappa must have one length".into()
+        ));
+    }
+    let points: Vec<CellPoint> = (0..n)
+        .map(|i| CellPoint {
+            alpha: slices[0][i],
+            beta: slices[1][i],
+            nu: slices[2][i],
+            eta: slices[3][i],
+            kappa: slices[4][i],
+            energy: 0.0,
+        })
+        .collect();
+    let bodies = atlas::cell_bodies(&points).map_err(value_error)?;
+    let pool = pool(threads)?;
+    let values = in_pool(py, &pool, || {
+        use rayon::prelude::*;
+        points
+            .par_iter()
+            .zip(&bodies)
+            .map(|(p, body)| {
+                crate::torus::EffectivePotential::new(body, p.kappa)
+                    .lowest_minimum()
+                    .unwrap_or(f64::NAN)
+            })
+            .collect::<Vec<f64>>()
+    });
+    Ok(PyArray1::from_vec(py, values))
+}
+
 /// A table as a dict: `dimension`, `columns` (dicts of name, values, long_name, units,
 /// comment, flag_values, flag_meanings) and `attributes`.
 fn table_dict<'py>(py: Python<'py>, table: Table) -> PyResult<Bound<'py, PyDict>> {
@@ -430,7 +481,7 @@ fn resonance(
     ))
 }
 
-/// The verdict of the boundedness hypothesis (SPEC §4) for each body, as JSON (the
+/// The verdict of the boundedness hypothesis (docs/hypothesis.md) for each body, as JSON (the
 /// `verdict --json` object), computed in parallel with the GIL released.
 #[pyfunction]
 #[pyo3(signature = (alpha, beta, nu, eta, tol, resolution, threads=None))]
@@ -551,6 +602,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(coordinate, m)?)?;
     m.add_function(wrap_pyfunction!(provenance, m)?)?;
     m.add_function(wrap_pyfunction!(cells, m)?)?;
+    m.add_function(wrap_pyfunction!(bottoms, m)?)?;
     m.add_function(wrap_pyfunction!(diagram, m)?)?;
     m.add_function(wrap_pyfunction!(trajectory, m)?)?;
     m.add_function(wrap_pyfunction!(resonance, m)?)?;

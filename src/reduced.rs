@@ -116,7 +116,7 @@ impl<'a, S: Shape> ReducedSystem<'a, S> {
 
     /// Velocity of the centre of mass on the plane, ζ̇ = ẋ_c + i ẏ_c:
     /// ζ̇ = −U(θ) e^{iψ} (κ / (J sinθ) + i p), from ṙ_c = Qᵀ v, v = −ω × r (`kin`, `constr`)
-    /// with the Euler-angle matrix Q of paper §4. The paper keeps only the κ-part; SPEC §1.3
+    /// with the Euler-angle matrix Q of paper §4. The paper keeps only the κ-part; docs/model.md
     /// prints the opposite overall sign. This sign is the one the full system gives (tested),
     /// and the one of the paper's own circle x_c = ρ_c sinψ, y_c = −ρ_c cosψ. Returns (ẋ_c, ẏ_c).
     #[inline]

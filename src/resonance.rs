@@ -2,7 +2,7 @@
 //! component equals p/q, traced by pseudo-arclength continuation with the cell solver (each
 //! point solved to the solver's tolerance, not read off a grid), and the fold of the curve of
 //! largest κ: N(κ, ε) = p/q, ∂N/∂ε = 0, which for N = 0 is κ_max of the boundedness
-//! hypothesis (SPEC §4; paper §5).
+//! hypothesis (docs/hypothesis.md; paper §5).
 
 use crate::body::Shape;
 use crate::cell::{solve_component, within_rounding_of_separatrix, CellOptions, Status};

@@ -1,4 +1,4 @@
-//! Scenes: the TOML files (SPEC §3.2) that describe an atlas run — the body (ν, η), the grid
+//! Scenes: the TOML files (docs/files.md) that describe an atlas run — the body (ν, η), the grid
 //! axes α, β, κ, ε, the solver settings and the outputs wanted. Parsing checks every key and
 //! value and names the file, the key and the reason of the first problem it finds.
 
@@ -125,7 +125,7 @@ const MAX_KAPPA: f64 = 1e150;
 /// The smallest s > 0 of a compactified plane: ε = 1/s² ≤ 1e300.
 const MIN_S: f64 = 1e-150;
 
-/// Which two axes span the (κ, ε) plane of each body (SPEC §3.2 and §4).
+/// Which two axes span the (κ, ε) plane of each body (docs/files.md and §4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Plane {
     /// `kappa` and `energy`: κ and ε themselves.

@@ -1,7 +1,7 @@
 //! One level set (κ, ε) of the reduced system, computed by quadrature: the critical points of
 //! V (found once per (body, κ) and reused for every ε), the components of {V ≤ ε} (each an
 //! invariant torus), their turning points, and the integrals over one θ-period — the period
-//! T, the precession Δψ and the drift Δζ of the centre of mass (paper §5, `dpsi`; SPEC §2).
+//! T, the precession Δψ and the drift Δζ of the centre of mass (paper §5, `dpsi`; docs/model.md).
 //!
 //! A libration is first integrated whole after the cosine substitution (module `cosine`),
 //! geometrically convergent unless a saddle or a pole comes close. Otherwise the component is
@@ -10,7 +10,7 @@
 //! piece's ends, where the 1/√ singularity of a turning point, the near-logarithmic one of a
 //! nearby saddle and the narrow ψ̇ peak near a pole at small κ all sit. In both, the gap
 //! ε − V(θ) is evaluated from the nearer end with the divided difference of V, so it keeps
-//! full relative precision right up to the turning points (SPEC §2.3).
+//! full relative precision right up to the turning points (docs/accuracy.md).
 
 use crate::body::{Angle, Body, Reduction, Shape};
 use crate::error::{AtlasError, Result};

@@ -30,7 +30,7 @@ pub struct Start {
 
 impl Start {
     /// The start at the lower turning point θ_min of component `index` of the level set
-    /// (κ, ε), with θ̇ = 0 (the start of SPEC §2's drift).
+    /// (κ, ε), with θ̇ = 0 (the start of docs/model.md's drift).
     pub fn at_energy<S: Shape>(
         body: &Body<S>,
         kappa: f64,

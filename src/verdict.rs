@@ -1,4 +1,4 @@
-//! The verdict on the paper's boundedness hypothesis (SPEC §4) for one body over the whole
+//! The verdict on the paper's boundedness hypothesis (docs/hypothesis.md) for one body over the whole
 //! (κ, ε) plane: integer resonances located to the solver's tolerance, with the limits of
 //! [`crate::limits`] closing the plane at ε → ∞, at the bottom of each well and at κ → 0.
 //!
@@ -16,9 +16,9 @@
 //! levels) have N − k of opposite signs, or a sample has N = k within its error. Each such
 //! pair is refined by regula falsi to N = k within the solver's tolerance, and the point is
 //! solved again with the drift: a counterexample is a point with Δζ ≠ 0 there (the centre of
-//! mass then runs away linearly, SPEC §2).
+//! mass then runs away linearly, docs/model.md).
 //!
-//! The hypothesis (SPEC §4): case 1, β² < 1 + α: bounded for every κ ≠ 0; case 2,
+//! The hypothesis (docs/hypothesis.md): case 1, β² < 1 + α: bounded for every κ ≠ 0; case 2,
 //! β² > 1 + α and α > 0: bounded for κ > κ_max, the top (fold) of the N = 0 curve that hugs
 //! σ_u. Other bodies (α = 0 with β ≥ 1, and β² = 1 + α exactly) are not covered.
 
@@ -46,7 +46,7 @@ const SEPARATRIX_PROBES: [f64; 8] = [1e-1, 1e-2, 1e-3, 1e-5, 1e-7, 1e-9, 1e-11, 
 const PER_INTEGER: usize = 2;
 const INTEGERS_REPORTED: usize = 6;
 
-/// Which part of the hypothesis covers a body (SPEC §4).
+/// Which part of the hypothesis covers a body (docs/hypothesis.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub enum Case {
     /// β² < 1 + α: bounded for every κ ≠ 0.
@@ -101,7 +101,7 @@ impl Default for VerdictOptions {
     }
 }
 
-/// A point on an integer resonance where the path runs away (SPEC §4 contract).
+/// A point on an integer resonance where the path runs away (docs/hypothesis.md contract).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Counterexample {
     pub kappa: f64,
@@ -152,7 +152,7 @@ pub struct Evidence {
     pub limits: Vec<&'static str>,
 }
 
-/// The verdict for one body (SPEC §4 contract of `rubber-atlas verdict`).
+/// The verdict for one body (docs/hypothesis.md contract of `rubber-atlas verdict`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Verdict {
     pub alpha: f64,
@@ -1112,7 +1112,7 @@ pub struct ScanPoint {
     pub high_energy: HighEnergyLimit,
 }
 
-/// The boundaries of the verdict along β at one α (SPEC §4 contract of `verdict
+/// The boundaries of the verdict along β at one α (docs/hypothesis.md contract of `verdict
 /// --boundaries`), with the scan they were found from.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Boundaries {

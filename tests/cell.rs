@@ -1,4 +1,4 @@
-//! The cell solver against the independent ODE method on the hard cases of SPEC §2.2, its
+//! The cell solver against the independent ODE method on the hard cases of docs/accuracy.md, its
 //! limits (linearised frequency, logarithmic growth near a saddle, κ → 0⁺), symmetries, and
 //! random cells.
 

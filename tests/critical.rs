@@ -1,4 +1,4 @@
-//! The corrected formulas of SPEC §1.5 and the analytic derivatives, each against a direct
+//! The corrected formulas of docs/model.md and the analytic derivatives, each against a direct
 //! numerical search or finite differences, over many random bodies (proptest, failing cases kept in
 //! `tests/critical.proptest-regressions` and replayed first).
 
@@ -120,7 +120,7 @@ proptest! {
     fn closed_forms_agree_with_the_vector_contact_point(
         (alpha, beta, nu, eta) in body_strategy(), theta in 0.0f64..PI, phi in 0.0f64..TAU
     ) {
-        // B = 1/η + |r|² (SPEC's corrected B) and U = −(r, γ) from r(γ) of paper `r`.
+        // B = 1/η + |r|² (the corrected B of docs/model.md) and U = −(r, γ) from r(γ) of paper `r`.
         let b = EllipsoidBody::ellipsoid(alpha, beta, nu, eta).unwrap();
         let gamma = nalgebra::Vector3::new(theta.sin() * phi.sin(), theta.sin() * phi.cos(), theta.cos());
         let r = b.shape.contact_point(&gamma);
@@ -229,7 +229,7 @@ proptest! {
     fn equator_stability_for_alpha_zero_matches_the_linearisation(
         beta in 0.2f64..4.0, kappa in 0.0f64..3.0, nu in 0.1f64..2.0, eta in 0.1f64..5.0
     ) {
-        // SPEC §1.5: V″(π/2) = κ² − (β² − 1)/β; stable iff |κ| > κ_c (β > 1), always (β < 1).
+        // docs/model.md: V″(π/2) = κ² − (β² − 1)/β; stable iff |κ| > κ_c (β > 1), always (β < 1).
         // The paper's `a0usl` has the inequality reversed.
         prop_assume!((beta - 1.0).abs() > 0.01);
         let b = EllipsoidBody::ellipsoid(0.0, beta, nu, eta).unwrap();
@@ -249,7 +249,7 @@ proptest! {
 
 #[test]
 fn paper_type_c_values_and_misprints() {
-    // α = 0.5, β = 3 (SPEC §1.5): θ* = 1.38509 (the paper's root gives 1.37912), ε_min =
+    // α = 0.5, β = 3 (docs/model.md): θ* = 1.38509 (the paper's root gives 1.37912), ε_min =
     // 3.04651 (the paper's gives 2.95275).
     let ts = inclined_equilibrium(0.5, 3.0).unwrap();
     assert!((ts - 1.38509).abs() < 5e-6, "theta* = {ts}");

@@ -94,7 +94,7 @@ fn slope_is_the_rate_at_which_n_vanishes_at_fixed_kappa() {
 
 #[test]
 fn extrema_of_the_limit_match_the_strongly_oblate_body() {
-    // SPEC §4: cells along λ = 0.06399 at ε = 1e4 … 1e16 give N → −1.7611358 for
+    // docs/hypothesis.md: cells along λ = 0.06399 at ε = 1e4 … 1e16 give N → −1.7611358 for
     // α = 0.9, β = 20, ν = η = 0.5: below −1, so N = −1 is crossed at every large κ.
     let body = EllipsoidBody::ellipsoid(0.9, 20.0, 0.5, 0.5).unwrap();
     let lim = HighEnergyLimit::of(&body, 1e-12).unwrap();

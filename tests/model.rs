@@ -1,4 +1,4 @@
-//! The reduced model against the full equations of motion (SPEC §1.4): θ(t), the four
+//! The reduced model against the full equations of motion (docs/model.md): θ(t), the four
 //! integrals, the paths of the centre of mass and the contact point, permanent rotations, and
 //! the paper's Fig. `xy` resonance (issue 2).
 
@@ -306,7 +306,7 @@ fn closure_after_seven_periods(theta0: f64, model: Model) -> (f64, f64) {
 
 #[test]
 fn paper_fig_xy_resonance_closes_after_seven_periods() {
-    // SPEC §2.1: with the correct B, N(0.4678) ≈ −0.14248, and N = −1/7 at θ0 ≈ 0.46703.
+    // docs/model.md: with the correct B, N(0.4678) ≈ −0.14248, and N = −1/7 at θ0 ≈ 0.46703.
     let n_paper = xy_rotation_number(0.4678);
     assert!((n_paper + 0.14248).abs() < 5e-6, "N(0.4678) = {n_paper}");
     // Root of N(θ0) + 1/7 by bisection (N is monotone on this bracket).
@@ -344,7 +344,7 @@ fn paper_fig_xy_resonance_closes_after_seven_periods() {
 #[test]
 fn quadrature_period_and_precession_match_the_ode() {
     // T and Δψ from the u-substituted trapezoid rule against one period of the reduced ODE:
-    // after T, θ and θ̇ are back and ψ has advanced by Δψ. Also SPEC §2.1: N ≈ −0.759.
+    // after T, θ and θ̇ are back and ψ has advanced by Δψ. Also docs/model.md: N ≈ −0.759.
     let b = EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 0.5).unwrap();
     let s = Start {
         kappa: 1.0,

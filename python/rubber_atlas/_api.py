@@ -4,7 +4,10 @@ names, units and flags of the files `rubber-atlas` writes."""
 from __future__ import annotations
 
 import json
+import re
 import sys
+import time
+import functools
 from fractions import Fraction
 from pathlib import Path
 from typing import Iterable
@@ -12,12 +15,49 @@ from typing import Iterable
 import numpy as np
 import xarray as xr
 
-from . import _core
 
-FIELDS: tuple[str, ...] = tuple(_core.FIELDS)
-"""The fields a scene (and `cells`) may ask for, in file order."""
+class _NoCore:
+    """Stands for the compiled core where it is not built (the source tree on the path, as the
+    quick start uses it): opening, reading and drawing atlas files need no core; anything that
+    computes says how to get it."""
 
-_INPUTS = ("alpha", "beta", "nu", "eta", "kappa", "energy")
+    def __getattr__(self, name):
+        raise ImportError(
+            "rubber_atlas's compiled core is not installed: `pip install .` in the repository builds "
+            "it (it needs the Rust toolchain; bash scripts/setup.sh does it). Opening and drawing "
+            "atlas files works without it."
+        )
+
+
+try:
+    from . import _core
+except ImportError:
+    _core = _NoCore()
+
+HAS_CORE = not isinstance(_core, _NoCore)
+"""Whether the compiled core is installed (everything but reading and drawing files needs it)."""
+
+FIELDS: tuple[str, ...] = tuple(_core.FIELDS) if HAS_CORE else ()
+"""The fields a scene (and `cells`) may ask for, in file order (empty without the core)."""
+
+_BODY = ("alpha", "beta", "nu", "eta")
+# The planes of a scene: the two inputs that give (κ, ε), and what each derived value needs.
+_PLANES = (("kappa", "energy"), ("kappa", "excess_energy"), ("lambda", "s"))
+_DERIVED = {
+    "excess_energy": {"energy": ("alpha", "beta", "kappa", "excess_energy")},
+    "s": {"kappa": ("lambda", "s"), "energy": ("s",)},
+}
+@functools.cache
+def _family_names() -> dict[int, str]:
+    """{code: name} of the torus families, as the core's `family` variable flags them."""
+    meta = next(m for m in _core.variables(None) if m["name"] == "family")
+    return {int(v): n for v, n in zip(meta["flag_values"], meta["flag_meanings"].split()) if int(v) != 255}
+_LAYOUTS = ("family", "theta_min")
+# `cells` shows progress by default above this many cells (in a terminal or in Jupyter), in
+# about _PROGRESS_STEPS batches of at least _BATCH_CELLS cells each.
+_PROGRESS_CELLS = 200_000
+_PROGRESS_STEPS = 100
+_BATCH_CELLS = 16_384
 
 
 def _call(name: str, arguments: dict) -> str:
@@ -46,8 +86,24 @@ def _variable_attrs(meta: dict) -> dict:
     return attrs
 
 
+# The axes of the other planes, described as the atlas files describe them (for cores that do
+# not know them by name).
+_OTHER_COORDINATES = {
+    "lambda": ("lambda = kappa / sqrt(energy), fixed along the high-energy limit", "kappa"),
+    "s": ("s = 1 / sqrt(energy): s = 0 is energy = infinity (the high-energy limit)", "kappa"),
+    "excess_energy": ("excess energy: energy minus the bottom of V (its deepest minimum) at this kappa",
+                      "energy"),
+}
+
+
 def _coordinate_attrs(name: str) -> dict:
-    long_name, units, comment = _core.coordinate(name)
+    try:
+        long_name, units, comment = _core.coordinate(name)
+    except ValueError:
+        if name not in _OTHER_COORDINATES:
+            raise
+        long_name, like = _OTHER_COORDINATES[name]
+        _, units, comment = _core.coordinate(like)
     attrs = {"long_name": long_name, "units": units}
     if comment:
         attrs["comment"] = comment
@@ -65,9 +121,68 @@ def _check_input(name: str, value) -> None:
         raise TypeError(f"{name} is complex: give real numbers")
 
 
-def _broadcast(given: dict[str, object]) -> tuple[tuple[str, ...], list[np.ndarray], dict]:
+def _plane(kappa, energy, excess_energy, lambda_, s) -> dict:
+    """The two inputs that span the (κ, ε) plane, by their coordinate names: kappa with
+    energy or excess_energy, or lambda with s."""
+    given = {n: v for n, v in (("kappa", kappa), ("energy", energy), ("excess_energy", excess_energy),
+                                 ("lambda", lambda_), ("s", s)) if v is not None}
+    for pair in _PLANES:
+        if set(given) == set(pair):
+            return {n: given[n] for n in pair}
+    shown = {"lambda": "lambda_"}
+    names = ", ".join(shown.get(n, n) for n in given) or "none of them"
+    if len(given) == 1:
+        (only,) = given
+        missing = {"energy": "kappa", "excess_energy": "kappa", "s": "lambda_", "lambda": "s",
+                   "kappa": "energy"}[only]
+        raise TypeError(f"{missing} is None: give a number or an array of numbers (the plane is kappa with "
+                        "energy, kappa with excess_energy, or lambda_ with s)")
+    raise TypeError("give the plane as kappa with energy, kappa with excess_energy, or lambda_ with s; "
+                    f"got {names}")
+
+
+def _dims_of(coordinate) -> tuple:
+    return tuple(coordinate[0]) if isinstance(coordinate, tuple) else tuple(coordinate.dims)
+
+
+def _numpy_dims(shape: tuple, values: dict[str, np.ndarray]) -> tuple[tuple[str, ...], dict]:
+    """Names of the dimensions of inputs broadcast by numpy's rules, and each input's
+    coordinate over the dimensions it varies along. One dimension is `cell`; of several, one
+    along which a single input varies (and that input along no other) takes the input's
+    name, the others are `cell_0`, `cell_1`, …"""
+    ndim = len(shape)
+    along = {}
+    for name, v in values.items():
+        padded = v.reshape((1,) * (ndim - v.ndim) + v.shape)
+        # An axis the input spans: it varies along it, or the axis has one value and the
+        # input was given along it.
+        along[name] = [i for i in range(ndim)
+                       if padded.shape[i] > 1 or (shape[i] == 1 and i >= ndim - v.ndim)]
+    if ndim == 1:
+        dims = ("cell",)
+    else:
+        dims = []
+        for i in range(ndim):
+            varying = [n for n, axes in along.items() if i in axes]
+            if len(varying) == 1 and along[varying[0]] == [i]:
+                dims.append(varying[0])
+            else:
+                dims.append(f"cell_{i}")
+        dims = tuple(dims)
+    coords = {}
+    for name, v in values.items():
+        padded = v.reshape((1,) * (ndim - v.ndim) + v.shape)
+        axes = along[name]
+        squeezed = padded.reshape([padded.shape[i] for i in axes]) if axes else padded.reshape(())
+        coords[name] = (tuple(dims[i] for i in axes), np.array(squeezed))
+    return dims, coords
+
+
+def _broadcast(given: dict[str, object], plane: tuple[str, str] | None = None
+               ) -> tuple[tuple[str, ...], list[np.ndarray], dict]:
     """Broadcasts the inputs together: DataArrays by their dimension names (xarray's rules),
-    anything else by numpy's (dimensions `cell`, or `cell_0`, `cell_1`, … for several).
+    anything else by numpy's (see `_numpy_dims` for the names of the dimensions); the two
+    inputs of `plane`, 1-D of different lengths with every other input a number, as a grid.
     Returns the dimensions, the arrays in that layout, and the coordinates of the result:
     each input over the dimensions it varies along (scalar where it is one number)."""
     for name, v in given.items():
@@ -109,13 +224,267 @@ def _broadcast(given: dict[str, object]) -> tuple[tuple[str, ...], list[np.ndarr
                 coords.setdefault(cname, c)
         return dims, layout, coords
     values = {k: np.asarray(v, dtype=np.float64) for k, v in given.items()}
-    layout = np.broadcast_arrays(*values.values())
-    shape = layout[0].shape
-    dims = ("cell",) if len(shape) == 1 else tuple(f"cell_{i}" for i in range(len(shape)))
-    coords = {}
-    for (name, v), full in zip(values.items(), layout):
-        coords[name] = ((), v) if v.ndim == 0 else (dims, np.array(full))
+    try:
+        layout = np.broadcast_arrays(*values.values())
+    except ValueError:
+        vectors = {k: v for k, v in values.items() if v.ndim > 0}
+        if (plane is not None and set(vectors) == set(plane) and all(v.ndim == 1 for v in vectors.values())):
+            # Two axes of different lengths: their grid, dimensions named after them.
+            values[plane[0]] = values[plane[0]][:, None]
+            values[plane[1]] = values[plane[1]][None, :]
+            layout = np.broadcast_arrays(*values.values())
+        else:
+            shapes = ", ".join(f"{k} {v.shape}" for k, v in vectors.items())
+            raise ValueError(
+                f"the inputs do not broadcast together ({shapes}): numpy pairs their last dimensions, "
+                "which must be equal or 1; give them as xarray.DataArrays with named dimensions (one "
+                "dimension per axis of the grid), or only the two axes of the plane as vectors"
+            ) from None
+    dims, coords = _numpy_dims(layout[0].shape, values)
     return dims, list(layout), coords
+
+
+def _derived(full: np.ndarray, dims: tuple, coords: dict, sources: Iterable[str]) -> tuple:
+    """A value computed per cell (`full`, in the layout of `dims`) as a coordinate over the
+    dimensions its `sources` vary along."""
+    spanned = set().union(*(_dims_of(coords[s]) for s in sources))
+    keep = tuple(d for d in dims if d in spanned)
+    index = tuple(slice(None) if d in keep else 0 for d in dims)
+    return keep, np.array(full[index])
+
+
+def _excess_to_energy(alpha: np.ndarray, beta: np.ndarray, nu: np.ndarray, eta: np.ndarray, kappa: np.ndarray,
+                      excess_energy: np.ndarray) -> np.ndarray:
+    """ε = V_min(κ) + `excess_energy` per cell (flat float64 arrays of one length), V_min the
+    bottom (deepest minimum) of V(θ) = κ²/(2 sin²θ) + U(θ) at each body and κ, as the atlas's
+    `kappa`/`excess_energy` plane computes it (the Rust core, in parallel)."""
+    _first_bad("excess_energy", excess_energy, ~np.isfinite(excess_energy), "must be a finite number")
+    bottom = _core.bottoms(*(np.ascontiguousarray(a, dtype=np.float64) for a in (alpha, beta, nu, eta, kappa)))
+    return bottom + excess_energy
+
+
+def _first_bad(name: str, values: np.ndarray, bad: np.ndarray, why: str) -> None:
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        value = float(values[i])
+        raise ValueError(f"cell {i}: invalid {name} = {'NaN' if np.isnan(value) else repr(value)}: {why}")
+
+
+def _to_kappa_energy(plane: tuple[str, str], flat: list[np.ndarray]) -> list[np.ndarray]:
+    """The six flat inputs (α, β, ν, η and the plane's two) as α, β, ν, η, κ, ε."""
+    a, b = flat[4], flat[5]
+    if plane == ("kappa", "energy"):
+        return flat
+    if plane == ("lambda", "s"):
+        _first_bad("lambda", a, ~np.isfinite(a), "lambda = kappa / sqrt(energy) must be a finite number")
+        _first_bad("s", b, b == 0, "s = 0 is the high-energy limit energy = infinity, which cells does "
+                   "not compute; give s > 0 (energy = 1/s^2)")
+        _first_bad("s", b, ~(b > 0) | ~np.isfinite(b), "s = 1 / sqrt(energy) must be a finite number > 0")
+        with np.errstate(over="ignore"):
+            return flat[:4] + [a / b, 1.0 / (b * b)]
+    return flat[:4] + [a, _excess_to_energy(*flat[:4], a, b)]
+
+
+def _show_bytes(n: float) -> str:
+    for name, size in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if n >= size:
+            return f"{n / size:.1f} {name}"
+    return f"{n:.0f} B"
+
+
+def _check_memory(cells: int, fields: list[str] | None, allow_large: bool) -> None:
+    """Refuses (unless `allow_large`) results that would take over 80 % of the memory the
+    kernel could give now: the rule of the core's own check, for the whole of a call the
+    package splits into batches."""
+    if allow_large:
+        return
+    try:
+        with open("/proc/meminfo") as f:
+            line = next(x for x in f if x.startswith("MemAvailable:"))
+        available = float(line.split()[1]) * 1024.0
+    except (OSError, StopIteration, ValueError, IndexError):
+        return
+    per_cell = sum(np.dtype(m["dtype"]).itemsize * (max(_core.COMPONENT_SLOTS, len(_family_names()))
+                                                   if m["per_component"] else 1)
+                   for m in _core.variables(fields))
+    needed = cells * (6 * 8 + 2 * per_cell)
+    if needed > 0.8 * available:
+        raise ValueError(f"cells needs about {_show_bytes(needed)} of memory ({_show_bytes(available)} "
+                         "available): give fewer cells at a time, or allow_large=True")
+
+
+def _in_jupyter() -> bool:
+    """Whether this runs in a Jupyter kernel (a notebook, JupyterLab, VS Code's)."""
+    ipython = sys.modules.get("IPython")
+    if ipython is None:
+        return False
+    try:
+        shell = ipython.get_ipython()
+    except Exception:  # noqa: BLE001 - any failure means no kernel
+        return False
+    return shell is not None and getattr(shell, "kernel", None) is not None
+
+
+def _stderr_is_terminal() -> bool:
+    try:
+        return bool(sys.stderr.isatty())
+    except (AttributeError, ValueError):
+        return False
+
+
+class _TextBar:
+    """A progress bar on standard error, for when tqdm is not installed."""
+
+    def __init__(self, total: int, desc: str):
+        self.total, self.desc, self.done = total, desc, 0
+        self.start = self.shown = time.monotonic()
+        self._draw()
+
+    def update(self, n: int) -> None:
+        self.done += n
+        now = time.monotonic()
+        if now - self.shown >= 0.1 or self.done >= self.total:
+            self.shown = now
+            self._draw()
+
+    def _draw(self) -> None:
+        fraction = self.done / self.total if self.total else 1.0
+        elapsed = time.monotonic() - self.start
+        left = elapsed / fraction - elapsed if fraction > 0 else float("nan")
+        clock = lambda t: "--:--" if not np.isfinite(t) else f"{int(t) // 60:02d}:{int(t) % 60:02d}"  # noqa: E731
+        filled = int(round(30 * fraction))
+        sys.stderr.write(f"\r{self.desc}: {100 * fraction:3.0f}% |{'#' * filled}{' ' * (30 - filled)}| "
+                         f"{self.done}/{self.total} [{clock(elapsed)}<{clock(left)}]")
+        sys.stderr.flush()
+
+    def close(self) -> None:
+        sys.stderr.write("\n")
+        sys.stderr.flush()
+
+
+def _progress_bar(total: int):
+    """tqdm's bar (a widget in Jupyter, text in a terminal) if tqdm is installed, else a text bar."""
+    try:
+        from tqdm.auto import tqdm
+    except ImportError:
+        return _TextBar(total, "rubber_atlas.cells")
+    return tqdm(total=total, desc="rubber_atlas.cells", unit="cell", unit_scale=True)
+
+
+def _fill(dtype: np.dtype):
+    """What a per-component variable holds where the component does not exist."""
+    dtype = np.dtype(dtype)
+    if dtype.kind == "f":
+        return np.nan
+    if dtype.kind == "u":
+        return np.iinfo(dtype).max
+    return -1
+
+
+def _solve_batch(flat: list[np.ndarray], start: int, options: tuple, layout: str) -> dict:
+    """One call of the core: {"columns": [(name, flat array)], "component": [labels],
+    "layout": …, and for the family layout possibly the component's "flag_values" and
+    "flag_meanings"}."""
+    try:
+        result = _core.cells(*flat, *options, layout=layout)
+    except ValueError as e:
+        if start == 0:
+            raise
+        # The index of a bad cell in the whole input, not in this batch.
+        message = re.sub(r"\bcell (\d+)", lambda m: f"cell {int(m.group(1)) + start}", str(e), count=1)
+        raise ValueError(message) from None
+    out = dict(result)
+    out["columns"] = list(result["columns"])
+    out["component"] = [int(c) for c in result["component"]]
+    out["layout"] = str(result["layout"])
+    return out
+
+
+def _solve(flat: list[np.ndarray], options: tuple, layout: str, meta: dict, progress: bool,
+           allow_large: bool, fields: list[str] | None) -> dict:
+    """Solves the flat cells, in batches when `progress` shows how far it got; returns what
+    one call of the core over all of them would (see `_solve_batch`): per-component arrays
+    with the component fastest, over the union of the batches' components less those empty
+    in every cell."""
+    n = len(flat[0])
+    if not progress:
+        return _solve_batch(flat, 0, options, layout)
+    size = max(_BATCH_CELLS, -(-n // _PROGRESS_STEPS))
+    if n > size:
+        _check_memory(n, fields, allow_large)
+    parts = []
+    bar = _progress_bar(n)
+    try:
+        for start in range(0, max(n, 1), size):
+            stop = min(n, start + size)
+            parts.append((stop - start, _solve_batch([a[start:stop] for a in flat], start, options, layout)))
+            bar.update(stop - start)
+    finally:
+        bar.close()
+    if len(parts) == 1:
+        return parts[0][1]
+    # The union of the batches' components (sorted: families by code, ranks in order).
+    component = sorted(set().union(*(p["component"] for _, p in parts)))
+    where = {c: i for i, c in enumerate(component)}
+    columns = []
+    for k, (name, _) in enumerate(parts[0][1]["columns"]):
+        pieces = []
+        for count, part in parts:
+            values = np.asarray(part["columns"][k][1])
+            per_component = meta.get(name, {}).get("per_component", values.size != count)
+            if not per_component:
+                pieces.append(values)
+                continue
+            full = np.full((count, len(component)), _fill(values.dtype), dtype=values.dtype)
+            full[:, [where[c] for c in part["component"]]] = values.reshape(count, len(part["component"]))
+            pieces.append(full.reshape(-1))
+        columns.append((name, np.concatenate(pieces)))
+    found = dict(columns)
+    if "family" in found:
+        # As the core does: no slot that is empty in every cell (one when all are).
+        family = found["family"].reshape(n, len(component))
+        used = [i for i in range(len(component)) if (family[:, i] != 255).any()]
+        if used and len(used) < len(component):
+            columns = [(name, v.reshape(n, len(component))[:, used].reshape(-1)
+                        if meta.get(name, {}).get("per_component", v.size != n) else v)
+                       for name, v in columns]
+            component = [component[i] for i in used]
+    out = {key: value for key, value in parts[0][1].items() if key not in ("flag_values", "flag_meanings")}
+    out.update(columns=columns, component=component)
+    return out
+
+
+def _family_meanings(meta: dict) -> dict[int, str]:
+    family = meta.get("family")
+    names = dict(_family_names())
+    if family and "flag_values" in family:
+        names = {int(v): n for v, n in zip(family["flag_values"], family["flag_meanings"].split())}
+    names.setdefault(255, "no_value")
+    return names
+
+
+# The component coordinate's names in the files, by layout.
+_COMPONENT_NAMES = {"family": "torus family", "theta_min": "rank of the component in increasing theta_min"}
+
+
+def _component_coordinate(solved: dict, meta: dict) -> xr.Variable:
+    """The `component` coordinate of a result, as the files have it: the ranks (int32) in
+    the theta_min layout; the families' codes (uint8 flags) in the family layout."""
+    layout = solved["layout"]
+    attrs = {"long_name": solved.get("long_name", _COMPONENT_NAMES[layout]), "units": "1"}
+    if layout != "family":
+        return xr.Variable("component", np.asarray(solved["component"], dtype=np.int32), attrs,
+                           {"_FillValue": None})
+    values = np.asarray(solved["component"], dtype=np.uint8)
+    if "flag_values" in solved and "flag_meanings" in solved:
+        flag_values = np.asarray(list(solved["flag_values"]), dtype=np.uint8)
+        meanings = str(solved["flag_meanings"])
+    else:
+        names = _family_meanings(meta)
+        flag_values = values
+        meanings = " ".join(names.get(int(c), f"family_{int(c)}") for c in values)
+    attrs.update(flag_values=flag_values, flag_meanings=meanings)
+    return xr.Variable("component", values, attrs, {"_FillValue": None})
 
 
 def cells(
@@ -123,53 +492,200 @@ def cells(
     beta,
     nu,
     eta,
-    kappa,
-    energy,
+    kappa=None,
+    energy=None,
     *,
+    excess_energy=None,
+    lambda_=None,
+    s=None,
     tol: float = 1e-10,
     method: str = "quadrature",
     fields: Iterable[str] | None = None,
     resonance_tol: float = 1e-9,
     threads: int | None = None,
     allow_large: bool = False,
+    layout: str = "family",
+    progress: bool | None = None,
 ) -> xr.Dataset:
-    """Solves cells (α, β, ν, η, κ, ε) given as numbers, numpy arrays or xarray DataArrays,
-    broadcast together, in parallel in Rust with the GIL released (`threads` threads; by
-    default rayon's, which honours RAYON_NUM_THREADS).
+    """Solve cells (α, β, ν, η and a point of the (κ, ε) plane) in parallel.
 
-    Returns the variables an atlas file holds for `fields` (default: all of `FIELDS`) and
-    `rubber-atlas cell` prints, bit for bit: `n_components` and `cell_status` per cell, and
-    per cell and `component` the fields and their `<field>_error`, NaN (floats) or 255
-    (flags, `no_value`) where a component does not exist. The inputs are coordinates.
-    Bad input raises ValueError naming the cell and the value; a request larger than 80 % of
-    the memory available is refused unless `allow_large`. Ctrl-C stops it within
-    milliseconds (KeyboardInterrupt)."""
-    given = {"alpha": alpha, "beta": beta, "nu": nu, "eta": eta, "kappa": kappa, "energy": energy}
+    The values are those an atlas file of the same fields holds, bit for bit (with all fields,
+    or any of drift, drift_radius and bounded, also those ``rubber-atlas cell`` prints): the
+    computation runs in Rust with the GIL released. Units are the paper's: length b3,
+    mass m, time sqrt(b3/g) (each variable's ``comment`` says so); see docs/model.md for
+    the model.
+
+    Parameters
+    ----------
+    alpha : float, array_like or xarray.DataArray
+        α = a/b3, offset of the centre of mass along the symmetry axis, -1 < α < 1
+        (α < 0 is the mirror image θ → π − θ of -α).
+    beta : float, array_like or xarray.DataArray
+        β = b1/b3 > 0, ratio of the semi-axes (< 1 prolate, 1 a ball, > 1 oblate).
+    nu : float, array_like or xarray.DataArray
+        ν = i3/i1, axial over equatorial moment of inertia, 0 < ν ≤ 2.
+    eta : float, array_like or xarray.DataArray
+        η = m b3²/i1 > 0.
+    kappa : float, array_like or xarray.DataArray, optional
+        κ, the value of the linear integral F2 = J(θ) ω3 (its sign is the direction of
+        rolling), any real number up to 1e150 in size; with `energy` or `excess_energy`.
+    energy : float, array_like or xarray.DataArray, optional
+        ε, the energy in units of m g b3, any real number (below the bottom of V there is
+        no motion).
+    excess_energy : float, array_like or xarray.DataArray, optional
+        ε − V_min(κ), the energy above the bottom of V at each κ (m g b3); instead of
+        `energy` (the bottom is found by the Rust core, as an atlas's
+        ``kappa``/``excess_energy`` plane finds it).
+    lambda_ : float, array_like or xarray.DataArray, optional
+        λ = κ/√ε, finite; with `s` instead of `kappa` and `energy` (κ = λ/s). Motion at high
+        energy needs λ ≤ √2.
+    s : float, array_like or xarray.DataArray, optional
+        s = 1/√ε > 0 (ε = 1/s²). s = 0, the high-energy limit ε = ∞, is refused for now.
+    tol : float, default 1e-10
+        Relative tolerance of the solver, 1e-15 ≤ tol ≤ 0.1.
+    method : {"quadrature", "ode"}, default "quadrature"
+        Quadrature of the period integrals, or integration of the reduced equations of
+        motion over one period.
+    fields : iterable of str, optional
+        The fields to compute, from `FIELDS` (default: all of them). A field left out costs
+        no time (the drift integrals only run for ``drift``, ``drift_radius`` or
+        ``bounded``).
+    resonance_tol : float, default 1e-9
+        0 ≤ resonance_tol ≤ 0.5: a component with drift whose rotation number is within this
+        of an integer is flagged unbounded.
+    threads : int, optional
+        Number of threads, ≥ 1 (capped at the number of cores); by default rayon's pool,
+        which honours ``RAYON_NUM_THREADS``.
+    allow_large : bool, default False
+        Compute even when the result would take over 80 % of the available memory.
+    layout : {"family", "theta_min"}, default "family"
+        How the ``component`` dimension is laid out, as in the atlas files: one entry per
+        torus family present (the coordinate holds their codes, uint8 flags with the
+        families' names), or the components of each cell by rank in increasing theta_min
+        (0 … n-1, n the most components of a cell). A core built before families of tori
+        gives "theta_min" whatever is asked; the attribute ``component_layout`` says which
+        one the result has.
+    progress : bool, optional
+        Show a progress bar (tqdm's if it is installed: a widget in Jupyter, text in a
+        terminal; else a text bar on standard error). By default shown when there are more
+        than 200,000 cells and standard error is a terminal or the call runs in Jupyter.
+
+    Inputs broadcast together. DataArrays broadcast by their dimension names (then every
+    array input must be a DataArray; numbers mix with either). Other arrays broadcast by
+    numpy's rules: the result has the dimension ``cell`` when it is 1-D (vectors of one length
+    are paired cell by cell), else one dimension per axis, named after the one input that
+    varies along it (``kappa[:, None]`` and ``energy[None, :]`` give dimensions ``kappa`` and
+    ``energy``) or ``cell_0``, ``cell_1``, … when several do. The two inputs of the plane
+    given as 1-D vectors of different lengths (every other input a number) are laid out as
+    their grid, with dimensions named after them.
+
+    Returns
+    -------
+    xarray.Dataset
+        Over the broadcast dimensions (below ``...``) and ``component``:
+
+        - ``n_components`` (...), uint8: number of components of {V ≤ ε}, 0, 1 or 2;
+        - ``cell_status`` (...), uint8 flags: ok, no_motion, failed, not_computed;
+        - per component (..., component), for each of `fields`: the value, NaN where the
+          component does not exist, and ``<field>_error``, its error estimate; flags
+          (``bounded``, ``motion``, ``status``, and ``family`` when the core gives it) are
+          uint8 with CF ``flag_values``/``flag_meanings``, 255 (``no_value``) where the
+          component does not exist.
+
+        The inputs are coordinates over the dimensions they vary along; with `lambda_` and
+        `s` (or `excess_energy`), κ and ε of each cell are coordinates too. Root attributes:
+        provenance (program, version, commit, ``history``), ``tolerance``, ``method``,
+        ``resonance_tol`` and ``component_layout``.
+
+    Raises
+    ------
+    ValueError
+        A value out of range (naming the cell by its index in the flattened input and the
+        value), inputs that do not broadcast, unknown fields or method, a bad tol or
+        threads, or a result over 80 % of the available memory without `allow_large`.
+    TypeError
+        An input that is None, complex, or an array mixed with DataArrays; a plane given
+        by other than kappa with energy, kappa with excess_energy, or lambda_ with s.
+    KeyboardInterrupt
+        Ctrl-C stops a call within milliseconds.
+
+    See Also
+    --------
+    components : the components of one cell as dicts.
+    RubberAccessor.family : the fields of one torus family over the plane.
+
+    Examples
+    --------
+    Two cells of the paper's body (α = 0.5, β = 3, ν = η = 0.5) at ε = 2.5:
+
+    >>> import numpy as np
+    >>> import rubber_atlas as ra
+    >>> ds = ra.cells(0.5, 3.0, 0.5, 0.5, kappa=[0.8, 1.0], energy=2.5)
+    >>> ds.n_components.dims, ds.n_components.values.tolist()
+    (('cell',), [1, 0])
+    >>> [round(c["rotation_number"], 6) for c in ds.rubber.components(cell=0)]
+    [-0.815177]
+
+    A grid: κ and ε as vectors of different lengths.
+
+    >>> grid = ra.cells(0.5, 3.0, 0.5, 0.5, kappa=np.linspace(0.2, 1.0, 5),
+    ...                 energy=np.linspace(1.5, 3.5, 3), fields=["rotation_number"])
+    >>> dict(grid.n_components.sizes)
+    {'kappa': 5, 'energy': 3}
+    >>> grid.n_components.values.tolist()
+    [[1, 2, 1], [0, 2, 1], [0, 1, 1], [0, 1, 1], [0, 0, 1]]
+
+    The compact plane (λ, s): κ = λ/s and ε = 1/s² come as coordinates.
+
+    >>> far = ra.cells(0.5, 3.0, 0.5, 0.5, lambda_=0.5, s=[0.1, 0.01], fields=["rotation_number"])
+    >>> far.kappa.values.round(6).tolist(), far.energy.values.round(6).tolist()
+    ([5.0, 50.0], [100.0, 10000.0])
+    """
+    plane = _plane(kappa, energy, excess_energy, lambda_, s)
+    given = {"alpha": alpha, "beta": beta, "nu": nu, "eta": eta, **plane}
+    names = tuple(plane)
+    if layout not in _LAYOUTS:
+        raise ValueError(f"layout {layout!r}: use \"family\" or \"theta_min\"")
     if isinstance(fields, str):
         fields = [fields]
     field_list = None if fields is None else [str(f) for f in fields]
-    dims, layout, coords = _broadcast(given)
-    shape = layout[0].shape
-    flat = [np.ascontiguousarray(a, dtype=np.float64).reshape(-1) for a in layout]
-    slots = _core.COMPONENT_SLOTS
-    computed = _core.cells(*flat, float(tol), str(method), float(resonance_tol), field_list, threads,
-                           bool(allow_large))
+    dims, arrays, coords = _broadcast(given, names)
+    shape = arrays[0].shape
+    derived = _DERIVED.get(names[1], {})
+    for name in derived:
+        if name in dims:
+            raise ValueError(f"the dimension {name!r} is named after {name}, which is computed here from "
+                             f"{' and '.join(names)}: rename the dimension")
+    flat = [np.ascontiguousarray(a, dtype=np.float64).reshape(-1) for a in arrays]
+    flat = _to_kappa_energy(names, flat)
+    for name, sources in derived.items():
+        full = flat[4 if name == "kappa" else 5].reshape(shape)
+        coords[name] = _derived(full, dims, coords, sources)
+    n = flat[0].size
+    show = (n > _PROGRESS_CELLS and (_stderr_is_terminal() or _in_jupyter())) if progress is None else bool(progress)
     meta = {m["name"]: m for m in _core.variables(field_list)}
+    options = (float(tol), str(method), float(resonance_tol), field_list, threads, bool(allow_large))
+    solved = _solve(flat, options, layout, meta, show, bool(allow_large), field_list)
+    slots = len(solved["component"])
+    used = solved["layout"]
     data_vars = {}
-    for name, values in computed:
-        m = meta[name]
-        if m["per_component"]:
-            data_vars[name] = (dims + ("component",), values.reshape(shape + (slots,)), _variable_attrs(m))
+    for name, values in solved["columns"]:
+        values = np.asarray(values)
+        m = meta.get(name)
+        attrs = _variable_attrs(m) if m else {}
+        per_component = m["per_component"] if m else values.size != n
+        if per_component:
+            data_vars[name] = (dims + ("component",), values.reshape(shape + (slots,)), attrs)
         else:
-            data_vars[name] = (dims, values.reshape(shape), _variable_attrs(m))
-    for name in _INPUTS:
-        if isinstance(coords.get(name), tuple):
-            cdims, cvalues = coords[name]
+            data_vars[name] = (dims, values.reshape(shape), attrs)
+    for name, c in list(coords.items()):
+        if isinstance(c, tuple):
+            cdims, cvalues = c
             coords[name] = xr.Variable(cdims, cvalues, _coordinate_attrs(name), {"_FillValue": None})
-    coords["component"] = xr.Variable(
-        "component", np.arange(slots, dtype=np.int32), _coordinate_attrs("component"), {"_FillValue": None}
-    )
-    arguments = dict(given, tol=tol, method=method, fields=field_list, resonance_tol=resonance_tol)
+    coords["component"] = _component_coordinate(solved, meta)
+    shown = {"lambda": "lambda_"}
+    arguments = dict({shown.get(k, k): v for k, v in given.items()}, tol=tol, method=method, fields=field_list,
+                     resonance_tol=resonance_tol, layout=layout)
     attrs = _root_attrs(
         "cells",
         arguments,
@@ -177,22 +693,70 @@ def cells(
         tolerance=float(tol),
         method=str(method),
         resonance_tol=float(resonance_tol),
+        component_layout=used,
     )
     ds = xr.Dataset(data_vars, coords, attrs)
-    for name in _INPUTS:
+    for name in ds.dims:
         # Dimension coordinates that came with DataArray inputs get the files' attributes.
-        if name in ds.dims:
+        if name in given:
             ds[name].attrs = _coordinate_attrs(name)
             ds[name].encoding["_FillValue"] = None
     return ds
 
 
 def open_atlas(path: str | Path, **kwargs) -> xr.Dataset:
-    """The atlas at `path` (`rubber-atlas run` or `merge`; a shard too) as an xarray Dataset:
-    dimensions alpha, beta, kappa, energy (or the scene's plane) and component; ν and η as
-    scalar coordinates; flags as uint8 with CF `flag_values`/`flag_meanings`. Engine
-    h5netcdf unless `engine=` says otherwise; other keywords go to `xarray.open_dataset`.
-    Refuses files that are not complete rubber-atlas atlases."""
+    """Open an atlas written by ``rubber-atlas run`` or ``merge`` (a shard too).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The atlas file (HDF5). An unfinished run's ``*.partial.h5`` is refused.
+    **kwargs
+        Passed to `xarray.open_dataset`; ``engine`` defaults to "h5netcdf".
+
+    Returns
+    -------
+    xarray.Dataset
+        Lazily loaded, over ``alpha``, ``beta``, the scene's plane (``kappa`` and ``energy``;
+        ``kappa`` and ``excess_energy``; or ``lambda`` and ``s``, with κ and ε of each cell as
+        2-D auxiliary coordinates) and ``component``; ν and η as scalar coordinates. The
+        variables are those of `cells` (per cell, and per cell and component); flags are
+        uint8 with CF ``flag_values``/``flag_meanings``. The root attribute
+        ``component_layout`` ("family" or "theta_min") says what ``component`` counts (see
+        `cells`); files from before families of tori have components in increasing
+        theta_min and no ``family`` variable. Use it as a context manager, or close it.
+
+    Raises
+    ------
+    ValueError
+        The file is not a complete rubber-atlas atlas (a table, a `cells` result written by
+        xarray, an unfinished run, not HDF5 at all, missing).
+
+    See Also
+    --------
+    RubberAccessor : ``ds.rubber.components``, ``.family``, ``.plot_slice``.
+
+    Examples
+    --------
+    The quick start's atlas (``rubber-atlas run atlas/demo.toml`` writes it):
+
+    >>> import rubber_atlas as ra
+    >>> with ra.open_atlas("atlas/out/demo.h5") as atlas:  # doctest: +SKIP
+    ...     print(dict(atlas.rotation_number.sizes))
+    {'alpha': 1, 'beta': 1, 'kappa': 401, 'energy': 401, 'component': 3}
+
+    Anything else is refused with one line:
+
+    >>> import os, tempfile
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = os.path.join(folder, "cells.nc")
+    ...     ra.cells(0.5, 3.0, 0.5, 0.5, 0.8, 2.5).to_netcdf(path, engine="h5netcdf")
+    ...     try:
+    ...         ra.open_atlas(path)
+    ...     except ValueError as e:
+    ...         print(str(e).split(": ", 1)[1][:26])
+    not a rubber-atlas atlas (
+    """
     path = Path(path)
     if path.name.endswith(".partial.h5"):
         raise ValueError(f"{path}: an unfinished run's file; resume the run with --resume")
@@ -209,7 +773,31 @@ def open_atlas(path: str | Path, **kwargs) -> xr.Dataset:
 
 
 def flag_names(variable: xr.DataArray) -> dict[int, str]:
-    """The CF flag meanings of a flag variable, as {value: name}."""
+    """The CF flag meanings of a flag variable.
+
+    Parameters
+    ----------
+    variable : xarray.DataArray
+        A variable with CF ``flag_values`` and ``flag_meanings`` attributes (``status``,
+        ``motion``, ``bounded``, ``family``, ``cell_status``, ``holds`` …).
+
+    Returns
+    -------
+    dict of int to str
+        {flag value: meaning}.
+
+    Raises
+    ------
+    ValueError
+        The variable has no ``flag_values``.
+
+    Examples
+    --------
+    >>> import rubber_atlas as ra
+    >>> ds = ra.cells(0.5, 3.0, 0.5, 0.5, 0.8, 2.5)
+    >>> ra.flag_names(ds.cell_status)
+    {0: 'ok', 1: 'no_motion', 2: 'failed', 3: 'not_computed'}
+    """
     if "flag_values" not in variable.attrs:
         raise ValueError(f"{variable.name} is not a flag variable (it has no flag_values)")
     values = np.atleast_1d(variable.attrs["flag_values"])
@@ -217,14 +805,68 @@ def flag_names(variable: xr.DataArray) -> dict[int, str]:
     return {int(v): n for v, n in zip(values, names)}
 
 
-def components(ds: xr.Dataset, alpha: float | None = None, beta: float | None = None, **cell: float) -> list[dict]:
-    """The components of one cell of an atlas (or of a `cells` result) as dicts, keys as in
-    `rubber-atlas cell --json`, status and motion as names, sorted by theta_min.
+def _component_layout(ds: xr.Dataset) -> str:
+    """"family" or "theta_min": what the `component` dimension of `ds` counts."""
+    layout = ds.attrs.get("component_layout")
+    if layout in _LAYOUTS:
+        return str(layout)
+    if "component" in ds.coords and "flag_meanings" in ds["component"].attrs:
+        return "family"
+    return "theta_min"
 
-    The cell is given by grid values (to 1e-12 relative) of the dataset's dimensions: for an
-    atlas `alpha=…, beta=…` and `kappa=…, energy=…` (or the file's own plane:
-    `excess_energy=…`, or `lambda_=…, s=…`; `lambda_` since `lambda` is a Python keyword);
-    for a `cells` result, the index along its dimensions (`cell=3`)."""
+
+def _existing_slots(ds: xr.Dataset, one: xr.Dataset) -> list[int]:
+    """The component slots of the cell `one` (a cell of `ds`) that hold a component."""
+    if _component_layout(ds) == "theta_min":
+        return list(range(min(int(one.n_components), ds.sizes["component"])))
+    for name, empty in (("family", 255), ("status", 255)):
+        if name in one:
+            return [i for i, v in enumerate(np.asarray(one[name].values)) if int(v) != empty]
+    floats = [v for v in one.data_vars.values() if "component" in v.dims and v.dtype.kind == "f"]
+    return [i for i in range(ds.sizes["component"]) if any(np.isfinite(v.values[i]) for v in floats)]
+
+
+def components(ds: xr.Dataset, alpha: float | None = None, beta: float | None = None, **cell: float) -> list[dict]:
+    """The components of one cell of an atlas or of a `cells` result, as dicts.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        An atlas (`open_atlas`) or a `cells` result.
+    alpha, beta : float, optional
+        The body, as grid values of the dimensions ``alpha`` and ``beta`` (an atlas).
+    **cell : float
+        The rest of the cell, one keyword per remaining dimension of ``cell_status``: a
+        grid value (to 1e-12 relative) of a dimension with a coordinate (``kappa=…,
+        energy=…``, ``excess_energy=…``, or ``lambda_=…, s=…``; ``lambda_`` since
+        ``lambda`` is a Python keyword), or the index along a dimension without one
+        (``cell=3`` for a 1-D `cells` result).
+
+    Returns
+    -------
+    list of dict
+        One dict per component, sorted by theta_min, keys as in ``rubber-atlas cell
+        --json``: every per-component variable of `ds` (``theta_min`` and ``theta_max`` in
+        rad, ``period`` in sqrt(b3/g), ``rotation_number``, ``drift`` in b3, … and their
+        ``_error``), with ``status``, ``motion`` and ``family`` as names (e.g. "ok",
+        "libration", "well_pi") and ``bounded`` as True, False or None. Empty when the cell
+        has no motion.
+
+    Raises
+    ------
+    KeyError
+        The cell is not given by exactly the dataset's dimensions, or a value is not a grid
+        value (or an index out of range).
+
+    Examples
+    --------
+    >>> import rubber_atlas as ra
+    >>> ds = ra.cells(0.5, 3.0, 0.5, 0.5, kappa=[0.8, 0.05], energy=2.5)
+    >>> for c in ra.components(ds, cell=1):
+    ...     print(f"{c['theta_min']:.4f} {c['theta_max']:.4f} {c['rotation_number']:.4f} {c['motion']}")
+    0.0354 0.7233 0.5321 libration
+    2.0334 3.1166 -0.5442 libration
+    """
     cell = {("lambda" if k == "lambda_" else k): v for k, v in cell.items()}
     if alpha is not None:
         cell["alpha"] = alpha
@@ -247,10 +889,10 @@ def components(ds: xr.Dataset, alpha: float | None = None, beta: float | None = 
             raise KeyError(f"{name} = {value} is not a grid value (nearest {axis[i]})")
         index[name] = i
     one = ds.isel(index)
-    count = int(one.n_components)
-    flags = {name: flag_names(ds[name]) for name in ("status", "motion") if name in ds}
+    flags = {name: flag_names(ds[name]) for name in ("status", "motion", "family")
+             if name in ds and "flag_values" in ds[name].attrs}
     out = []
-    for slot in range(min(count, ds.sizes["component"])):
+    for slot in _existing_slots(ds, one):
         c = one.isel(component=slot)
         entry = {}
         for name, var in c.data_vars.items():
@@ -263,6 +905,8 @@ def components(ds: xr.Dataset, alpha: float | None = None, beta: float | None = 
                 value = None if int(value) == 255 else bool(value)
             entry[name] = value
         out.append(entry)
+    if out and "theta_min" in out[0]:
+        out.sort(key=lambda e: (np.isnan(e["theta_min"]), e["theta_min"]))
     return out
 
 
@@ -281,10 +925,39 @@ def _table(table: dict, attrs: dict) -> xr.Dataset:
 
 
 def read_table(path: str | Path) -> xr.Dataset:
-    """A table file of `rubber-atlas trajectory`, `diagram --out` or `resonance --out`, as a
-    Dataset along its dimension (`t` or `sample`): HDF5 through h5netcdf with every
-    attribute, CSV through pandas with the `# key: value` lines as attributes (numbers
-    parsed)."""
+    """Read a table file of ``rubber-atlas trajectory``, ``diagram --out`` or ``resonance --out``.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        An HDF5 file (read through h5netcdf with every attribute) or a CSV file (read
+        through pandas; its leading ``# key: value`` lines become attributes, numbers
+        parsed).
+
+    Returns
+    -------
+    xarray.Dataset
+        The columns along the table's dimension (``t`` for a trajectory, ``sample`` for a
+        diagram or resonance curves), loaded into memory, with their ``long_name``,
+        ``units`` and flags (HDF5); the same as `trajectory`, `diagram` or `resonance` give.
+
+    Raises
+    ------
+    OSError, ValueError
+        The file is missing or not a table.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> import rubber_atlas as ra
+    >>> t = ra.trajectory(0.5, 3.0, 0.5, 0.5, kappa=0.8, energy=2.5, periods=1, samples=20)
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = os.path.join(folder, "t.h5")
+    ...     t.to_netcdf(path, engine="h5netcdf")
+    ...     back = ra.read_table(path)
+    >>> back.sizes["t"], bool((back.theta == t.theta).all())
+    (21, True)
+    """
     path = Path(path)
     if path.suffix.lower() == ".csv":
         import pandas as pd
@@ -310,10 +983,48 @@ def read_table(path: str | Path) -> xr.Dataset:
 
 def diagram(alpha: float, beta: float, nu: float = 0.5, eta: float = 0.5, *, samples: int = 2000,
             kappa_max: float = 3.0, allow_large: bool = False) -> xr.Dataset:
-    """The critical set of one body (paper §4, Fig. `bif`): its fixed-point curves along
-    `sample` (branch, θ0, κ, ε, stability, the radii ρ_c and ρ_p, N at the bottom of the
-    well), as `rubber-atlas diagram --out` writes them; `attrs["critical_set_json"]` holds
-    the summary (`diagram --json`). ν and η do not change the set; they are recorded."""
+    """The critical set of one body: its fixed-point curves (the paper's bifurcation diagram).
+
+    Parameters
+    ----------
+    alpha : float
+        α = a/b3, -1 < α < 1.
+    beta : float
+        β = b1/b3 > 0.
+    nu, eta : float, default 0.5
+        ν = i3/i1 (0 < ν ≤ 2) and η = m b3²/i1 > 0: they do not change the set and are
+        recorded.
+    samples : int, default 2000
+        Number of θ0 samples along the curves, ≥ 2.
+    kappa_max : float, default 3.0
+        The largest |κ| the curves are drawn to, > 0.
+    allow_large : bool, default False
+        Allow `samples` beyond 80 % of the available memory.
+
+    Returns
+    -------
+    xarray.Dataset
+        Along ``sample``: ``segment`` and ``branch`` (of the curve), ``theta0`` (rad), the
+        permanent rotation's ``kappa`` and ``energy``, ``stable`` (flags), the radii of the
+        circles of the centre of mass ``rho_c`` and the contact point ``rho_p`` (b3), and
+        ``rotation_number``, N at the bottom of the well, as ``rubber-atlas diagram --out``
+        writes them. ``attrs["critical_set_json"]`` holds the summary of ``diagram --json``:
+        the diagram type (a … e), θ*, ε_min, the equilibria, the cusp.
+
+    Raises
+    ------
+    ValueError
+        A parameter out of range, or too many samples without `allow_large`.
+
+    Examples
+    --------
+    >>> import json
+    >>> import rubber_atlas as ra
+    >>> d = ra.diagram(0.5, 3.0, samples=200)
+    >>> summary = json.loads(d.attrs["critical_set_json"])
+    >>> summary["diagram_type"], round(summary["energy_min"], 5)
+    ('c', 3.04651)
+    """
     table, summary = _core.diagram(float(alpha), float(beta), float(nu), float(eta), int(samples), float(kappa_max),
                                    bool(allow_large))
     arguments = dict(alpha=alpha, beta=beta, nu=nu, eta=eta, samples=samples, kappa_max=kappa_max)
@@ -327,10 +1038,62 @@ def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, e
                component: int = 0, theta0: float | None = None, theta_dot0: float = 0.0,
                periods: float | None = None, t_end: float | None = None, samples: int = 2000,
                model: str = "reduced", tol: float = 1e-12, allow_large: bool = False) -> xr.Dataset:
-    """A trajectory along `t` (θ, θ̇, φ, ψ, the centre of mass and the contact point), as
-    `rubber-atlas trajectory` writes it: from the lower turning point of `component` at
-    `energy`, or from `theta0`, `theta_dot0`; for `periods` θ-periods or up to `t_end`;
-    `samples + 1` times; `model` "reduced" or "full" (paper `eqred`)."""
+    """A trajectory of the body over time, as ``rubber-atlas trajectory`` writes it.
+
+    Parameters
+    ----------
+    alpha, beta, nu, eta : float
+        The body: -1 < α < 1, β > 0, 0 < ν ≤ 2, η > 0.
+    kappa : float
+        κ, the value of F2 = J(θ) ω3.
+    energy : float, optional
+        ε (m g b3): start at the lower turning point θ_min of `component` (θ̇ = 0).
+        Exactly one of `energy` and `theta0`.
+    component : int, default 0
+        Which component of {V ≤ ε} to start on, ≥ 0, in increasing theta_min.
+    theta0 : float, optional
+        Start at θ = theta0 (rad, 0 < θ0 < π) instead of a turning point.
+    theta_dot0 : float, default 0.0
+        θ̇ at the start when `theta0` is given (rad per unit of time sqrt(b3/g)).
+    periods : float, optional
+        Duration in θ-periods (> 0). Exactly one of `periods` and `t_end`.
+    t_end : float, optional
+        Duration in units of sqrt(b3/g) (> 0).
+    samples : int, default 2000
+        Number of time steps: the table has ``samples + 1`` rows.
+    model : {"reduced", "full"}, default "reduced"
+        The reduced one-degree-of-freedom system, or the full equations of motion (ω, γ)
+        with the positions.
+    tol : float, default 1e-12
+        Tolerance of the integrator.
+    allow_large : bool, default False
+        Allow `samples` beyond 80 % of the available memory.
+
+    Returns
+    -------
+    xarray.Dataset
+        Along ``t`` (sqrt(b3/g)): ``theta``, ``theta_dot``, ``phi``, ``psi`` (rad, rad per
+        unit time), the centre of mass ``x_c``, ``y_c`` (on the plane) and ``z_c`` (its
+        height) and the contact point ``x_p``, ``y_p`` (b3); attributes record the body,
+        κ, ε, θ(0), θ̇(0), the model and the tolerance.
+
+    Raises
+    ------
+    ValueError
+        A parameter out of range, no motion at `energy`, a component that does not exist,
+        not exactly one of `energy`/`theta0` or of `periods`/`t_end`.
+
+    Examples
+    --------
+    One θ-period of the paper's near-resonant case (κ = 0.8, ε = 2.5), from θ_min:
+
+    >>> import rubber_atlas as ra
+    >>> t = ra.trajectory(0.5, 3.0, 0.5, 0.5, kappa=0.8, energy=2.5, periods=1, samples=100)
+    >>> t.sizes["t"], sorted(k for k in t.data_vars if k.endswith("_c"))
+    (101, ['x_c', 'y_c', 'z_c'])
+    >>> round(float(t.theta[0]), 4) == round(float(t.attrs["theta0"]), 4)
+    True
+    """
     table, (k, e, t0, td0) = _core.trajectory(
         float(alpha), float(beta), float(nu), float(eta), float(kappa),
         None if energy is None else float(energy), int(component),
@@ -353,9 +1116,48 @@ def _rotation_number(value) -> float:
 def resonance(alpha: float, beta: float, nu: float, eta: float, rotation_number, *, kappa_min: float = 0.01,
               kappa_max: float = 2.0, energy_min: float | None = None, energy_max: float = 5.0,
               grid: int = 48, tol: float = 1e-10) -> xr.Dataset:
-    """The curves N = `rotation_number` (a number or "p/q") of the (κ, ε) plane in the
-    window, traced by continuation, along `sample` (curve, point, κ, ε, N and its error,
-    the component and its turning points), as `rubber-atlas resonance --out` writes them."""
+    """The curves N = p/q of the (κ, ε) plane in a window, traced by continuation.
+
+    Parameters
+    ----------
+    alpha, beta, nu, eta : float
+        The body: -1 < α < 1, β > 0, 0 < ν ≤ 2, η > 0.
+    rotation_number : float or str
+        The rotation number N of the curves, a number or a fraction "p/q" (e.g. "-1/7").
+    kappa_min, kappa_max : float, default 0.01 and 2.0
+        The κ window, 0 < kappa_min < kappa_max.
+    energy_min : float, optional
+        Bottom of the ε window (m g b3); default the bottom of V over the κ window.
+    energy_max : float, default 5.0
+        Top of the ε window (m g b3).
+    grid : int, default 48
+        Cells per side of the coarse grid on which the curves are first bracketed, ≥ 4.
+    tol : float, default 1e-10
+        Solver tolerance (1e-15 … 0.1); points are located to it.
+
+    Returns
+    -------
+    xarray.Dataset
+        Along ``sample``: ``curve`` and ``point`` (indices), ``kappa``, ``energy``,
+        ``rotation_number`` and its ``error_estimate``, the ``component`` and its turning
+        points ``theta_min``, ``theta_max`` (rad), the bottom of its ``well`` (rad) and
+        ``closed`` (a flag: the curve closes on itself), as ``rubber-atlas resonance --out``
+        writes them.
+
+    Raises
+    ------
+    ValueError
+        A parameter out of range or an empty window.
+
+    Examples
+    --------
+    >>> import rubber_atlas as ra
+    >>> curves = ra.resonance(0.5, 3.0, 0.5, 0.5, "-1/7", grid=12)
+    >>> bool(abs(curves.rotation_number + 1 / 7).max() < 1e-6)
+    True
+    >>> sorted(set(curves.component.values.tolist()))
+    [0, 1]
+    """
     target = _rotation_number(rotation_number)
     table, e_min = _core.resonance(float(alpha), float(beta), float(nu), float(eta), target, float(kappa_min),
                                    float(kappa_max), None if energy_min is None else float(energy_min),
@@ -374,13 +1176,79 @@ def resonance(alpha: float, beta: float, nu: float, eta: float, rotation_number,
 _CASES = {"1": 0, "2": 1, "not_covered": 2}
 
 
+def _padded(rows: list[list], fill, dtype, shape: tuple, width: int) -> np.ndarray:
+    """Per-body lists padded with `fill` to `width`, shaped `shape + (width,)`."""
+    if dtype is np.bytes_:
+        # Fixed-width text as wide as the longest entry (np.full of b"" would give one byte).
+        dtype = np.dtype(f"S{max([len(x) for row in rows for x in row] + [len(fill), 1])}")
+    out = np.full((len(rows), width), fill, dtype=dtype)
+    for i, row in enumerate(rows):
+        out[i, :len(row)] = row
+    return out.reshape(shape + (width,))
+
+
 def verdict(alpha, beta, nu, eta, *, tol: float = 1e-10, resolution: int = 64,
             threads: int | None = None) -> xr.Dataset:
-    """The verdict of the boundedness hypothesis (SPEC §4) for each body (α, β, ν, η),
-    broadcast as in `cells`, computed in parallel: `holds` (a flag: fails, holds, or
-    no_value where the hypothesis does not cover the body or it is undecided), `case`,
-    `kappa_max` and its error, `fail_margin` and the number of `counterexamples`;
-    `verdict_json` keeps each body's whole `rubber-atlas verdict --json` object."""
+    """The verdict of the paper's boundedness hypothesis for each body, computed in parallel.
+
+    The hypothesis: paths are bounded (case 1) for β² < 1 + α except rolling over the top at
+    κ = 0, and (case 2) for β² > 1 + α, α > 0, when κ > κ_max, the fold of the N = 0
+    resonance curve. A counterexample is a torus on an integer resonance N ∈ ℤ with a drift
+    Δζ ≠ 0 (its path runs away) where the hypothesis says bounded. See docs/model.md.
+
+    Parameters
+    ----------
+    alpha, beta, nu, eta : float, array_like or xarray.DataArray
+        The bodies (-1 < α < 1, β > 0, 0 < ν ≤ 2, η > 0), broadcast together as in `cells`.
+    tol : float, default 1e-10
+        Solver tolerance (1e-15 … 0.1).
+    resolution : int, default 64
+        Sampling of the (κ, ε) plane: κ-lines and energies per line, ≥ 4; higher finds
+        narrower resonance regions, and costs about its square.
+    threads : int, optional
+        Number of threads (≥ 1); by default rayon's pool.
+
+    Returns
+    -------
+    xarray.Dataset
+        Over the broadcast dimensions (below ``...``), with the inputs as coordinates:
+
+        - ``holds`` (...), uint8 flags: fails, holds, or no_value where the hypothesis does
+          not cover the body or the verdict is undecided;
+        - ``case`` (...), fixed-width bytes: "1", "2" or "not_covered";
+        - ``kappa_max`` (...) and ``kappa_max_error`` (...): κ_max (case 2, else NaN);
+        - ``fail_margin`` (...): positive where N reaches an integer in the region the
+          hypothesis covers (continuous in the body's parameters);
+        - ``counterexamples`` (...), int32: the number of counterexamples found;
+        - along ``counterexample`` (..., counterexample), one entry per counterexample,
+          padded where a body has fewer than the most: ``kappa``, ``energy``,
+          ``rotation_number``, ``theta_min``, ``theta_max`` (rad) and ``drift`` (|Δζ| per
+          θ-period, b3), NaN as padding; ``family`` (bytes, the torus family's name, "" as
+          padding) and ``component`` (int32, the rank of the component among its cell's
+          components in increasing theta_min, as `trajectory` takes it; -1 as padding);
+        - ``verdict_json`` (...): each body's whole ``rubber-atlas verdict --json`` object
+          (the high-energy limit, the margins, the evidence).
+
+    Raises
+    ------
+    ValueError
+        A parameter out of range, or inputs that do not broadcast.
+
+    See Also
+    --------
+    boundaries : the β at which the verdict changes, at one α.
+
+    Examples
+    --------
+    >>> import rubber_atlas as ra
+    >>> v = ra.verdict([0.5, 0.2], [0.5, 3.0], 0.5, 0.5, resolution=8)
+    >>> v.case.values.astype(str).tolist(), ra.flag_names(v.holds)[int(v.holds[0])]
+    (['1', '2'], 'fails')
+    >>> v.counterexamples.values.tolist(), dict(v.kappa.sizes)
+    ([2, 0], {'cell': 2, 'counterexample': 2})
+    >>> [round(float(k), 3) for k in v.kappa[0]], bool(v.kappa[1].isnull().all())
+    ([1.0, 1.5], True)
+    """
     given = {"alpha": alpha, "beta": beta, "nu": nu, "eta": eta}
     dims, layout, coords = _broadcast(given)
     shape = layout[0].shape
@@ -391,15 +1259,30 @@ def verdict(alpha, beta, nu, eta, *, tol: float = 1e-10, resolution: int = 64,
         return np.array([get(v) for v in found], dtype=dtype).reshape(shape)
 
     number = {"units": "1"}
+    examples = [v["counterexamples"] for v in found]
+    width = max((len(c) for c in examples), default=0)
+    along = dims + ("counterexample",)
+
+    def per_example(key, fill, dtype, get=None):
+        get = get or (lambda c: c[key])
+        return _padded([[get(c) for c in row] for row in examples], fill, dtype, shape, width)
+
+    def text(value: str) -> bytes:
+        return str(value).encode("ascii", "replace")
+
+    def described(long_name: str, source: dict) -> dict:
+        """`long_name` with the units (and their comment) of the variable or coordinate `source`."""
+        return {"long_name": long_name, **{k: source[k] for k in ("units", "comment") if source.get(k)}}
+
+    fields = {m["name"]: m for m in _core.variables(None)}
     data_vars = {
         "holds": (dims, column(lambda v: 255 if v["holds"] is None else int(v["holds"]), np.uint8),
                   {"long_name": "whether the boundedness hypothesis holds for the body", "units": "1",
                    "flag_values": np.array([0, 1, 255], dtype=np.uint8),
                    "flag_meanings": "fails holds no_value"}),
-        "case": (dims, column(lambda v: _CASES[v["case"]], np.uint8),
-                 {"long_name": "part of the hypothesis that covers the body", "units": "1",
-                  "flag_values": np.array([0, 1, 2], dtype=np.uint8),
-                  "flag_meanings": "case_1 case_2 not_covered"}),
+        "case": (dims, column(lambda v: text(v["case"]), np.bytes_),
+                 {"long_name": "part of the hypothesis that covers the body: 1 (beta^2 < 1 + alpha), "
+                               "2 (beta^2 > 1 + alpha, alpha > 0) or not_covered"}),
         "kappa_max": (dims, column(lambda v: np.nan if v["kappa_max"] is None else v["kappa_max"], float),
                       {"long_name": "fold kappa_max of the N = 0 curve (case 2)", **_coordinate_attrs("kappa")}),
         "kappa_max_error": (dims, column(lambda v: np.nan if v["kappa_max_error"] is None else v["kappa_max_error"], float),
@@ -408,6 +1291,27 @@ def verdict(alpha, beta, nu, eta, *, tol: float = 1e-10, resolution: int = 64,
                         {"long_name": "fail margin: positive where N reaches an integer", **number}),
         "counterexamples": (dims, column(lambda v: len(v["counterexamples"]), np.int32),
                             {"long_name": "number of counterexamples found", **number}),
+        "kappa": (along, per_example("kappa", np.nan, float),
+                  described("kappa of the counterexample", _coordinate_attrs("kappa"))),
+        "energy": (along, per_example("energy", np.nan, float),
+                   described("energy of the counterexample", _coordinate_attrs("energy"))),
+        "rotation_number": (along, per_example("rotation_number", np.nan, float),
+                            described("rotation number N of the counterexample (an "
+                                      "integer to the solver's tolerance)", fields["rotation_number"])),
+        "theta_min": (along, per_example("theta_min", np.nan, float),
+                      described("lower turning point of theta of the counterexample",
+                                fields["theta_min"])),
+        "theta_max": (along, per_example("theta_max", np.nan, float),
+                      described("upper turning point of theta of the counterexample",
+                                fields["theta_max"])),
+        "family": (along, per_example("family", b"", np.bytes_, lambda c: text(c.get("family", ""))),
+                   {"long_name": "torus family of the counterexample (empty: none, or not given)"}),
+        "component": (along, per_example("component", -1, np.int32, lambda c: int(c.get("component", -1))),
+                      {"long_name": "rank of the counterexample's component among its cell's components in "
+                                    "increasing theta_min (-1: none, or not given)", **number}),
+        "drift": (along, per_example("drift", np.nan, float),
+                  described("drift |delta zeta| of the centre of mass over one theta-period of "
+                            "the counterexample", fields["drift"])),
         "verdict_json": (dims, column(lambda v: json.dumps(v, ensure_ascii=True).encode(), np.bytes_),
                          {"long_name": "the verdict as `rubber-atlas verdict --json` prints it"}),
     }
@@ -420,18 +1324,59 @@ def verdict(alpha, beta, nu, eta, *, tol: float = 1e-10, resolution: int = 64,
     return xr.Dataset(data_vars, coords, attrs)
 
 
-
 def _flag(values, meanings: str) -> dict:
     return {"units": "1", "flag_values": np.asarray(values, dtype=np.uint8), "flag_meanings": meanings}
 
 
 def boundaries(alpha: float, nu: float, eta: float, *, beta_min: float = 0.05, beta_max: float = 50.0,
                scan: int = 48, tol: float = 1e-10, resolution: int = 64, threads: int | None = None) -> xr.Dataset:
-    """The β at which the verdict of the boundedness hypothesis changes along β at one α
-    (`rubber-atlas verdict --boundaries`), each by root-finding on a quantity that changes
-    sign there: along `boundary`, `beta` with its error bound, the `quantity`, and the case
-    and verdict on either side; along `scan`, the log-spaced bodies scanned first. The
-    whole `--json` object is `attrs["boundaries_json"]`."""
+    """The β at which the verdict of the boundedness hypothesis changes, at one α.
+
+    As ``rubber-atlas verdict --boundaries``: a log-spaced scan of β, then each change
+    located by root-finding on the quantity that changes sign there (the fail margin, or
+    β² − 1 − α where the case changes).
+
+    Parameters
+    ----------
+    alpha : float
+        α, -1 < α < 1.
+    nu, eta : float
+        ν (0 < ν ≤ 2) and η > 0.
+    beta_min, beta_max : float, default 0.05 and 50.0
+        The β range, 0 < beta_min < beta_max.
+    scan : int, default 48
+        Number of log-spaced bodies scanned first, ≥ 2.
+    tol : float, default 1e-10
+        Solver tolerance (1e-15 … 0.1).
+    resolution : int, default 64
+        Sampling of each body's (κ, ε) plane, as in `verdict`.
+    threads : int, optional
+        Number of threads (≥ 1); by default rayon's pool.
+
+    Returns
+    -------
+    xarray.Dataset
+        Along ``boundary``: ``boundary_beta`` and its error bound ``boundary_error``,
+        ``quantity`` (bytes: what changes sign), and the case and verdict below and above
+        (``case_below``, ``holds_below``, ``case_above``, ``holds_above``: uint8 flags).
+        Along ``scan``: ``scan_beta``, ``scan_case``, ``scan_holds``. The whole ``--json``
+        object is ``attrs["boundaries_json"]``.
+
+    Raises
+    ------
+    ValueError
+        A parameter out of range.
+
+    Examples
+    --------
+    >>> import rubber_atlas as ra
+    >>> b = ra.boundaries(0.5, 0.5, 0.5, beta_min=0.5, beta_max=1.0, scan=4, resolution=8)
+    >>> [round(float(x), 3) for x in b.boundary_beta]
+    [0.744]
+    >>> names = ra.flag_names(b.holds_below)
+    >>> names[int(b.holds_below[0])], names[int(b.holds_above[0])]
+    ('fails', 'holds')
+    """
     found = json.loads(_core.boundaries(float(alpha), float(nu), float(eta), float(beta_min), float(beta_max),
                                         int(scan), float(tol), int(resolution), threads))
     holds = lambda h: 255 if h is None else int(h)  # noqa: E731

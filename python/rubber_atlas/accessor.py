@@ -10,9 +10,34 @@ import xarray as xr
 
 from . import _api
 
+# Short axis labels of the planes' dimensions.
+_LABELS = {"kappa": "κ", "energy": "ε", "excess_energy": "ε − V_min", "lambda": "λ = κ/√ε",
+           "s": "s = 1/√ε", "alpha": "α", "beta": "β", "nu": "ν", "eta": "η"}
+# At most this many resonance contours per panel: fewer denominators beyond.
+_MAX_LEVELS = 60
+
 
 def resonances(lo: float, hi: float, max_q: int = 7) -> list[float]:
-    """The fractions p/q with q ≤ max_q in [lo, hi], sorted."""
+    """The rational numbers p/q with q ≤ `max_q` in [lo, hi].
+
+    Parameters
+    ----------
+    lo, hi : float
+        The interval.
+    max_q : int, default 7
+        The largest denominator, ≥ 1.
+
+    Returns
+    -------
+    list of float
+        The values p/q, sorted, each once.
+
+    Examples
+    --------
+    >>> from rubber_atlas.accessor import resonances
+    >>> [round(x, 4) for x in resonances(-0.5, 0.5, max_q=3)]
+    [-0.5, -0.3333, 0.0, 0.3333, 0.5]
+    """
     found = {
         Fraction(p, q)
         for q in range(1, max_q + 1)
@@ -21,68 +46,326 @@ def resonances(lo: float, hi: float, max_q: int = 7) -> list[float]:
     return sorted(float(f) for f in found if lo <= f <= hi)
 
 
+def _family_codes(ds: xr.Dataset) -> dict[str, int]:
+    """{name: code} of the torus families the `family` flags of `ds` know."""
+    if "family" not in ds:
+        raise ValueError("this dataset has no `family` variable: it was written by a version of rubber-atlas "
+                         "from before the families of tori (its components are numbered by increasing "
+                         "theta_min); compute it again (`rubber-atlas run`, or rubber_atlas.cells)")
+    return {name: code for code, name in _api.flag_names(ds["family"]).items() if name != "no_value"}
+
+
 @xr.register_dataset_accessor("rubber")
 class RubberAccessor:
-    """`ds.rubber.components(...)`, `ds.rubber.flags(name)`, `ds.rubber.plot_slice(...)`."""
+    """The ``.rubber`` accessor of atlases (`open_atlas`) and `cells` results.
+
+    ``ds.rubber.components(...)``, ``ds.rubber.flags(name)``, ``ds.rubber.families()``,
+    ``ds.rubber.family(name)``, ``ds.rubber.plot_slice(...)``.
+
+    Examples
+    --------
+    >>> import rubber_atlas as ra
+    >>> ds = ra.cells(0.5, 3.0, 0.5, 0.5, kappa=[0.8, 1.0], energy=2.5)
+    >>> ds.rubber.flags("motion")
+    {0: 'libration', 1: 'fixed_point', 2: 'rotation', 255: 'no_value'}
+    """
 
     def __init__(self, ds: xr.Dataset):
         self._ds = ds
 
     def components(self, alpha: float | None = None, beta: float | None = None, **cell) -> list[dict]:
-        """The components of one cell as dicts (see `rubber_atlas.components`)."""
+        """The components of one cell as dicts (see `rubber_atlas.components`).
+
+        Parameters
+        ----------
+        alpha, beta : float, optional
+            The body, as grid values (an atlas).
+        **cell : float
+            The rest of the cell by the dataset's other dimensions: grid values (``kappa=…,
+            energy=…``, ``lambda_=…, s=…``) or indices (``cell=3``).
+
+        Returns
+        -------
+        list of dict
+            One dict per component, sorted by theta_min, keys as in ``rubber-atlas cell
+            --json``; ``status``, ``motion`` and ``family`` as names, ``bounded`` as
+            True/False/None.
+
+        Raises
+        ------
+        KeyError
+            The cell is not given by the dataset's dimensions, or is not on the grid.
+
+        Examples
+        --------
+        >>> import rubber_atlas as ra
+        >>> ds = ra.cells(0.5, 3.0, 0.5, 0.5, kappa=[0.8, 0.05], energy=2.5)
+        >>> [round(c["rotation_number"], 4) for c in ds.rubber.components(cell=1)]
+        [0.5321, -0.5442]
+        """
         return _api.components(self._ds, alpha, beta, **cell)
 
     def flags(self, name: str) -> dict[int, str]:
-        """{value: meaning} of the flag variable `name` (`status`, `motion`, `bounded`, …)."""
+        """The meanings of the flag variable `name`.
+
+        Parameters
+        ----------
+        name : str
+            A flag variable of the dataset: ``status``, ``motion``, ``bounded``,
+            ``family``, ``cell_status``.
+
+        Returns
+        -------
+        dict of int to str
+            {flag value: meaning}.
+
+        Raises
+        ------
+        KeyError
+            No variable `name`.
+        ValueError
+            `name` is not a flag variable.
+
+        Examples
+        --------
+        >>> import rubber_atlas as ra
+        >>> ds = ra.cells(0.5, 3.0, 0.5, 0.5, 0.8, 2.5)
+        >>> ds.rubber.flags("bounded")
+        {0: 'unbounded', 1: 'bounded', 255: 'no_value'}
+        """
         return _api.flag_names(self._ds[name])
 
+    def families(self) -> list[str]:
+        """The names of the torus families present in the dataset.
+
+        Returns
+        -------
+        list of str
+            In order of their codes, e.g. ``['well_0', 'well_pi', 'over_the_top']``: the
+            families of the ``component`` coordinate (layout "family"), or those that some
+            cell has (layout "theta_min").
+
+        Raises
+        ------
+        ValueError
+            The dataset has no ``family`` variable (an atlas from before families of tori).
+
+        Examples
+        --------
+        >>> import rubber_atlas as ra
+        >>> ds = ra.cells(0.5, 3.0, 0.5, 0.5, kappa=[0.05, 0.8], energy=2.5)
+        >>> ds.rubber.families()
+        ['well_0', 'well_pi']
+        """
+        ds = self._ds
+        names = {code: name for name, code in _family_codes(ds).items()}
+        if _api._component_layout(ds) == "family":
+            codes = [int(c) for c in ds["component"].values if int(c) in names]
+        else:
+            codes = sorted(int(c) for c in np.unique(np.asarray(ds["family"].values)) if int(c) in names)
+        return [names.get(c, f"family_{c}") for c in codes]
+
+    def family(self, name: str) -> xr.Dataset:
+        """The per-component variables of one torus family, as fields over the plane.
+
+        The families label a component of {V ≤ ε} by the minima of V it encloses: "well_0"
+        (a well whose minimum is at θ < π/2), "well_pi" (at θ > π/2), "well_equator" (α = 0
+        with the single minimum at θ = π/2) and "over_the_top" (κ = 0, rolling over the
+        top); a torus above a saddle, round both wells, belongs to the family of the well V
+        keeps at large κ ("well_pi" for α > 0). A family's rotation number is continuous
+        over the plane except across a critical curve, so its resonance curves are contours
+        of one field. See docs/model.md.
+
+        Parameters
+        ----------
+        name : str
+            The family's name (a meaning of the ``family`` flags).
+
+        Returns
+        -------
+        xarray.Dataset
+            Every variable of the dataset with a ``component`` dimension (``theta_min``,
+            ``rotation_number``, ``drift``, … and their ``_error``, the flags), for that
+            family, over the dataset's other dimensions (the plane, and α, β for an atlas),
+            with its coordinates; NaN (floats) and 255 (flags) where the cell has no torus
+            of the family. ``attrs["family"]`` is `name`.
+
+        Raises
+        ------
+        ValueError
+            The dataset has no ``family`` variable (written before families of tori).
+        KeyError
+            `name` is not a family, or none of its tori is in the dataset; the message lists
+            the families present.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import rubber_atlas as ra
+        >>> ds = ra.cells(0.5, 3.0, 0.5, 0.5, kappa=np.linspace(0.2, 1.0, 5), energy=[2.0, 2.5, 3.0],
+        ...               fields=["rotation_number"])
+        >>> ds.rubber.families()
+        ['well_0', 'well_pi']
+        >>> pi = ds.rubber.family("well_pi")
+        >>> dict(pi.rotation_number.sizes)
+        {'kappa': 5, 'energy': 3}
+        >>> pi.rotation_number.sel(energy=2.5).round(4).values.tolist()
+        [-0.6646, -0.7721, -0.8171, -0.8152, nan]
+        >>> ds.rubber.family("well_0").rotation_number.sel(energy=3.0).round(4).values.tolist()
+        [0.601, 0.6633, 0.6857, nan, nan]
+        """
+        ds = self._ds
+        codes = _family_codes(ds)
+        present = self.families()
+        if name not in codes or name not in present:
+            what = "no torus family" if name not in codes else "no torus of the family"
+            raise KeyError(f"{what} {name!r} in this dataset: it has {', '.join(present) or 'none'}")
+        code = codes[name]
+        per_component = [v for v in ds.data_vars if "component" in ds[v].dims]
+        if _api._component_layout(ds) == "family":
+            out = ds[per_component].sel(component=code, drop=True)
+        else:
+            # Components in increasing theta_min: the one of this family in each cell (at κ = 0
+            # two mirror twins may both be; their values are equal: the first is taken).
+            mask = ds["family"] == code
+            fields = {}
+            for v in per_component:
+                var = ds[v]
+                fill = _api._fill(var.dtype)
+                picked = xr.full_like(var.isel(component=0, drop=True), fill)
+                for slot in reversed(range(ds.sizes["component"])):
+                    picked = xr.where(mask.isel(component=slot, drop=True),
+                                      var.isel(component=slot, drop=True), picked)
+                fields[v] = picked.astype(var.dtype).assign_attrs(var.attrs)
+            out = xr.Dataset(fields, attrs=dict(ds.attrs))
+            for c, coord in ds.coords.items():
+                if "component" not in coord.dims and c not in out.coords:
+                    out = out.assign_coords({c: coord})
+        out.attrs = dict(ds.attrs, family=name)
+        return out
+
     def plot_slice(self, alpha_index: int = 0, beta_index: int = 0, max_q: int = 7):
-        """A matplotlib Figure of one (α, β) slice of an atlas: the rotation number N of each
-        component over the plane with the resonance curves N = p/q (q ≤ max_q) as white
-        contours, and log10 of the drift radius R of component 0 (R blows up on the integer
-        resonances, where the path runs away). Raises ValueError when the atlas has neither
-        a finite rotation_number nor drift_radius (the scene left them out)."""
+        """A matplotlib Figure of the rotation number of each torus family over a plane.
+
+        One panel per family present: its rotation number N over the plane on a diverging
+        colour map centred on N = 0, over the whole range of N (nothing is clipped; grey where
+        a cell has no torus of the family), with the resonance curves N = p/q as contours
+        (integers, where the path may run away, in black; other fractions in dark grey); and
+        a last panel with log10 of the drift radius R,
+        the largest over the tori of each cell (R blows up on the integer resonances). A
+        dataset without the ``family`` variable (from before families of tori) gets one
+        panel per component slot instead.
+
+        Parameters
+        ----------
+        alpha_index, beta_index : int, default 0
+            The body of an atlas (indices along ``alpha`` and ``beta``), when the dataset
+            has those dimensions.
+        max_q : int, default 7
+            The largest denominator q of the contours N = p/q, ≥ 1; lowered where a panel
+            would have more than 60 contours.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            The figure (one row of panels, each with its colour bar). Axes are the plane's
+            dimensions: (κ, ε), (κ, ε − V_min) or (λ, s) for an atlas or a `cells` result
+            over such a grid.
+
+        Raises
+        ------
+        ValueError
+            The dataset is not an atlas or a `cells` result over two dimensions (besides
+            α and β), or has neither a finite rotation_number nor drift_radius.
+
+        Examples
+        --------
+        >>> import matplotlib
+        >>> matplotlib.use("Agg")
+        >>> import numpy as np
+        >>> import rubber_atlas as ra
+        >>> ds = ra.cells(0.5, 3.0, 0.5, 0.5, kappa=np.linspace(0.05, 2.0, 12),
+        ...               energy=np.linspace(0.5, 4.5, 10))
+        >>> fig = ds.rubber.plot_slice()
+        >>> [ax.get_title() for ax in fig.axes if ax.get_title()]
+        ['well_0: N', 'well_pi: N', 'log10 R (largest)']
+        """
         import matplotlib.pyplot as plt
 
         ds = self._ds
-        if not {"alpha", "beta"} <= set(ds.dims) or "cell_status" not in ds:
-            raise ValueError("plot_slice draws an atlas (dimensions alpha and beta, as open_atlas gives it); "
-                             f"this dataset has dimensions {list(ds.dims)}")
-        cut = ds.isel(alpha=alpha_index, beta=beta_index)
-        plane = [d for d in cut.cell_status.dims]
+        if "cell_status" not in ds:
+            raise ValueError("plot_slice draws an atlas slice or a cells result over a plane of two dimensions; "
+                             "this dataset has no cell_status")
+        cut = ds
+        for name, index in (("alpha", alpha_index), ("beta", beta_index)):
+            if name in ds.cell_status.dims:
+                cut = cut.isel({name: index})
+        plane = list(cut.cell_status.dims)
         if len(plane) != 2:
-            raise ValueError(f"plot_slice needs an atlas with two plane dimensions; this one has {plane}")
-        x, y = (cut[d].values for d in plane)
-        slots = []
-        if "rotation_number" in ds:
-            slots = [s for s in range(ds.sizes["component"])
-                     if np.isfinite(cut.rotation_number.isel(component=s)).any()]
-        panels = len(slots) + ("drift_radius" in ds)
-        if panels == 0:
+            raise ValueError("plot_slice draws an atlas slice or a cells result over a plane of two dimensions "
+                             f"(e.g. kappa and energy); this dataset has dimensions {list(ds.cell_status.dims)}")
+        x, y = (cut[d].values if d in cut.coords else np.arange(cut.sizes[d]) for d in plane)
+        panels = []  # (title, N over the plane)
+        if "rotation_number" in cut:
+            if "family" in cut:
+                accessor = cut.rubber
+                for name in accessor.families():
+                    n = accessor.family(name).rotation_number
+                    if np.isfinite(n).any():
+                        panels.append((f"{name}: N", n))
+            else:
+                for slot in range(cut.sizes["component"]):
+                    n = cut.rotation_number.isel(component=slot)
+                    if np.isfinite(n).any():
+                        panels.append((f"component {slot}: N", n))
+        drift = "drift_radius" in cut and bool(np.isfinite(cut.drift_radius).any())
+        if not panels and not drift:
             raise ValueError("no finite rotation_number and no drift_radius to draw "
                              "(the scene's [outputs] fields left them out)")
-        fig, axes = plt.subplots(1, panels, figsize=(5.2 * panels, 4.4), squeeze=False)
-        for ax, slot in zip(axes[0], slots):
-            n = cut.rotation_number.isel(component=slot).transpose(*plane).values.T
-            finite = n[np.isfinite(n)]
-            lo, hi = np.percentile(finite, [1, 99])
-            mesh = ax.pcolormesh(x, y, n, shading="auto", cmap="viridis", vmin=lo, vmax=hi)
-            levels = resonances(lo, hi, max_q)
-            if levels:
-                ax.contour(x, y, n, levels=levels, colors="white", linewidths=0.5)
-            fig.colorbar(mesh, ax=ax, label="rotation number N")
-            ax.set_title(f"N, component {slot} (white: N = p/q, q ≤ {max_q})")
-        if "drift_radius" in ds:
+        count = len(panels) + drift
+        fig, axes = plt.subplots(1, count, figsize=(4.6 * count, 4.0), squeeze=False, layout="constrained")
+        denominators = []
+        for ax, (title, n) in zip(axes[0], panels):
+            values = n.transpose(*plane).values.T
+            finite = values[np.isfinite(values)]
+            top = float(np.abs(finite).max()) if finite.size else 1.0
+            top = top if top > 0 else 1.0
+            # Infinities (on a separatrix) take the end colours: arrows say so.
+            extend = {(False, False): "neither", (True, False): "min", (False, True): "max",
+                      (True, True): "both"}[(bool(np.isneginf(values).any()), bool(np.isposinf(values).any()))]
+            # Grey where the cell has no torus of the family (white is N = 0).
+            ax.set_facecolor("0.82")
+            mesh = ax.pcolormesh(x, y, np.ma.masked_invalid(values), shading="auto", cmap="RdBu_r",
+                                 vmin=-top, vmax=top)
+            fig.colorbar(mesh, ax=ax, label="N", extend=extend)
+            lo, hi = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 0.0)
+            q = max_q
+            while q > 1 and len(resonances(lo, hi, q)) > _MAX_LEVELS:
+                q -= 1
+            levels = resonances(lo, hi, q)
+            integers = [v for v in levels if float(v).is_integer()]
+            fractions = [v for v in levels if not float(v).is_integer()]
+            contoured = np.ma.masked_invalid(values)
+            if len(x) > 1 and len(y) > 1:
+                if fractions:
+                    ax.contour(x, y, contoured, levels=fractions, colors="0.3", linewidths=0.5)
+                if integers[:_MAX_LEVELS]:
+                    ax.contour(x, y, contoured, levels=integers[:_MAX_LEVELS], colors="black", linewidths=1.1)
+            ax.set_title(title if q == max_q else f"{title} (q ≤ {q})", fontsize=10)
+            denominators.append(q)
+        if drift:
             ax = axes[0][-1]
             with np.errstate(divide="ignore", invalid="ignore"):
-                r = np.log10(cut.drift_radius.isel(component=0).transpose(*plane).values.T)
-            mesh = ax.pcolormesh(x, y, np.where(np.isfinite(r), r, np.nan), shading="auto",
-                                 cmap="magma", vmin=-2, vmax=2)
-            fig.colorbar(mesh, ax=ax, label="log10 R")
-            ax.set_title("drift radius R, component 0")
+                r = np.log10(cut.drift_radius.max("component", skipna=True).transpose(*plane).values.T)
+            mesh = ax.pcolormesh(x, y, np.ma.masked_invalid(r), shading="auto", cmap="magma", vmin=-2, vmax=2)
+            fig.colorbar(mesh, ax=ax, label="log10 R", extend="both")
+            ax.set_title("log10 R (largest)", fontsize=10)
         for ax in axes[0]:
-            ax.set_xlabel(plane[0])
-            ax.set_ylabel(plane[1])
-        fig.suptitle(f"{ds.attrs.get('scene_name', '')}: α = {float(cut.alpha):g}, β = {float(cut.beta):g}")
-        fig.tight_layout()
+            ax.set_xlabel(_LABELS.get(plane[0], plane[0]))
+            ax.set_ylabel(_LABELS.get(plane[1], plane[1]))
+        body = ", ".join(f"{_LABELS[k]} = {float(cut[k]):g}" for k in ("alpha", "beta", "nu", "eta")
+                         if k in cut.coords and cut[k].ndim == 0)
+        name = ds.attrs.get("scene_name", "")
+        contours = f"; contours N = p/q, q ≤ {max_q} (integers black)" if denominators else ""
+        fig.suptitle(f"{name}: {body}{contours}" if name else f"{body}{contours}", fontsize=10)
         return fig

@@ -49,9 +49,11 @@ def test_cells_equal_the_cell_command_bit_for_bit_on_random_cells():
     eta = rng.uniform(0.1, 3.0, n)
     kappa = np.where(rng.random(n) < 0.15, 0.0, rng.uniform(0.0, 2.0, n))
     energy = rng.uniform(0.2, 6.0, n)
-    ds = ra.cells(alpha, beta, nu, eta, kappa, energy)
+    # Components in increasing theta_min, as the command lists them.
+    ds = ra.cells(alpha, beta, nu, eta, kappa, energy, layout="theta_min")
     assert ds.rotation_number.dims == ("cell", "component")
-    flags = {name: ra.flag_names(ds[name]) for name in ("status", "motion")}
+    assert ds.attrs["component_layout"] == "theta_min"
+    flags = {name: ra.flag_names(ds[name]) for name in ("status", "motion", "family") if name in ds}
     with_motion = 0
     for i in range(n):
         args = ["cell", *[a for name, values in (("--alpha", alpha), ("--beta", beta), ("--nu", nu), ("--eta", eta),
@@ -69,7 +71,8 @@ def test_cells_equal_the_cell_command_bit_for_bit_on_random_cells():
                 else:
                     assert same_double(c[key], e[key]), (i, key, float(c[key]), e[key])
             for key, names in flags.items():
-                assert names[int(c[key])] == e[key], (i, key)
+                if key in e:
+                    assert names[int(c[key])] == e[key], (i, key)
             assert (None if int(c.bounded) == 255 else bool(c.bounded)) == e["bounded"], i
         # Slots beyond the components are NaN and the flags' no_value.
         for slot in range(len(expected), ds.sizes["component"]):
@@ -85,8 +88,11 @@ def test_cells_on_named_dimensions_equal_an_atlas_file(slice_atlas):
         atlas = atlas.load()
     kappa = xr.DataArray(atlas.kappa.values, dims="kappa", coords={"kappa": atlas.kappa.values})
     energy = xr.DataArray(atlas.energy.values, dims="energy", coords={"energy": atlas.energy.values})
-    ds = ra.cells(0.5, 3.0, 0.5, 0.5, kappa, energy, threads=2)
+    layout = atlas.attrs.get("component_layout", "theta_min")
+    ds = ra.cells(0.5, 3.0, 0.5, 0.5, kappa, energy, threads=2, layout=layout)
+    assert ds.attrs["component_layout"] == layout
     cut = atlas.isel(alpha=0, beta=0)
+    np.testing.assert_array_equal(ds.component, atlas.component)
     assert set(ds.data_vars) == set(atlas.data_vars)
     for name in atlas.data_vars:
         assert ds[name].dims == cut[name].dims, name
@@ -103,8 +109,8 @@ def test_cells_on_named_dimensions_equal_an_atlas_file(slice_atlas):
     # Fewer fields: only theirs (and the cell's counts). Without the drift the quadrature
     # stops when N alone has converged: the same N within its error estimate (as an atlas
     # with these fields gives it), not bit for bit.
-    few = ra.cells(0.5, 3.0, 0.5, 0.5, kappa, energy, fields=["rotation_number", "error_estimate"])
-    assert set(few.data_vars) == {"n_components", "cell_status", "rotation_number", "error_estimate"}
+    few = ra.cells(0.5, 3.0, 0.5, 0.5, kappa, energy, fields=["rotation_number", "error_estimate"], layout=layout)
+    assert set(few.data_vars) - {"family"} == {"n_components", "cell_status", "rotation_number", "error_estimate"}
     np.testing.assert_array_equal(np.isnan(few.rotation_number), np.isnan(ds.rotation_number))
     gap = np.abs(few.rotation_number - ds.rotation_number).fillna(0)
     assert (gap <= few.error_estimate.fillna(0) + ds.error_estimate.fillna(0)).all()
@@ -202,22 +208,27 @@ def test_requests_beyond_the_machine_are_refused_and_threads_capped():
     assert core.COMPONENT_SLOTS == 3
 
 
-def test_ctrl_c_stops_a_long_call_at_once(tmp_path):
+@pytest.mark.parametrize("progress", [None, True])
+def test_ctrl_c_stops_a_long_call_at_once(tmp_path, progress):
+    """In one call of the core, or in the batches that show progress (the bar is closed)."""
     import signal
 
     code = ("import numpy as np, rubber_atlas as ra, sys; print('start', flush=True)\n"
             "try:\n"
-            "    ra.cells(0.5, 3.0, 0.5, 0.5, np.linspace(0.05, 2, 400)[:, None], np.linspace(0.5, 4.5, 400), method='ode')\n"
+            "    ra.cells(0.5, 3.0, 0.5, 0.5, np.linspace(0.05, 2, 400)[:, None], np.linspace(0.5, 4.5, 400), "
+            f"method='ode', progress={progress})\n"
             "except KeyboardInterrupt:\n"
             "    print('interrupted', flush=True); sys.exit(3)\n")
-    child = subprocess.Popen([sys.executable, "-c", code], cwd=tmp_path, stdout=subprocess.PIPE, text=True)
+    child = subprocess.Popen([sys.executable, "-c", code], cwd=tmp_path, stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True)
     assert child.stdout.readline().strip() == "start"
     time.sleep(1.0)
     sent = time.perf_counter()
     child.send_signal(signal.SIGINT)
-    out, _ = child.communicate(timeout=60)
-    assert child.returncode == 3 and "interrupted" in out
+    out, err = child.communicate(timeout=60)
+    assert child.returncode == 3 and "interrupted" in out, err
     assert time.perf_counter() - sent < 2.0
+    assert (err.endswith("\n") and "%" in err) if progress else "%" not in err
 
 
 def test_bad_options_raise_value_errors():
@@ -240,7 +251,7 @@ back = xr.open_dataset("round.nc", engine="h5netcdf").load()
 assert (back.rotation_number.values.view(np.uint8) == ds.rotation_number.values.view(np.uint8)).all()
 assert back.status.dtype == np.uint8
 with h5py.File("round.nc") as f:
-    assert f["rotation_number"].shape == (7, 3)
+    assert f["rotation_number"].shape == (7, ds.sizes["component"])
 maps = open("/proc/self/maps").read()
 libraries = {{line.split()[-1] for line in maps.splitlines() if "libhdf5" in line.split()[-1]}}
 print(sorted(libraries))
@@ -314,6 +325,7 @@ def test_verdicts_equal_the_command():
     along = ra.verdict(xr.DataArray([0.5], dims="alpha"), 0.5, 0.5, 0.5, resolution=8)
     assert along.holds.dims == ("alpha",) and float(along.alpha[0]) == 0.5
     assert found.holds.dims == ("body",) and found.holds.dtype == np.uint8
+    assert found.kappa.dims == ("body", "counterexample") and found.sizes["counterexample"] > 0
     for i in range(2):
         expected = json.loads(run("verdict", "--alpha", float(alpha[i]), "--beta", float(beta[i]), "--nu", "0.5",
                                   "--eta", "0.5", "--resolution", "16", "--json"))
@@ -321,7 +333,21 @@ def test_verdicts_equal_the_command():
         assert got == expected
         holds = int(found.holds[i])
         assert ({0: False, 1: True, 255: None}[holds]) == expected["holds"]
-        assert ra.flag_names(found.case)[int(found.case[i])] == "case_" + expected["case"]
+        assert found.case[i].item().decode() == expected["case"]
+        # The counterexamples as data, padded beyond the body's count.
+        count = len(expected["counterexamples"])
+        assert int(found.counterexamples[i]) == count
+        for j in range(found.sizes["counterexample"]):
+            row = found.isel(body=i, counterexample=j)
+            if j < count:
+                c = expected["counterexamples"][j]
+                for key in ("kappa", "energy", "rotation_number", "theta_min", "theta_max", "drift"):
+                    assert same_double(row[key], c[key]), (i, j, key)
+                assert row.family.item().decode() == c.get("family", "")
+                assert int(row.component) == c.get("component", -1)
+            else:
+                assert all(np.isnan(float(row[k])) for k in ("kappa", "energy", "rotation_number", "drift"))
+                assert row.family.item() == b"" and int(row.component) == -1
 
 
 def test_the_accessor_gives_components_and_a_figure(slice_atlas):

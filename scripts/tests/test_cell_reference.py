@@ -1,5 +1,5 @@
 """`rubber-atlas cell` against an independent high-precision quadrature (mpmath, 40 digits) on
-the hard cells of SPEC §2.2 — near a separatrix and at small κ, where an ODE run is the least
+the hard cells of docs/accuracy.md — near a separatrix and at small κ, where an ODE run is the least
 reliable reference — and the hand-written Python solvers of scripts/ on the same cells."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""`rubber-atlas verdict` through its command line (the SPEC §4 contract, bad input) and
+"""`rubber-atlas verdict` through its command line (the docs/hypothesis.md contract, bad input) and
 scripts/hypothesis.py on a small (α, β) grid: the map, the boundary curves, and the
 trajectory evidence of each failure region (the full model's centre of mass runs away by
 n·|Δζ| after n periods)."""

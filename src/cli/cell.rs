@@ -21,7 +21,7 @@ pub struct CellArgs {
     /// |N − round(N)| at or below this (or N's error estimate) counts as a resonance.
     #[arg(long, default_value_t = 1e-9, allow_hyphen_values = true)]
     pub resonance_tol: f64,
-    /// Print one JSON object (keys of SPEC §3.1).
+    /// Print one JSON object (keys of docs/files.md).
     #[arg(long)]
     pub json: bool,
 }

@@ -46,7 +46,7 @@ pub struct VerdictArgs {
     /// spacing).
     #[arg(long, default_value_t = 64)]
     pub resolution: usize,
-    /// Print one JSON object (SPEC §4 contract).
+    /// Print one JSON object (docs/hypothesis.md contract).
     #[arg(long)]
     pub json: bool,
 }
