@@ -71,18 +71,12 @@ pub const FLAG_FILL: u8 = 255;
 /// κ and ε, and the component slot (the atlas file's coordinates, and the Python package's).
 pub fn coordinate(name: &str) -> Option<(&'static str, Units)> {
     Some(match name {
-        "alpha" => (
-            "alpha = a / b3, offset of the centre of mass along the symmetry axis",
-            cf::NUMBER,
-        ),
-        "beta" => ("beta = b1 / b3, ratio of the semi-axes", cf::NUMBER),
-        "nu" => ("nu = i3 / i1, ratio of the moments of inertia", cf::NUMBER),
-        "eta" => ("eta = m b3^2 / i1", cf::NUMBER),
-        "kappa" => ("kappa = F2, the first integral of the reduction", cf::PAPER),
-        "energy" => (
-            "energy, the value of the reduced energy integral",
-            cf::ENERGY,
-        ),
+        "alpha" => ("alpha, centre-of-mass offset a/b3", cf::NUMBER),
+        "beta" => ("beta, semi-axis ratio b1/b3", cf::NUMBER),
+        "nu" => ("nu, inertia ratio i3/i1", cf::NUMBER),
+        "eta" => ("eta = m b3^2/i1", cf::NUMBER),
+        "kappa" => ("kappa, integral F2", cf::PAPER),
+        "energy" => ("energy", cf::ENERGY),
         "component" => ("component (torus family, or rank in theta_min)", cf::NUMBER),
         _ => return None,
     })
@@ -222,7 +216,7 @@ pub fn variables(fields: &[Field]) -> Vec<Variable> {
         Variable {
             name: "n_components",
             kind: Kind::CellFlag,
-            long_name: "number of connected components of the allowed set {V <= energy}",
+            long_name: "number of tori",
             units: cf::NUMBER,
             flags: None,
             value: |_| 0.0,
@@ -245,101 +239,65 @@ pub fn variables(fields: &[Field]) -> Vec<Variable> {
     for &field in fields {
         let (var, error): (Variable, Option<Variable>) = match field {
             Field::ThetaMin => (
-                float(
-                    "theta_min",
-                    "lower turning point of theta",
-                    cf::ANGLE,
-                    |c| c.theta_min,
-                ),
+                float("theta_min", "theta_min", cf::ANGLE, |c| c.theta_min),
                 None,
             ),
             Field::ThetaMax => (
-                float(
-                    "theta_max",
-                    "upper turning point of theta",
-                    cf::ANGLE,
-                    |c| c.theta_max,
-                ),
+                float("theta_max", "theta_max", cf::ANGLE, |c| c.theta_max),
                 None,
             ),
             Field::Period => (
-                float("period", "period T of theta", cf::TIME, |c| c.period),
-                Some(float(
-                    "period_error",
-                    "estimated absolute error of period",
-                    cf::TIME,
-                    |c| c.errors.period,
-                )),
+                float("period", "period T", cf::TIME, |c| c.period),
+                Some(float("period_error", "error of T", cf::TIME, |c| {
+                    c.errors.period
+                })),
             ),
             Field::OmegaTheta => (
-                float(
-                    "omega_theta",
-                    "frequency of theta, 2 pi / T",
-                    cf::RATE,
-                    |c| c.omega_theta,
-                ),
+                float("omega_theta", "frequency omega_theta", cf::RATE, |c| {
+                    c.omega_theta
+                }),
                 Some(float(
                     "omega_theta_error",
-                    "estimated absolute error of omega_theta",
+                    "error of omega_theta",
                     cf::RATE,
                     |c| c.errors.omega_theta,
                 )),
             ),
             Field::OmegaPsi => (
-                float(
-                    "omega_psi",
-                    "mean precession rate, (psi advance over a period) / T",
-                    cf::RATE,
-                    |c| c.omega_psi,
-                ),
+                float("omega_psi", "precession rate omega_psi", cf::RATE, |c| {
+                    c.omega_psi
+                }),
                 Some(float(
                     "omega_psi_error",
-                    "estimated absolute error of omega_psi",
+                    "error of omega_psi",
                     cf::RATE,
                     |c| c.errors.omega_psi,
                 )),
             ),
             Field::RotationNumber => (
-                float(
-                    "rotation_number",
-                    "rotation number N = -omega_psi / omega_theta",
-                    cf::NUMBER,
-                    |c| c.rotation_number,
-                ),
+                float("rotation_number", "rotation number N", cf::NUMBER, |c| {
+                    c.rotation_number
+                }),
                 None,
             ),
             Field::Drift => (
-                float(
-                    "drift",
-                    "displacement |delta zeta| of the centre of mass over one period of theta",
-                    cf::LENGTH,
-                    |c| c.drift,
-                ),
-                Some(float(
-                    "drift_error",
-                    "estimated absolute error of drift",
-                    cf::LENGTH,
-                    |c| c.errors.drift,
-                )),
+                float("drift", "drift per period", cf::LENGTH, |c| c.drift),
+                Some(float("drift_error", "error of drift", cf::LENGTH, |c| {
+                    c.errors.drift
+                })),
             ),
             Field::DriftRadius => (
-                float(
-                    "drift_radius",
-                    "radius |delta zeta| / (2 |sin pi N|) of the circle of stroboscopic points",
-                    cf::LENGTH,
-                    |c| c.drift_radius,
-                ),
-                Some(float(
-                    "drift_radius_error",
-                    "estimated absolute error of drift_radius",
-                    cf::LENGTH,
-                    |c| c.errors.drift_radius,
-                )),
+                float("drift_radius", "drift radius R", cf::LENGTH, |c| {
+                    c.drift_radius
+                }),
+                Some(float("drift_radius_error", "error of R", cf::LENGTH, |c| {
+                    c.errors.drift_radius
+                })),
             ),
             Field::Bounded => (
                 flag(
                     "bounded",
-                    "whether the path of the body on the plane stays bounded",
+                    "path bounded",
                     (&[0, 1], "unbounded bounded"),
                     |c| match c.bounded {
                         Some(true) => 1.0,
@@ -352,7 +310,7 @@ pub fn variables(fields: &[Field]) -> Vec<Variable> {
             Field::Motion => (
                 flag(
                     "motion",
-                    "kind of motion of the component",
+                    "kind of motion",
                     (&motion_flag::VALUES, motion_flag::MEANINGS),
                     |c| {
                         f64::from(match c.motion {
@@ -367,7 +325,7 @@ pub fn variables(fields: &[Field]) -> Vec<Variable> {
             Field::Status => (
                 flag(
                     "status",
-                    "how to read the component's values",
+                    "status",
                     (&status_flag::VALUES, status_flag::MEANINGS),
                     |c| {
                         f64::from(match c.status {
@@ -382,12 +340,9 @@ pub fn variables(fields: &[Field]) -> Vec<Variable> {
                 None,
             ),
             Field::ErrorEstimate => (
-                float(
-                    "error_estimate",
-                    "estimated absolute error of rotation_number",
-                    cf::NUMBER,
-                    |c| c.error_estimate,
-                ),
+                float("error_estimate", "error of N", cf::NUMBER, |c| {
+                    c.error_estimate
+                }),
                 None,
             ),
         };

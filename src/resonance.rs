@@ -80,6 +80,8 @@ pub struct CurvePoint {
     pub error_estimate: f64,
     /// Which component of the cell (index in increasing θ_min, as `rubber-atlas cell`).
     pub component: usize,
+    /// The family of tori of that component.
+    pub family: crate::family::Family,
     pub theta_min: f64,
     pub theta_max: f64,
     /// θ of the minimum of V (the permanent rotation) that the component surrounds.
@@ -139,6 +141,7 @@ pub(crate) fn evaluate<S: Shape>(
         rotation_number: r.rotation_number,
         error_estimate: r.error_estimate,
         component: index,
+        family: r.family,
         theta_min: r.theta_min,
         theta_max: r.theta_max,
         well: minimum,

@@ -5,6 +5,7 @@
 
 use crate::cf::{self, AttrValue, Units};
 use crate::critical::CriticalSet;
+use crate::family::Family;
 use crate::resonance::Curve;
 use crate::trajectory::Trajectory;
 
@@ -269,6 +270,12 @@ pub fn resonance(curves: &[Curve]) -> Table {
             index(&|r| r.2.component),
             "component of the cell, in increasing theta_min",
             cf::NUMBER,
+        ),
+        flag_column(
+            "family",
+            rows.iter().map(|r| r.2.family.code()).collect(),
+            "torus family",
+            (&Family::VALUES, Family::MEANINGS),
         ),
         column(
             "theta_min",

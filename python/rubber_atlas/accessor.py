@@ -15,6 +15,9 @@ _LABELS = {"kappa": "κ", "energy": "ε", "excess_energy": "ε − V_min", "lamb
            "s": "s = 1/√ε", "alpha": "α", "beta": "β", "nu": "ν", "eta": "η"}
 # At most this many resonance contours per panel: fewer denominators beyond.
 _MAX_LEVELS = 60
+# A trajectory's plane is drawn with equal scales only while the path's extents differ by at
+# most this factor: a drifting path, long and thin, would otherwise shrink to a flat line.
+_EQUAL_ASPECT_UP_TO = 4.0
 
 
 def resonances(lo: float, hi: float, max_q: int = 7) -> list[float]:
@@ -244,6 +247,69 @@ class RubberAccessor:
         out.attrs = dict(ds.attrs, family=name)
         return out
 
+    def plot_trajectory(self):
+        """Draws a trajectory (from `trajectory`, or a file of `rubber-atlas trajectory` read
+        with `read_table`): the paths of the centre of mass and of the contact point on the
+        plane, and θ(t).
+
+        The plane is drawn to scale unless the path is much longer one way than the other (a
+        drifting path, e.g. on an integer resonance), when each axis gets its own scale so that
+        the path does not shrink to a line (the title says so).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            Two panels: the plane (x, y in units of b3) and θ over t (units of √(b3/g)).
+
+        Raises
+        ------
+        ValueError
+            The dataset is not a trajectory (it lacks t, theta, x_c, y_c, x_p or y_p).
+
+        Examples
+        --------
+        >>> import matplotlib
+        >>> matplotlib.use("Agg")
+        >>> import rubber_atlas as ra
+        >>> path = ra.trajectory(0.5, 3.0, 0.5, 0.5, kappa=0.8, theta0=0.4670288, periods=7)
+        >>> fig = path.rubber.plot_trajectory()
+        >>> [ax.get_title() for ax in fig.axes]
+        ['on the plane', 'theta(t)']
+        """
+        import matplotlib.pyplot as plt
+
+        ds = self._ds
+        missing = [k for k in ("t", "theta", "x_c", "y_c", "x_p", "y_p") if k not in ds.variables]
+        if missing:
+            raise ValueError(f"plot_trajectory draws a trajectory; this dataset lacks {', '.join(missing)}")
+        cols = {k: np.asarray(ds[k].values) for k in ("t", "theta", "x_c", "y_c", "x_p", "y_p")}
+        fig, (ax_xy, ax_t) = plt.subplots(1, 2, figsize=(11, 5), gridspec_kw={"width_ratios": [1, 1.2]},
+                                          layout="constrained")
+        ax_xy.plot(cols["x_p"], cols["y_p"], lw=0.6, color="tab:orange", label="contact point")
+        ax_xy.plot(cols["x_c"], cols["y_c"], lw=0.9, color="tab:blue", label="centre of mass")
+        ax_xy.plot(cols["x_c"][:1], cols["y_c"][:1], "ko", ms=4, label="start")
+        xs = np.concatenate([cols["x_p"], cols["x_c"]])
+        ys = np.concatenate([cols["y_p"], cols["y_c"]])
+        width, height = float(np.ptp(xs)), float(np.ptp(ys))
+        if min(width, height) > 0 and max(width, height) / min(width, height) <= _EQUAL_ASPECT_UP_TO:
+            ax_xy.set_aspect("equal", adjustable="datalim")
+            ax_xy.set_title("on the plane", fontsize=9)
+        else:
+            ax_xy.set_title("on the plane (axes not to scale)", fontsize=9)
+        ax_xy.set_xlabel("x / b3")
+        ax_xy.set_ylabel("y / b3")
+        # Above the axes, outside them: never over the path.
+        ax_xy.legend(loc="lower center", bbox_to_anchor=(0.5, 1.06), ncol=3, fontsize=8, frameon=False)
+        ax_t.plot(cols["t"], cols["theta"], lw=0.8)
+        ax_t.set_xlabel("t / sqrt(b3/g)")
+        ax_t.set_ylabel("theta / rad")
+        ax_t.set_title("theta(t)", fontsize=9)
+        attrs = ds.attrs
+        title = ", ".join(f"{k} = {float(attrs[k]):.7g}"
+                          for k in ("alpha", "beta", "nu", "eta", "kappa", "energy") if k in attrs)
+        fig.suptitle(f"{attrs.get('model', '')} model: {title}", fontsize=9)
+        return fig
+
     def plot_slice(self, alpha_index: int = 0, beta_index: int = 0, max_q: int = 7):
         """A matplotlib Figure of the rotation number of each torus family over a plane.
 
@@ -290,6 +356,7 @@ class RubberAccessor:
         >>> [ax.get_title() for ax in fig.axes if ax.get_title()]
         ['well_0: N', 'well_pi: N', 'log10 R (largest)']
         """
+        import matplotlib.colors
         import matplotlib.pyplot as plt
 
         ds = self._ds
@@ -303,15 +370,19 @@ class RubberAccessor:
         plane = list(cut.cell_status.dims)
         if len(plane) != 2:
             raise ValueError("plot_slice draws an atlas slice or a cells result over a plane of two dimensions "
-                             f"(e.g. kappa and energy); this dataset has dimensions {list(ds.cell_status.dims)}")
+                             f"(e.g. kappa and energy); this dataset has dimensions {list(ds.cell_status.dims)}. "
+                             "For a grid give cells kappa and energy as DataArrays along 'kappa' and 'energy' "
+                             "(or numpy vectors of different lengths): vectors of one length are paired cell "
+                             "by cell")
         x, y = (cut[d].values if d in cut.coords else np.arange(cut.sizes[d]) for d in plane)
         panels = []  # (title, N over the plane)
         if "rotation_number" in cut:
             if "family" in cut:
                 accessor = cut.rubber
+                # Rolling over the top (kappa = 0) has N = 0 by definition: no panel.
                 for name in accessor.families():
                     n = accessor.family(name).rotation_number
-                    if np.isfinite(n).any():
+                    if name != "over_the_top" and np.isfinite(n).any():
                         panels.append((f"{name}: N", n))
             else:
                 for slot in range(cut.sizes["component"]):
@@ -328,15 +399,19 @@ class RubberAccessor:
         for ax, (title, n) in zip(axes[0], panels):
             values = n.transpose(*plane).values.T
             finite = values[np.isfinite(values)]
-            top = float(np.abs(finite).max()) if finite.size else 1.0
-            top = top if top > 0 else 1.0
+            # Centred on 0, each side over its own range (N is often mostly of one sign: a
+            # symmetric scale would show the other side as white).
+            low = float(finite.min()) if finite.size else -1.0
+            high = float(finite.max()) if finite.size else 1.0
+            span = max(abs(low), abs(high), 1e-300)
+            norm = matplotlib.colors.TwoSlopeNorm(vcenter=0.0, vmin=min(low, -1e-6 * span),
+                                                  vmax=max(high, 1e-6 * span))
             # Infinities (on a separatrix) take the end colours: arrows say so.
             extend = {(False, False): "neither", (True, False): "min", (False, True): "max",
                       (True, True): "both"}[(bool(np.isneginf(values).any()), bool(np.isposinf(values).any()))]
             # Grey where the cell has no torus of the family (white is N = 0).
             ax.set_facecolor("0.82")
-            mesh = ax.pcolormesh(x, y, np.ma.masked_invalid(values), shading="auto", cmap="RdBu_r",
-                                 vmin=-top, vmax=top)
+            mesh = ax.pcolormesh(x, y, np.ma.masked_invalid(values), shading="auto", cmap="RdBu_r", norm=norm)
             fig.colorbar(mesh, ax=ax, label="N", extend=extend)
             lo, hi = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 0.0)
             q = max_q
@@ -348,16 +423,23 @@ class RubberAccessor:
             contoured = np.ma.masked_invalid(values)
             if len(x) > 1 and len(y) > 1:
                 if fractions:
-                    ax.contour(x, y, contoured, levels=fractions, colors="0.3", linewidths=0.5)
+                    ax.contour(x, y, contoured, levels=fractions, colors="0.3", linewidths=0.5,
+                               linestyles="solid")
                 if integers[:_MAX_LEVELS]:
-                    ax.contour(x, y, contoured, levels=integers[:_MAX_LEVELS], colors="black", linewidths=1.1)
+                    ax.contour(x, y, contoured, levels=integers[:_MAX_LEVELS], colors="black", linewidths=1.1,
+                               linestyles="solid")
             ax.set_title(title if q == max_q else f"{title} (q ≤ {q})", fontsize=10)
             denominators.append(q)
         if drift:
             ax = axes[0][-1]
             with np.errstate(divide="ignore", invalid="ignore"):
                 r = np.log10(cut.drift_radius.max("component", skipna=True).transpose(*plane).values.T)
-            mesh = ax.pcolormesh(x, y, np.ma.masked_invalid(r), shading="auto", cmap="magma", vmin=-2, vmax=2)
+            # R spans decades and is infinite on a resonance: the scale covers the 2nd to 98th
+            # percentiles of the slice's finite values, the arrows say that more lies beyond.
+            finite_r = r[np.isfinite(r)]
+            lo_r, hi_r = np.percentile(finite_r, [2, 98]) if finite_r.size else (-2.0, 2.0)
+            hi_r = hi_r if hi_r > lo_r else lo_r + 1.0
+            mesh = ax.pcolormesh(x, y, np.ma.masked_invalid(r), shading="auto", cmap="magma", vmin=lo_r, vmax=hi_r)
             fig.colorbar(mesh, ax=ax, label="log10 R", extend="both")
             ax.set_title("log10 R (largest)", fontsize=10)
         for ax in axes[0]:

@@ -400,8 +400,10 @@ def test_an_atlas_slice_per_family_and_its_figure():
         mesh = ax.collections[0]
         low, high = mesh.get_clim()
         n = ds.rubber.family(name).rotation_number
-        # Centred on 0, over the whole range of N.
-        assert low == -high and high == pytest.approx(float(np.abs(n).max()))
+        # Centred on 0, over the whole range of N, each side over its own range.
+        assert mesh.norm.vcenter == 0
+        assert low == pytest.approx(min(float(n.min()), -1e-6 * float(np.abs(n).max())))
+        assert high == pytest.approx(max(float(n.max()), 1e-6 * float(np.abs(n).max())))
         assert mesh.get_cmap().name == "RdBu_r"
         assert ax.get_xlabel() == "κ" and ax.get_ylabel() == "ε"
         assert len(ax.collections) >= 2  # the contours N = p/q

@@ -76,7 +76,10 @@ def test_xarray_opens_it_with_named_dimensions(demo):
     assert tuple(ds.rotation_number.dims) == DIMENSIONS
     assert tuple(ds.n_components.dims) == DIMENSIONS[:4]
     assert not any(d.startswith("phony_dim") for d in ds.dims)
-    assert list(ds.component.values) == [0, 1, 2]
+    # By family (the default): the demo has both wells and, at kappa = 0, rolling over the top.
+    assert ds.attrs["component_layout"] == "family"
+    assert list(ds.component.values) == [0, 1, 3]
+    assert flag_names(ds.component) == {0: "well_0", 1: "well_pi", 3: "over_the_top"}
     assert flag_names(ds.status)[0] == "ok"
     # Flags stay integers in xarray (no _FillValue: 255 is a flag value of its own).
     for name in ("status", "motion", "bounded", "cell_status", "n_components"):
@@ -88,11 +91,17 @@ def test_xarray_opens_it_with_named_dimensions(demo):
     assert ds.theta_min.attrs["units"] == "rad"
     assert ds.attrs["history"].startswith(ds.attrs["created"] + ": ")
     # The motion is where the scene says: N is finite exactly on the existing components.
+    # (At kappa = 0 the mirror images of one family, the body leaning either way, share its
+    # slot: one value for two components.)
     count = ds.n_components.values
     finite = np.isfinite(ds.rotation_number.values).sum(axis=-1)
-    np.testing.assert_array_equal(finite, np.minimum(count, 3))
-    # The paper's Fig. xy cell: κ = 0.8 near the libration of N = −1/7 has one component.
-    n = ds.rotation_number.sel(alpha=0.5, beta=3.0, kappa=0.8, component=0)
+    np.testing.assert_array_equal(finite, (ds.family.values != 255).sum(axis=-1))
+    moving = ds.kappa.values != 0
+    np.testing.assert_array_equal(finite[:, :, moving], count[:, :, moving])
+    assert (finite[:, :, ~moving] <= count[:, :, ~moving]).all()
+    # The paper's Fig. xy cell: kappa = 0.8 near the libration of N = -1/7, in the well of
+    # sigma_spi.
+    n = ds.rubber.family("well_pi").rotation_number.sel(alpha=0.5, beta=3.0, kappa=0.8)
     assert np.nanmin(n.values) < -1 / 7 < np.nanmax(n.values)
     ds.close()
 
@@ -199,9 +208,11 @@ def test_compact_plane_has_kappa_and_energy_as_coordinates(make_atlas):
     lam, s = float(cell["lambda"]), float(cell["s"])
     assert float(cell.kappa) == lam / s and float(cell.energy) == 1 / s**2
     got = components(ds, 0.5, 3.0, lambda_=lam, s=s)
-    assert got and got[0]["rotation_number"] == float(cell.rotation_number.isel(component=0))
+    assert got and got[0]["rotation_number"] == float(cell.rubber.family(got[0]["family"]).rotation_number)
     with pytest.raises(KeyError):
         components(ds, 0.5, 3.0, kappa=1.0, energy=2.0)
     limit = ds.sel(alpha=0.5, beta=3.0, s=0.0)
     assert np.isinf(limit.energy).all()
-    assert (flag_names(ds.status)[int(limit.status.isel(**{"lambda": 0}, component=0))] == "high_energy_limit")
+    # At kappa = lambda sqrt(energy) -> infinity V is one well, that of sigma_spi (alpha > 0).
+    at_infinity = limit.rubber.family("well_pi")
+    assert (flag_names(ds.status)[int(at_infinity.status.isel(**{"lambda": 0}))] == "high_energy_limit")

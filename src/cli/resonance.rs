@@ -164,6 +164,13 @@ pub(super) fn resonance(args: ResonanceArgs) -> Result<()> {
         args.shape.alpha, args.shape.beta, args.nu, args.eta, curves.len(),
         options.kappa.0, options.kappa.1, options.energy.0, options.energy.1
     );
+    if curves.is_empty() {
+        println!(
+            "  (no component reaches N = {target} in this window: the curve may lie beyond it; \
+             widen it with --kappa-max and --energy-max, or see where N takes this value with \
+             an atlas or `rubber-atlas verdict`)"
+        );
+    }
     for (i, c) in curves.iter().enumerate() {
         let (kmin, kmax) = c
             .points
