@@ -170,6 +170,52 @@ impl Census {
     }
 }
 
+/// The families an ellipsoid (α, β) can have anywhere on its (κ, ε) plane: a superset read
+/// off its diagram type (paper §4). For κ ≠ 0 a second well (σ_s0 beside σ_sπ, or its mirror
+/// for α < 0) exists only in type (c), β² > 1 + |α| (type (e) for α = 0, β > 1); the single
+/// well of a body symmetric about its equator is `well_equator`. Cells at κ = 0 may have any
+/// family (the equilibria, θ*, rolling over the top, the degenerate sphere): with
+/// `kappa_zero` every family is possible. The boundary β² = 1 + |α| is widened by a margin,
+/// so that rounding never leaves out a family: a superset only costs the census its early
+/// end.
+pub fn possible_for_ellipsoid(alpha: f64, beta: f64, kappa_zero: bool) -> [bool; 4] {
+    if kappa_zero {
+        return [true; 4];
+    }
+    let two_wells = beta * beta > (1.0 + alpha.abs()) * (1.0 - 1e-6);
+    let mut possible = [false; 4];
+    let mut allow = |f: Family| possible[usize::from(f.code())] = true;
+    if alpha == 0.0 {
+        allow(Family::WellEquator);
+        if two_wells {
+            allow(Family::Well0);
+            allow(Family::WellPi);
+        }
+    } else {
+        // The well V keeps at large κ, on the side U descends to at π/2 (U′(π/2) = −α).
+        allow(if alpha > 0.0 {
+            Family::WellPi
+        } else {
+            Family::Well0
+        });
+        if two_wells {
+            allow(Family::Well0);
+            allow(Family::WellPi);
+        }
+    }
+    possible
+}
+
+impl Census {
+    /// Whether this census has found every family `possible` allows (and so can end).
+    pub fn covers(&self, possible: &[bool; 4]) -> bool {
+        self.families
+            .iter()
+            .zip(possible)
+            .all(|(&found, &allowed)| found || !allowed)
+    }
+}
+
 /// The labels of an atlas's component axis: the family codes present (layout `Family`) or
 /// 0, 1, … (layout `ThetaMin`). A grid without motion anywhere keeps one slot, labelled
 /// [`crate::atlas::FLAG_FILL`] in the family layout.

@@ -289,6 +289,14 @@ fn the_census_agrees_with_the_components_over_the_whole_domain() {
             census, solved,
             "alpha {alpha} beta {beta} kappa {kappa} energy {energy}"
         );
+        // Every family is one the census may expect of the body (its early end is safe).
+        let possible = rubber_atlas::family::possible_for_ellipsoid(alpha, beta, kappa == 0.0);
+        for f in &solved {
+            assert!(
+                possible[usize::from(f.code())],
+                "{f} at alpha {alpha} beta {beta} kappa {kappa} energy {energy}"
+            );
+        }
         // Two components of one family only at κ = 0 (mirror images).
         if kappa != 0.0 {
             let mut unique = solved.clone();
@@ -302,6 +310,39 @@ fn the_census_agrees_with_the_components_over_the_whole_domain() {
         checked += 1;
     }
     assert_eq!(checked, 3000);
+}
+
+#[test]
+fn the_families_a_body_can_have_hold_at_the_type_boundaries_and_small_kappa() {
+    // Bodies on either side of β² = 1 + |α| (where the second well is born, at κ = 0) and
+    // α = ±0, swept over small κ and the energies of their wells and saddles.
+    let mut checked = 0;
+    for alpha in [0.5, -0.5, 1e-12, -1e-12, 0.0, 0.3] {
+        for factor in [1.0 - 1e-3, 1.0 - 1e-9, 1.0, 1.0 + 1e-9, 1.0 + 1e-3] {
+            let beta = ((1.0 + f64::abs(alpha)) * factor).sqrt();
+            let b = body(alpha, beta);
+            let possible = rubber_atlas::family::possible_for_ellipsoid(alpha, beta, false);
+            for kappa in [1e-8, 1e-5, 1e-3, 0.05, 0.5, 2.0] {
+                let potential = EffectivePotential::new(&b, kappa);
+                let mut levels: Vec<f64> = potential
+                    .critical_points()
+                    .iter()
+                    .flat_map(|p| [p.value * (1.0 + 1e-12), p.value + 1e-6, p.value + 0.3])
+                    .collect();
+                levels.push(potential.lowest_minimum().unwrap() + 5.0);
+                for energy in levels {
+                    for f in potential.families(energy).unwrap_or_default() {
+                        assert!(
+                            possible[usize::from(f.code())],
+                            "{f} at alpha {alpha} beta {beta} kappa {kappa} energy {energy}"
+                        );
+                        checked += 1;
+                    }
+                }
+            }
+        }
+    }
+    assert!(checked > 300, "{checked}");
 }
 
 #[test]
