@@ -748,7 +748,7 @@ fn visit_row(
 /// ([`crate::family::possible_for_ellipsoid`]): on planes where every cell has its own κ
 /// (λ, s) the critical points are the bulk of a cell's cost, and a full census would double
 /// it.
-pub fn census(scene: &Scene) -> Census {
+pub fn census(scene: &Scene, stop: &(dyn Fn() -> bool + Sync)) -> Census {
     use std::sync::atomic::{AtomicBool, Ordering};
     use std::sync::Mutex;
     let [na, nb, nk, _] = scene.shape();
@@ -769,7 +769,7 @@ pub fn census(scene: &Scene) -> Census {
         .into_par_iter()
         .with_max_len(1)
         .for_each(|i| {
-            if done.load(Ordering::Relaxed) {
+            if done.load(Ordering::Relaxed) || stop() {
                 return;
             }
             let (slice, row) = (i / nk, i % nk);
@@ -793,9 +793,9 @@ pub fn census(scene: &Scene) -> Census {
 }
 
 /// The component axis of `scene`'s file: its layout over the families and counts its
-/// [`census`] finds.
-pub fn component_axis(scene: &Scene) -> ComponentAxis {
-    ComponentAxis::of(scene.layout, &census(scene))
+/// [`census`] finds (cut short, and then meaningless, once `stop` says so).
+pub fn component_axis(scene: &Scene, stop: &(dyn Fn() -> bool + Sync)) -> ComponentAxis {
+    ComponentAxis::of(scene.layout, &census(scene, stop))
 }
 
 /// Computes the κ-rows `rows` (in that order) of slice (ia, ib), rows shared out by rayon one

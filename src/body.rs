@@ -22,6 +22,9 @@ pub struct Angle {
 }
 
 impl Angle {
+    /// θ = π/2 exactly (sin 1, cos 0), which no rounded θ gives: cos(FRAC_PI_2) is 6e-17.
+    pub const EQUATOR: Angle = Angle { sin: 1.0, cos: 0.0 };
+
     /// The angle θ itself.
     #[inline]
     pub fn new(theta: f64) -> Self {

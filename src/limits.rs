@@ -201,7 +201,7 @@ fn turning_cosine(lambda: f64) -> f64 {
 /// body symmetric about its equator. The tori above a saddle belong to this family too.
 pub fn high_energy_family<S: Shape>(body: &Body<S>) -> crate::family::Family {
     use crate::family::Family;
-    let slope = body.shape.potential_prime_at(Angle::new(FRAC_PI_2));
+    let slope = body.shape.potential_prime_at(Angle::EQUATOR);
     if body.shape.symmetric_about_equator() || slope == 0.0 {
         Family::WellEquator
     } else if slope < 0.0 {

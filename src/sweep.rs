@@ -252,21 +252,18 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
     request.shard.check_against(scene.shape())?;
     // Held until the file is in place and the journal gone.
     let _claim = crate::store::OutputLock::acquire(out)?;
-    // The journal belongs to this scene, build and shard: a unit kept for one shard is
-    // chunked for that shard's file, and never taken by a run of another shard or the
-    // whole grid into the same output.
-    let fingerprint = crate::scene::fnv1a(
-        scene.fingerprint(),
-        format!("shard {}", request.shard).as_bytes(),
-    );
-    // The component axis, from the whole grid's critical points: the same for every shard.
-    let axis = atlas::component_axis(scene);
-    if out.exists() && request.update && output_is_current(out, scene, request.shard, &axis) {
-        return Ok(Summary {
-            up_to_date: true,
-            seconds: started.elapsed().as_secs_f64(),
-            ..Summary::default()
-        });
+    // A current output (made from this scene by this build for this shard) carries the axis
+    // this build lays its grid out on: --update keeps it without a census.
+    if out.exists() && request.update {
+        if let Ok(axis) = AtlasFile::read_axis(out) {
+            if output_is_current(out, scene, request.shard, &axis) {
+                return Ok(Summary {
+                    up_to_date: true,
+                    seconds: started.elapsed().as_secs_f64(),
+                    ..Summary::default()
+                });
+            }
+        }
     }
     if out.exists() && !request.force && !request.update {
         return Err(AtlasError::atlas(
@@ -274,6 +271,29 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
             "exists; use --force to overwrite it (a finished run has nothing to resume)",
         ));
     }
+    // The component axis, from the whole grid's critical points: the same for every shard.
+    // (A census cut short by a signal lays out nothing: the run stops before any work.)
+    let axis = atlas::component_axis(scene, &|| progress.interrupted());
+    if progress.interrupted() {
+        return Err(AtlasError::Interrupted {
+            path: out.display().to_string(),
+            done: 0,
+            total: scene.cells() as u64,
+        });
+    }
+    // The journal belongs to this scene, build, shard and component axis: a unit kept for
+    // one shard is chunked for that shard's file and axis, and never taken by a run of
+    // another shard, the whole grid or another layout into the same output.
+    let fingerprint = crate::scene::fnv1a(
+        scene.fingerprint(),
+        format!(
+            "shard {} component {} {:?}",
+            request.shard,
+            axis.layout.name(),
+            axis.labels
+        )
+        .as_bytes(),
+    );
     let journal_dir = Journal::dir_for(out);
     let journal = if journal_dir.exists() {
         let matching = || Journal::open(&journal_dir, fingerprint);
@@ -465,6 +485,21 @@ pub fn merge(
         shard
             .check_against(shape)
             .map_err(|e| AtlasError::atlas(path, e))?;
+        let own = AtlasFile::read_axis(path)?;
+        if own != axis {
+            return Err(AtlasError::atlas(
+                path,
+                format!(
+                    "its component axis ({} {:?}) differs from that of {} ({} {:?}): shards \
+                     of one scene made by different builds?",
+                    own.layout.name(),
+                    own.labels,
+                    first.display(),
+                    axis.layout.name(),
+                    axis.labels
+                ),
+            ));
+        }
         let file = AtlasFile::open(path, &shard.region(shape), &variables, &axis)?;
         if file.text_attribute("scene_fingerprint").as_deref() != Some(fingerprint.as_str()) {
             return Err(AtlasError::atlas(

@@ -22,9 +22,9 @@ mod cosine;
 
 const EPS: f64 = f64::EPSILON;
 
-/// How close to ±π/2 a minimum of U on the κ = 0 circle of a body symmetric about its
-/// equator is taken as lying on the equator (its minima there are at ±π/2 exactly, or a
-/// pair θ*, π − θ* that meets there only for a degenerate body).
+/// How close to ±π/2 a minimum of V is taken as lying at the equator, its side then decided
+/// by the exact sign of U′(π/2) (or, for a body symmetric about its equator, on it). A well
+/// this close to π/2 with a saddle between them exists only next to a degenerate body.
 const EQUATOR_WINDOW: f64 = 1e-6;
 
 /// The nodes of V round the θ-axis at one ε ([`EffectivePotential::levels`]).
@@ -662,45 +662,47 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             .expect("a run holds at least one node")
     }
 
-    /// Which side of the equator a minimum of V lies on. For κ ≠ 0, the single minimum of a
+    /// Which side of the equator a minimum of V lies on, by its distance from θ = 0 (on the
+    /// κ = 0 circle the lifted angle taken to (−π, π]). For κ ≠ 0 the single minimum of a
     /// body symmetric about its equator lies at π/2 exactly (by symmetry, whatever its
-    /// rounding); a minimum rounded onto π/2 of another body lies on the side V descends
-    /// to there. On the κ = 0 circle, by the distance from θ = 0 (the lifted angle taken to
-    /// (−π, π]).
+    /// rounding). A minimum within [`EQUATOR_WINDOW`] of π/2 may have been rounded across
+    /// it (at large κ the well sits within |U′(π/2)|/κ² of π/2, and cos(FRAC_PI_2) = 6e-17
+    /// then outweighs U′ in V′): its side is that of the exact sign of V′(π/2) = U′(π/2)
+    /// (the κ term vanishes there), beyond π/2 where V descends.
     fn side(&self, p: &CriticalPoint) -> Side {
         let symmetric = self.body.shape.symmetric_about_equator();
-        if self.kappa != 0.0 {
+        let wrapped = (p.site.theta + PI).rem_euclid(TAU) - PI;
+        let from_equator = wrapped.abs() - FRAC_PI_2;
+        if self.kappa != 0.0 && symmetric {
+            // One well, at π/2; or a mirror pair, one on each side however close.
             let minima = self
                 .critical
                 .iter()
                 .filter(|c| c.kind == CriticalKind::Minimum)
                 .count();
-            if symmetric && minima == 1 {
-                return Side::Equator;
-            }
-            return match p.site.theta.total_cmp(&FRAC_PI_2) {
-                std::cmp::Ordering::Less => Side::Upper,
-                std::cmp::Ordering::Greater => Side::Lower,
-                std::cmp::Ordering::Equal => {
-                    let slope = self.slope(Angle::new(FRAC_PI_2));
-                    if slope > 0.0 {
-                        Side::Upper
-                    } else if slope < 0.0 {
-                        Side::Lower
-                    } else {
-                        Side::Equator
-                    }
-                }
+            return if minima == 1 {
+                Side::Equator
+            } else if from_equator < 0.0 {
+                Side::Upper
+            } else {
+                Side::Lower
             };
         }
-        let wrapped = (p.site.theta + PI).rem_euclid(TAU) - PI;
-        let from_equator = wrapped.abs() - FRAC_PI_2;
-        if symmetric && from_equator.abs() <= EQUATOR_WINDOW {
+        if from_equator.abs() > EQUATOR_WINDOW {
+            return if from_equator < 0.0 {
+                Side::Upper
+            } else {
+                Side::Lower
+            };
+        }
+        // (On the circle U(−θ) = U(θ): the well near −π/2 mirrors the one near π/2.)
+        let slope = self.body.shape.potential_prime_at(Angle::EQUATOR);
+        if symmetric || slope == 0.0 {
             Side::Equator
-        } else if from_equator < 0.0 {
-            Side::Upper
-        } else {
+        } else if slope < 0.0 {
             Side::Lower
+        } else {
+            Side::Upper
         }
     }
 

@@ -257,7 +257,10 @@ fn families_are_named_after_the_wells_of_the_paper() {
 #[test]
 fn the_census_agrees_with_the_components_over_the_whole_domain() {
     // Seeded pseudo-random cells over the whole domain: α in (−1, 1), β from 1e-2 to 1e2
-    // (log), κ from 0 (a tenth of the cells exactly 0) to 10, ε from the bottom of V up.
+    // (log), κ from 0 (a tenth of the cells exactly 0) to 1e9, ε from the bottom of V up.
+    // At large κ the well sits within |α|/κ² of π/2, where rounding once put it on the
+    // wrong side (α < 0 labelled well_pi at κ ≈ 1e8): the mirror body −α must have the
+    // mirror families at every cell.
     let mut state: u64 = 0x9e37_79b9_7f4a_7c15;
     let mut uniform = || {
         state ^= state << 13;
@@ -272,7 +275,7 @@ fn the_census_agrees_with_the_components_over_the_whole_domain() {
         let kappa = if uniform() < 0.1 {
             0.0
         } else {
-            10f64.powf(4.0 * uniform() - 3.0)
+            10f64.powf(12.0 * uniform() - 3.0)
         };
         let b = body(alpha, beta);
         let potential = EffectivePotential::new(&b, kappa);
@@ -295,6 +298,24 @@ fn the_census_agrees_with_the_components_over_the_whole_domain() {
             assert!(
                 possible[usize::from(f.code())],
                 "{f} at alpha {alpha} beta {beta} kappa {kappa} energy {energy}"
+            );
+        }
+        let mirror = body(-alpha, beta);
+        let mirrored: Vec<Family> = EffectivePotential::new(&mirror, kappa)
+            .families(energy)
+            .unwrap()
+            .iter()
+            .rev()
+            .map(|f| match f {
+                Family::Well0 => Family::WellPi,
+                Family::WellPi => Family::Well0,
+                other => *other,
+            })
+            .collect();
+        if kappa != 0.0 {
+            assert_eq!(
+                solved, mirrored,
+                "mirror of alpha {alpha} beta {beta} kappa {kappa} energy {energy}"
             );
         }
         // Two components of one family only at κ = 0 (mirror images).
@@ -354,7 +375,7 @@ fn an_atlas_has_no_slot_empty_everywhere_and_each_slot_is_one_family() {
              energy = {{ start = 0.5, stop = 4.5, num = 41 }}\n[outputs]\nlayout = \"{layout}\"\n"
         );
         let scene = Scene::parse(&text, "t.toml").unwrap();
-        let axis = atlas::component_axis(&scene);
+        let axis = atlas::component_axis(&scene, &|| false);
         assert_eq!(axis.layout, Layout::from_name(layout).unwrap());
         let vars = variables(&[Field::RotationNumber, Field::Status]);
         let family_index = vars.iter().position(|v| v.name == "family").unwrap();

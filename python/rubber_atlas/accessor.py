@@ -228,15 +228,16 @@ class RubberAccessor:
         if _api._component_layout(ds) == "family":
             out = ds[per_component].sel(component=code, drop=True)
         else:
-            # Components in increasing theta_min: the one of this family in each cell (at κ = 0
-            # two mirror twins may both be; their values are equal: the first is taken).
+            # Components in increasing theta_min: the one of this family in each cell. At κ = 0
+            # two mirror twins (the body leaning either way) may both be: the one at larger θ
+            # is taken, as the family layout keeps it.
             mask = ds["family"] == code
             fields = {}
             for v in per_component:
                 var = ds[v]
                 fill = _api._fill(var.dtype)
                 picked = xr.full_like(var.isel(component=0, drop=True), fill)
-                for slot in reversed(range(ds.sizes["component"])):
+                for slot in range(ds.sizes["component"]):
                     picked = xr.where(mask.isel(component=slot, drop=True),
                                       var.isel(component=slot, drop=True), picked)
                 fields[v] = picked.astype(var.dtype).assign_attrs(var.attrs)

@@ -173,7 +173,8 @@ impl StartArgs {
 /// α and β of the ellipsoid.
 #[derive(Debug, Args)]
 pub struct ShapeArgs {
-    /// α = a/b3: displacement of the centre of mass along the axis, 0 <= α < 1.
+    /// α = a/b3: displacement of the centre of mass along the axis, -1 < α < 1 (α < 0 is the
+    /// mirror image θ -> π - θ).
     #[arg(long, allow_hyphen_values = true)]
     pub alpha: f64,
     /// β = b1/b3: < 1 prolate, > 1 oblate, 1 sphere.

@@ -9,7 +9,8 @@ use rubber_atlas::EllipsoidBody;
 
 #[derive(Debug, Args)]
 pub struct VerdictArgs {
-    /// α = a/b3: displacement of the centre of mass along the axis, 0 <= α < 1.
+    /// α = a/b3: displacement of the centre of mass along the axis, 0 <= α < 1 (α < 0 is the
+    /// mirror image θ -> π - θ of -α).
     #[arg(long, allow_hyphen_values = true)]
     pub alpha: f64,
     /// β = b1/b3 (not with --boundaries).
