@@ -19,7 +19,8 @@ if bash scripts/setup.sh --package-is-current; then
   echo "quickstart: reading and drawing with the package rubber_atlas installed in .venv"
   python=(.venv/bin/python)
 else
-  echo "quickstart: reading and drawing with the package's Python source (python/, without its compiled core)"
+  echo "quickstart: reading and drawing with the package's Python source (python/, without its compiled core;" \
+    "bash scripts/setup.sh installs the whole package)"
   python=(env "PYTHONPATH=$root/python${PYTHONPATH:+:$PYTHONPATH}" .venv/bin/python)
 fi
 mkdir -p atlas/out
