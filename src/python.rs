@@ -126,6 +126,34 @@ fn variables(py: Python<'_>, fields: Option<Vec<String>>) -> PyResult<Bound<'_, 
     Ok(list)
 }
 
+/// The arrays' values, refused in one line (naming them as `names`) unless they have one
+/// length.
+fn equal_length<'a>(
+    arrays: &[&'a PyReadonlyArray1<'_, f64>],
+    names: &str,
+) -> PyResult<Vec<&'a [f64]>> {
+    let slices = arrays
+        .iter()
+        .map(|a| a.as_slice().map_err(|e| bad(e.to_string())))
+        .collect::<PyResult<Vec<&[f64]>>>()?;
+    if slices.iter().any(|s| s.len() != slices[0].len()) {
+        return Err(bad(format!("{names} must have one length")));
+    }
+    Ok(slices)
+}
+
+/// Cell `i` of the arrays α, β, ν, η, κ and, if given, ε (else ε = 0).
+fn point(slices: &[&[f64]], i: usize) -> CellPoint {
+    CellPoint {
+        alpha: slices[0][i],
+        beta: slices[1][i],
+        nu: slices[2][i],
+        eta: slices[3][i],
+        kappa: slices[4][i],
+        energy: slices.get(5).map_or(0.0, |e| e[i]),
+    }
+}
+
 /// Solves cells given by six equal-length arrays, in parallel with the GIL released. Returns
 /// a dict: `columns`, the values of every variable of `fields` as (name, flat array) pairs
 /// in file order (a per-component variable has one value per cell and component slot, slot
@@ -152,17 +180,11 @@ fn cells<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let layout = Layout::from_name(layout)
         .ok_or_else(|| bad(format!("layout {layout:?}: use {}", Layout::NAMES)))?;
-    let arrays = [&alpha, &beta, &nu, &eta, &kappa, &energy];
-    let slices = arrays
-        .iter()
-        .map(|a| a.as_slice().map_err(|e| bad(e.to_string())))
-        .collect::<PyResult<Vec<&[f64]>>>()?;
+    let slices = equal_length(
+        &[&alpha, &beta, &nu, &eta, &kappa, &energy],
+        "alpha, beta, nu, eta, kappa and energy",
+    )?;
     let n = slices[0].len();
-    if slices.iter().any(|s| s.len() != n) {
-        return Err(bad(
-            "alpha, beta, nu, eta, kappa and energy must have one length".into(),
-        ));
-    }
     let fields = parse_fields(fields)?;
     let vars = atlas::variables(&fields);
     // The points, the blocks and their concatenation: about twice the output per cell.
@@ -175,16 +197,7 @@ fn cells<'py>(
         "give fewer cells at a time, or allow_large=True",
     )?;
     let pool = pool(threads)?;
-    let points: Vec<CellPoint> = (0..n)
-        .map(|i| CellPoint {
-            alpha: slices[0][i],
-            beta: slices[1][i],
-            nu: slices[2][i],
-            eta: slices[3][i],
-            kappa: slices[4][i],
-            energy: slices[5][i],
-        })
-        .collect();
+    let points: Vec<CellPoint> = (0..n).map(|i| point(&slices, i)).collect();
     let options = CellOptions {
         tol,
         method: match method {
@@ -269,26 +282,11 @@ fn bottoms<'py>(
     kappa: PyReadonlyArray1<'py, f64>,
     threads: Option<i64>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let slices = [&alpha, &beta, &nu, &eta, &kappa]
-        .iter()
-        .map(|a| a.as_slice().map_err(|e| bad(e.to_string())))
-        .collect::<PyResult<Vec<&[f64]>>>()?;
-    let n = slices[0].len();
-    if slices.iter().any(|s| s.len() != n) {
-        return Err(bad(
-            "alpha, beta, nu, eta and kappa must have one length".into()
-        ));
-    }
-    let points: Vec<CellPoint> = (0..n)
-        .map(|i| CellPoint {
-            alpha: slices[0][i],
-            beta: slices[1][i],
-            nu: slices[2][i],
-            eta: slices[3][i],
-            kappa: slices[4][i],
-            energy: 0.0,
-        })
-        .collect();
+    let slices = equal_length(
+        &[&alpha, &beta, &nu, &eta, &kappa],
+        "alpha, beta, nu, eta and kappa",
+    )?;
+    let points: Vec<CellPoint> = (0..slices[0].len()).map(|i| point(&slices, i)).collect();
     let bodies = atlas::cell_bodies(&points).map_err(value_error)?;
     let pool = pool(threads)?;
     let values = in_pool(py, &pool, || {
