@@ -5,19 +5,25 @@
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$root"
+start=$SECONDS
+# Names the next phase, after the time since the start (the phases' times for a slow run).
+phase() {
+  echo "test: [$(( SECONDS - start )) s] $1"
+}
 bash scripts/setup.sh
-echo "test: cargo fmt --check"
+phase "cargo fmt --check"
 cargo fmt --all -- --check
-echo "test: cargo clippy -D warnings (the program, and the Python extension's features)"
+phase "cargo clippy -D warnings (the program, and the Python extension's features)"
 cargo clippy --release --all-targets --quiet -- -D warnings
 cargo clippy --release --lib --no-default-features --features python --quiet -- -D warnings
-echo "test: cargo test --release"
+phase "cargo test --release"
 cargo test --release
-echo "test: pytest scripts/tests"
+phase "pytest scripts/tests"
 cargo build --release --quiet
-RUBBER_ATLAS_BIN="$root/target/release/rubber-atlas" .venv/bin/python -m pytest -q scripts/tests
-echo "test: pytest python/tests, on the installed package, from a folder outside the repository"
+RUBBER_ATLAS_BIN="$root/target/release/rubber-atlas" .venv/bin/python -m pytest -q --durations=10 scripts/tests
+phase "pytest python/tests, on the installed package, from a folder outside the repository"
 outside="$(mktemp -d)"
 trap 'rm -rf "$outside"' EXIT
 (cd "$outside" && RUBBER_ATLAS_BIN="$root/target/release/rubber-atlas" \
   "$root/.venv/bin/python" -m pytest -q -p no:cacheprovider --rootdir "$outside" "$root/python/tests")
+echo "test: all suites passed in $(( (SECONDS - start) / 60 )) min $(( (SECONDS - start) % 60 )) s"
