@@ -11,6 +11,9 @@
 #     - libhdf5-dev and pkg-config,
 #     - .venv with scripts/requirements-quickstart.txt only (reading and drawing files),
 #     - not the package: the quick start reads and draws with its Python source (python/).
+#   bash scripts/setup.sh --without-package   everything but the package;
+#   bash scripts/setup.sh --package-only      the package alone, into the .venv set up before
+#     (scripts/test.sh builds it beside the Rust tests' build, which leaves a core idle).
 #   bash scripts/setup.sh --package-is-current
 #     installs nothing; exits 0 when .venv holds the package built from this tree as it is.
 #
@@ -21,12 +24,15 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 
 mode=full
+package=yes
 case "${1:-}" in
   "") ;;
+  --without-package) package=no ;;
+  --package-only) package=only ;;
   --quickstart) mode=quickstart ;;
   --package-is-current) mode=package-is-current ;;
-  -h | --help) sed -n '2,19p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
-  *) echo "setup: unknown option $1 (--quickstart, --package-is-current, or none for everything)" >&2; exit 2 ;;
+  -h | --help) sed -n '2,22p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
+  *) echo "setup: unknown option $1 (--quickstart, --without-package, --package-only, --package-is-current, or none for everything)" >&2; exit 2 ;;
 esac
 
 venv="$root/.venv"
@@ -46,8 +52,29 @@ package_is_current() {
     && (cd "$venv" && env -u PYTHONPATH "$venv/bin/python" -c "import rubber_atlas._core" >/dev/null 2>&1)
 }
 
+# The package, built from this tree (no build isolation: maturin comes from requirements.txt)
+# and installed like any other, so that tests import it from site-packages. Built in a target
+# folder of its own (target/python-package), so that it can build while cargo builds in target/.
+build_package() {
+  if ! package_is_current; then
+    local want
+    want="$(package_want)"  # before the build: an edit during it leaves the package stale
+    echo "setup: building and installing the Python package rubber_atlas into .venv (maturin, release)"
+    CARGO_TARGET_DIR="$root/target/python-package" PATH="$venv/bin:$PATH" "$venv/bin/python" -m pip install --quiet --disable-pip-version-check \
+      --no-build-isolation --no-deps --force-reinstall "$root"
+    echo "$want" > "$package_stamp"
+  else
+    echo "setup: the Python package rubber_atlas is installed and current"
+  fi
+}
+
 if [ "$mode" = package-is-current ]; then
   package_is_current
+  exit
+fi
+
+if [ "$package" = only ]; then
+  build_package
   exit
 fi
 
@@ -103,14 +130,6 @@ else
   exit 0
 fi
 
-# The package, built from this tree (no build isolation: maturin comes from requirements.txt)
-# and installed like any other, so that tests import it from site-packages.
-if ! package_is_current; then
-  want="$(package_want)"  # before the build: an edit during it leaves the package stale
-  echo "setup: building and installing the Python package rubber_atlas into .venv (maturin, release)"
-  PATH="$venv/bin:$PATH" "$venv/bin/python" -m pip install --quiet --disable-pip-version-check \
-    --no-build-isolation --no-deps --force-reinstall "$root"
-  echo "$want" > "$package_stamp"
-else
-  echo "setup: the Python package rubber_atlas is installed and current"
+if [ "$package" = yes ]; then
+  build_package
 fi

@@ -10,7 +10,14 @@ start=$SECONDS
 phase() {
   echo "test: [$(( SECONDS - start )) s] $1"
 }
-bash scripts/setup.sh
+bash scripts/setup.sh --without-package
+# The Python package builds beside the Rust checks and tests, whose builds leave a core idle
+# part of the time; its output is shown when it is waited for.
+package_log="$(mktemp)"
+outside="$(mktemp -d)"
+bash scripts/setup.sh --package-only > "$package_log" 2>&1 &
+package_pid=$!
+trap 'kill "$package_pid" 2>/dev/null || true; rm -rf "$outside" "$package_log"' EXIT
 phase "cargo fmt --check"
 cargo fmt --all -- --check
 phase "cargo clippy -D warnings (the program, and the Python extension's features)"
@@ -18,12 +25,18 @@ cargo clippy --release --all-targets --quiet -- -D warnings
 cargo clippy --release --lib --no-default-features --features python --quiet -- -D warnings
 phase "cargo test --release"
 cargo test --release
+phase "waiting for the Python package (bash scripts/setup.sh --package-only)"
+if ! wait "$package_pid"; then
+  cat "$package_log"
+  echo "test: building the Python package failed" >&2
+  exit 1
+fi
+cat "$package_log"
+# The program cargo test built (with the dev-dependencies' features; a plain cargo build
+# would compile it again for nothing).
 phase "pytest scripts/tests"
-cargo build --release --quiet
 RUBBER_ATLAS_BIN="$root/target/release/rubber-atlas" .venv/bin/python -m pytest -q --durations=10 scripts/tests
 phase "pytest python/tests, on the installed package, from a folder outside the repository"
-outside="$(mktemp -d)"
-trap 'rm -rf "$outside"' EXIT
 (cd "$outside" && RUBBER_ATLAS_BIN="$root/target/release/rubber-atlas" \
   "$root/.venv/bin/python" -m pytest -q -p no:cacheprovider --rootdir "$outside" "$root/python/tests")
 echo "test: all suites passed in $(( (SECONDS - start) / 60 )) min $(( (SECONDS - start) % 60 )) s"

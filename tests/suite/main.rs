@@ -1,0 +1,13 @@
+//! The integration tests of rubber-atlas, one binary (one link instead of ten): each module
+//! tests one part of the pipeline through the public library or the built program.
+
+mod cell;
+mod cli;
+mod critical;
+mod family;
+mod limits;
+mod model;
+mod plane;
+mod resonance;
+mod run;
+mod verdict;
