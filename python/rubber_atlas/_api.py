@@ -3,11 +3,15 @@ names, units and flags of the files `rubber-atlas` writes."""
 
 from __future__ import annotations
 
+import contextlib
 import json
+import math
+import numbers
 import re
 import sys
 import time
 import functools
+from decimal import Decimal
 from fractions import Fraction
 from pathlib import Path
 from typing import Iterable
@@ -43,6 +47,8 @@ FIELDS: tuple[str, ...] = tuple(_core.FIELDS) if HAS_CORE else ()
 _BODY = ("alpha", "beta", "nu", "eta")
 # The planes of a scene: the two inputs that give (κ, ε), and what each derived value needs.
 _PLANES = (("kappa", "energy"), ("kappa", "excess_energy"), ("lambda", "s"))
+# The keywords of inputs whose coordinate has another name.
+_KEYWORDS = {"lambda": "lambda_"}
 _DERIVED = {
     "excess_energy": {"energy": ("alpha", "beta", "kappa", "excess_energy")},
     "s": {"kappa": ("lambda", "s"), "energy": ("s",)},
@@ -110,15 +116,105 @@ def _coordinate_attrs(name: str) -> dict:
     return attrs
 
 
-def _check_input(name: str, value) -> None:
-    """Refuses inputs that would be read as something the user did not give."""
+class NotInDataset(KeyError, ValueError):
+    """A cell, index or variable a dataset does not have: a KeyError, as xarray's lookups
+    raise, and a ValueError, as every bad input of the package."""
+
+    def __str__(self) -> str:
+        return str(self.args[0])
+
+
+def _shown(x) -> str:
+    """A number as a message shows it: short (no 300-digit integers), NaN as NaN."""
+    if isinstance(x, (int, np.integer)) and not isinstance(x, (bool, np.bool_)) and abs(int(x)) >= 10**16:
+        return f"{Decimal(int(x)):.3g}"
+    if isinstance(x, (float, np.floating)):
+        return "NaN" if np.isnan(x) else repr(float(x))
+    return repr(x)
+
+
+def _at(index: tuple) -> str:
+    return f"[{', '.join(str(int(i)) for i in index)}]" if index else ""
+
+
+def _numbers(name: str, value) -> np.ndarray:
+    """`value` (a number, array_like or DataArray) as float64, refused in one line naming
+    `name` when it is not real numbers: None, text, booleans, dates or durations, complex or
+    masked values, nested lists of different lengths, integers beyond float64. A broadcast
+    view (``np.broadcast_to``) stays one: nothing is materialised."""
     if value is None:
         raise TypeError(f"{name} is None: give a number or an array of numbers")
     if isinstance(value, np.ma.MaskedArray) and np.ma.is_masked(value):
         raise ValueError(f"{name} has masked values: give only the cells to compute")
-    dtype = value.dtype if isinstance(value, (np.ndarray, xr.DataArray)) else np.asarray(value).dtype
-    if np.issubdtype(dtype, np.complexfloating):
-        raise TypeError(f"{name} is complex: give real numbers")
+    try:
+        array = np.asarray(value.values if isinstance(value, xr.DataArray) else value)
+    except ValueError:
+        raise ValueError(f"{name} is nested lists of different lengths: give a number, or an array with "
+                         "rows of one length") from None
+    kind = array.dtype.kind
+    if kind == "O":
+        for index, x in np.ndenumerate(array):
+            if isinstance(x, (bool, np.bool_)) or not isinstance(x, numbers.Real):
+                raise TypeError(f"{name}{_at(index)} is {x!r}: give real numbers")
+            try:
+                float(x)
+            except OverflowError:
+                raise ValueError(f"invalid {name}{_at(index)} = {_shown(x)}: beyond the largest float64 "
+                                 f"({np.finfo(np.float64).max:.3g})") from None
+        return np.array([float(x) for x in array.flat], dtype=np.float64).reshape(array.shape)
+    if kind not in "iuf":
+        what = {"b": "boolean", "c": "complex", "U": "text", "S": "text", "M": "date", "m": "duration"}
+        first = array.flat[0] if array.size else None
+        example = "none" if first is None else repr(first.item()) if kind in "US" else str(first)
+        more = ", …" if array.size > 1 else ""
+        raise TypeError(f"{name} has {what.get(kind, str(array.dtype))} values ({example}{more}): give real numbers")
+    if array.dtype == np.float64:
+        return array
+    # Converted where the values are stored: a broadcast view stays a view.
+    stored = array[tuple(slice(None) if stride else slice(0, 1) for stride in array.strides)]
+    if stored.shape == array.shape:
+        return array.astype(np.float64)
+    return np.broadcast_to(stored.astype(np.float64), array.shape)
+
+
+def _real(name: str, value) -> float:
+    """One number (an option or a parameter of one body), refused naming `name` otherwise."""
+    array = _numbers(name, value)
+    if array.ndim:
+        raise TypeError(f"{name} must be one number, not an array of shape {array.shape}")
+    return float(array)
+
+
+def _optional_real(name: str, value) -> float | None:
+    return None if value is None else _real(name, value)
+
+
+def _reals(**parameters) -> dict[str, float]:
+    """Parameters that are one number each (a body's α, β, ν, η, a window), by name."""
+    return {name: _real(name, value) for name, value in parameters.items()}
+
+
+def _count(name: str, value) -> int:
+    """A whole number (threads, samples, …) as the core takes it, a 64-bit integer; refused
+    naming `name` otherwise (its range is the core's to check)."""
+    whole = isinstance(value, numbers.Integral) or (
+        isinstance(value, (float, np.floating)) and float(value).is_integer())
+    if isinstance(value, (bool, np.bool_)) or not whole:
+        raise TypeError(f"{name} must be a whole number, not {value!r}")
+    if abs(int(value)) >= 2**63:
+        raise ValueError(f"invalid {name} = {_shown(int(value))}: beyond a 64-bit integer")
+    return int(value)
+
+
+def _optional_count(name: str, value) -> int | None:
+    return None if value is None else _count(name, value)
+
+
+def _switch(name: str, value) -> bool:
+    """True or False, and nothing else taken for them ("no" would be True)."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{name} must be True or False, not {value!r}")
+    return bool(value)
 
 
 def _plane(kappa, energy, excess_energy, lambda_, s) -> dict:
@@ -129,8 +225,7 @@ def _plane(kappa, energy, excess_energy, lambda_, s) -> dict:
     for pair in _PLANES:
         if set(given) == set(pair):
             return {n: given[n] for n in pair}
-    shown = {"lambda": "lambda_"}
-    names = ", ".join(shown.get(n, n) for n in given) or "none of them"
+    names = ", ".join(_KEYWORDS.get(n, n) for n in given) or "none of them"
     if len(given) == 1:
         (only,) = given
         missing = {"energy": "kappa", "excess_energy": "kappa", "s": "lambda_", "lambda": "s",
@@ -157,7 +252,7 @@ def _numpy_dims(shape: tuple, values: dict[str, np.ndarray]) -> tuple[tuple[str,
         # An axis the input spans: it varies along it, or the axis has one value and the
         # input was given along it.
         along[name] = [i for i in range(ndim)
-                       if padded.shape[i] > 1 or (shape[i] == 1 and i >= ndim - v.ndim)]
+                       if padded.shape[i] != 1 or (shape[i] == 1 and i >= ndim - v.ndim)]
     if ndim == 1:
         dims = ("cell",)
     else:
@@ -178,43 +273,63 @@ def _numpy_dims(shape: tuple, values: dict[str, np.ndarray]) -> tuple[tuple[str,
     return dims, coords
 
 
-def _broadcast(given: dict[str, object], plane: tuple[str, str] | None = None
-               ) -> tuple[tuple[str, ...], list[np.ndarray], dict]:
+def _broadcast(given: dict[str, object], plane: tuple[str, str] | None = None, outputs: Iterable[str] = (),
+               check=None) -> tuple[tuple[str, ...], list[np.ndarray], dict, dict]:
     """Broadcasts the inputs together: DataArrays by their dimension names (xarray's rules),
     anything else by numpy's (see `_numpy_dims` for the names of the dimensions); the two
     inputs of `plane`, 1-D of different lengths with every other input a number, as a grid.
-    Returns the dimensions, the arrays in that layout, and the coordinates of the result:
-    each input over the dimensions it varies along (scalar where it is one number)."""
-    for name, v in given.items():
-        _check_input(name, v)
+    A dimension named after one of `outputs` (the result's variables) is refused, and
+    `check` is called with the number of cells before anything of that size is made.
+    Returns the dimensions, the arrays in that layout (views), the coordinates of the result
+    (each input over the dimensions it varies along, scalar where it is one number), and
+    where each input lies: {name: (its shape, the result's axis of each of its axes)}."""
+    values = {name: _numbers(name, v) for name, v in given.items()}
     if any(isinstance(v, xr.DataArray) for v in given.values()):
         arrays = {}
         for name, v in given.items():
             if isinstance(v, xr.DataArray):
-                arrays[name] = v.astype(np.float64)
-            elif np.ndim(v) == 0:
-                arrays[name] = xr.DataArray(np.float64(v))
+                arrays[name] = v.copy(data=values[name])
+            elif values[name].ndim == 0:
+                arrays[name] = xr.DataArray(values[name])
             else:
                 raise TypeError(
                     f"{name}: give every array input as an xarray.DataArray (with named "
                     "dimensions) when any is one, or none as one"
                 )
-        try:
-            aligned = xr.align(*arrays.values(), join="exact")
-        except ValueError as e:
-            raise ValueError(f"the DataArray inputs' coordinates do not line up: {e}") from None
-        broadcast = xr.broadcast(*aligned)
-        dims = broadcast[0].dims
+        lengths: dict[str, dict[str, int]] = {}
+        for name, a in arrays.items():
+            for d, size in a.sizes.items():
+                lengths.setdefault(d, {})[name] = size
+        for d, by in lengths.items():
+            if len(set(by.values())) > 1:
+                raise ValueError(f"the DataArray inputs' dimension {d!r} has different lengths: "
+                                 f"{', '.join(f'{size} in {name}' for name, size in by.items())}; give it one length")
+        # The order xarray's broadcast gives the first input.
+        first = next(iter(arrays.values()))
+        dims = first.dims + tuple(d for d in lengths if d not in first.dims)
         for name in given:
             # A dimension named after an input is that input's axis, or a mistake.
             if name in dims and arrays[name].dims != (name,):
                 raise ValueError(f"the dimension {name!r} is named after the input {name}, which is not given "
                                  f"along it: rename the dimension, or give {name} as a DataArray along {name!r}")
+        _refuse_outputs(dims, outputs)
+        for name, a in arrays.items():
+            for c in a.coords:
+                if c in outputs and c not in a.dims:
+                    raise ValueError(f"the coordinate {c!r} of {name} is named after a variable of the result: "
+                                     "rename or drop it")
+        if check is not None:
+            check(math.prod(next(iter(by.values())) for by in lengths.values()))
+        try:
+            aligned = xr.align(*arrays.values(), join="exact")
+        except ValueError as e:
+            raise ValueError(f"the DataArray inputs' coordinates do not line up: {_one_line(e)}") from None
+        broadcast = xr.broadcast(*aligned)
         layout = [b.transpose(*dims).values for b in broadcast]
         coords = {}
         for name, source in arrays.items():
-            if name in dims and name in source.coords and not np.array_equal(
-                    np.asarray(source.coords[name].values, dtype=np.float64), source.values):
+            labels = source.coords[name].values if name in dims and name in source.coords else None
+            if labels is not None and (labels.dtype.kind not in "iuf" or not np.array_equal(labels, source.values)):
                 # The values computed at would differ from the labels shown.
                 raise ValueError(f"{name}: the DataArray's {name!r} coordinate differs from its values; "
                                  "give the values as the coordinate, or none")
@@ -222,26 +337,66 @@ def _broadcast(given: dict[str, object], plane: tuple[str, str] | None = None
         for b in broadcast:
             for cname, c in b.coords.items():
                 coords.setdefault(cname, c)
-        return dims, layout, coords
-    values = {k: np.asarray(v, dtype=np.float64) for k, v in given.items()}
+        places = {name: (a.shape, tuple(dims.index(d) for d in a.dims)) for name, a in arrays.items()}
+        return dims, layout, coords, places
+    shapes = {name: v.shape for name, v in values.items()}
     try:
-        layout = np.broadcast_arrays(*values.values())
+        shape = np.broadcast_shapes(*shapes.values())
+        places = {name: (s, tuple(range(len(shape) - len(s), len(shape)))) for name, s in shapes.items()}
     except ValueError:
-        vectors = {k: v for k, v in values.items() if v.ndim > 0}
-        if (plane is not None and set(vectors) == set(plane) and all(v.ndim == 1 for v in vectors.values())):
-            # Two axes of different lengths: their grid, dimensions named after them.
-            values[plane[0]] = values[plane[0]][:, None]
-            values[plane[1]] = values[plane[1]][None, :]
-            layout = np.broadcast_arrays(*values.values())
-        else:
-            shapes = ", ".join(f"{k} {v.shape}" for k, v in vectors.items())
+        vectors = {k: s for k, s in shapes.items() if s}
+        if not (plane is not None and set(vectors) == set(plane) and all(len(s) == 1 for s in vectors.values())):
+            shown = ", ".join(f"{k} {s}" for k, s in vectors.items())
             raise ValueError(
-                f"the inputs do not broadcast together ({shapes}): numpy pairs their last dimensions, "
+                f"the inputs do not broadcast together ({shown}): numpy pairs their last dimensions, "
                 "which must be equal or 1; give them as xarray.DataArrays with named dimensions (one "
                 "dimension per axis of the grid), or only the two axes of the plane as vectors"
             ) from None
-    dims, coords = _numpy_dims(layout[0].shape, values)
-    return dims, list(layout), coords
+        # Two axes of different lengths: their grid, dimensions named after them.
+        shape = (shapes[plane[0]][0], shapes[plane[1]][0])
+        places = {name: (s, (plane.index(name),) if s else ()) for name, s in shapes.items()}
+        values[plane[0]] = values[plane[0]][:, None]
+        values[plane[1]] = values[plane[1]][None, :]
+    if check is not None:
+        check(math.prod(shape))
+    layout = np.broadcast_arrays(*values.values())
+    dims, coords = _numpy_dims(shape, values)
+    _refuse_outputs(dims, outputs)
+    return dims, list(layout), coords, places
+
+
+def _refuse_outputs(dims: tuple, outputs: Iterable[str]) -> None:
+    """Refuses a dimension named after a variable of the result (it would become a coordinate)."""
+    for d in dims:
+        if d in outputs:
+            raise ValueError(f"the dimension {d!r} is named after a variable of the result: rename the dimension")
+
+
+def _located(error: ValueError, shape: tuple, places: dict, sources: dict) -> ValueError:
+    """The core's "cell i: invalid name = value: why" with the cell named where it was given:
+    by its index in the input `name` in that input's own shape (``kappa[1, 2]``; no index for
+    a number), or for a value computed from the inputs (κ from λ and s) by the inputs it
+    comes from (`sources`: {name: the inputs' names})."""
+    found = re.fullmatch(r"cell (\d+): invalid (\w+) = ([^:]*): (.*)", str(error), re.S)
+    if not found:
+        return error
+    cell = np.unravel_index(int(found[1]), shape)
+    name, value, why = found[2], found[3], found[4]
+
+    def where(source: str) -> str:
+        own, axes = places[source]
+        return _KEYWORDS.get(source, source) + _at(tuple(cell[a] if n != 1 else 0 for n, a in zip(own, axes)))
+
+    if name in places:
+        return ValueError(f"invalid {where(name)} = {value}: {why}")
+    if name in sources:
+        return ValueError(f"invalid {name} = {value} (computed from {', '.join(map(where, sources[name]))}): {why}")
+    return ValueError(f"cell {_at(cell)}: invalid {name} = {value}: {why}")
+
+
+def _one_line(error: BaseException) -> str:
+    """An error's message on one line (HDF5's span several)."""
+    return " ".join(str(error).split())
 
 
 def _derived(full: np.ndarray, dims: tuple, coords: dict, sources: Iterable[str]) -> tuple:
@@ -400,8 +555,7 @@ def _solve_batch(flat: list[np.ndarray], start: int, options: tuple, layout: str
     return out
 
 
-def _solve(flat: list[np.ndarray], options: tuple, layout: str, meta: dict, progress: bool,
-           allow_large: bool, fields: list[str] | None) -> dict:
+def _solve(flat: list[np.ndarray], options: tuple, layout: str, meta: dict, progress: bool) -> dict:
     """Solves the flat cells, in batches when `progress` shows how far it got; returns what
     one call of the core over all of them would (see `_solve_batch`): per-component arrays
     with the component fastest, over the union of the batches' components less those empty
@@ -410,8 +564,6 @@ def _solve(flat: list[np.ndarray], options: tuple, layout: str, meta: dict, prog
     if not progress:
         return _solve_batch(flat, 0, options, layout)
     size = max(_BATCH_CELLS, -(-n // _PROGRESS_STEPS))
-    if n > size:
-        _check_memory(n, fields, allow_large)
     parts = []
     bar = _progress_bar(n)
     try:
@@ -557,7 +709,8 @@ def cells(
         Number of threads, ≥ 1 (capped at the number of cores); by default rayon's pool,
         which honours ``RAYON_NUM_THREADS``.
     allow_large : bool, default False
-        Compute even when the result would take over 80 % of the available memory.
+        Compute even when the result would take over 80 % of the available memory (True or
+        False, nothing else).
     layout : {"family", "theta_min"}, default "family"
         How the ``component`` dimension is laid out, as in the atlas files: one entry per
         torus family present (the coordinate holds their codes, uint8 flags with the
@@ -600,12 +753,17 @@ def cells(
     Raises
     ------
     ValueError
-        A value out of range (naming the cell by its index in the flattened input and the
-        value), inputs that do not broadcast, unknown fields or method, a bad tol or
-        threads, or a result over 80 % of the available memory without `allow_large`.
+        A value out of range, named where it was given (``invalid kappa[1, 2] = NaN: …``,
+        the index in that input's own shape; none for a number), inputs that do not
+        broadcast (named with their shapes), a dimension named after a variable of the
+        result, unknown fields or method, a bad tol or threads, an integer beyond float64,
+        or a result over 80 % of the available memory without `allow_large` (checked from
+        the shapes, before any input is copied).
     TypeError
-        An input that is None, complex, or an array mixed with DataArrays; a plane given
-        by other than kappa with energy, kappa with excess_energy, or lambda_ with s.
+        An input that is not real numbers (None, text, booleans, dates, complex), or an
+        array mixed with DataArrays; a plane given by other than kappa with energy, kappa
+        with excess_energy, or lambda_ with s; `allow_large` or `progress` not True or
+        False; `threads` not a whole number.
     KeyboardInterrupt
         Ctrl-C stops a call within milliseconds.
 
@@ -646,10 +804,16 @@ def cells(
     names = tuple(plane)
     if layout not in _LAYOUTS:
         raise ValueError(f"layout {layout!r}: use \"family\" or \"theta_min\"")
-    if isinstance(fields, str):
-        fields = [fields]
-    field_list = None if fields is None else [str(f) for f in fields]
-    dims, arrays, coords = _broadcast(given, names)
+    try:
+        field_list = None if fields is None else [str(f) for f in ([fields] if isinstance(fields, str) else fields)]
+    except TypeError:
+        raise TypeError(f"fields must be names of fields (a str or a list of them), not {fields!r}") from None
+    options = (_real("tol", tol), str(method), _real("resonance_tol", resonance_tol), field_list,
+               _optional_count("threads", threads), _switch("allow_large", allow_large))
+    progress = None if progress is None else _switch("progress", progress)
+    outputs = [m["name"] for m in _core.variables(None)] + ["component"]
+    dims, arrays, coords, places = _broadcast(given, names, outputs,
+                                              check=lambda n: _check_memory(n, field_list, options[-1]))
     shape = arrays[0].shape
     derived = _DERIVED.get(names[1], {})
     for name in derived:
@@ -657,15 +821,17 @@ def cells(
             raise ValueError(f"the dimension {name!r} is named after {name}, which is computed here from "
                              f"{' and '.join(names)}: rename the dimension")
     flat = [np.ascontiguousarray(a, dtype=np.float64).reshape(-1) for a in arrays]
-    flat = _to_kappa_energy(names, flat)
+    n = flat[0].size
+    show = (n > _PROGRESS_CELLS and (_stderr_is_terminal() or _in_jupyter())) if progress is None else progress
+    meta = {m["name"]: m for m in _core.variables(field_list)}
+    try:
+        flat = _to_kappa_energy(names, flat)
+        solved = _solve(flat, options, layout, meta, show)
+    except ValueError as e:
+        raise _located(e, shape, places, derived) from None
     for name, sources in derived.items():
         full = flat[4 if name == "kappa" else 5].reshape(shape)
         coords[name] = _derived(full, dims, coords, sources)
-    n = flat[0].size
-    show = (n > _PROGRESS_CELLS and (_stderr_is_terminal() or _in_jupyter())) if progress is None else bool(progress)
-    meta = {m["name"]: m for m in _core.variables(field_list)}
-    options = (float(tol), str(method), float(resonance_tol), field_list, threads, bool(allow_large))
-    solved = _solve(flat, options, layout, meta, show, bool(allow_large), field_list)
     slots = len(solved["component"])
     used = solved["layout"]
     data_vars = {}
@@ -683,16 +849,15 @@ def cells(
             cdims, cvalues = c
             coords[name] = xr.Variable(cdims, cvalues, _coordinate_attrs(name), {"_FillValue": None})
     coords["component"] = _component_coordinate(solved, meta)
-    shown = {"lambda": "lambda_"}
-    arguments = dict({shown.get(k, k): v for k, v in given.items()}, tol=tol, method=method, fields=field_list,
+    arguments = dict({_KEYWORDS.get(k, k): v for k, v in given.items()}, tol=tol, method=method, fields=field_list,
                      resonance_tol=resonance_tol, layout=layout)
     attrs = _root_attrs(
         "cells",
         arguments,
         title="rubber-atlas cells",
-        tolerance=float(tol),
+        tolerance=options[0],
         method=str(method),
-        resonance_tol=float(resonance_tol),
+        resonance_tol=options[2],
         component_layout=used,
     )
     ds = xr.Dataset(data_vars, coords, attrs)
@@ -730,7 +895,17 @@ def open_atlas(path: str | Path, **kwargs) -> xr.Dataset:
     ------
     ValueError
         The file is not a complete rubber-atlas atlas (a table, a `cells` result written by
-        xarray, an unfinished run, not HDF5 at all, missing).
+        xarray, an unfinished run, not HDF5 at all, a folder, missing).
+    TypeError
+        `path` is not a file's name.
+
+    Notes
+    -----
+    The values are read when they are used: a file damaged after it was written (a
+    corrupted chunk) opens, and reading the damaged values raises HDF5's OSError ("Can't
+    synchronously read data"), from xarray (``.load()``, ``.values``); from the ``.rubber``
+    accessor, a ValueError that names the file as damaged. Checking every value on opening
+    would read the whole file.
 
     See Also
     --------
@@ -757,19 +932,56 @@ def open_atlas(path: str | Path, **kwargs) -> xr.Dataset:
     ...         print(str(e).split(": ", 1)[1][:26])
     not a rubber-atlas atlas (
     """
-    path = Path(path)
+    path = _file(path)
     if path.name.endswith(".partial.h5"):
         raise ValueError(f"{path}: an unfinished run's file; resume the run with --resume")
     kwargs.setdefault("engine", "h5netcdf")
     try:
         ds = xr.open_dataset(path, **kwargs)
     except (OSError, ValueError) as e:
-        raise ValueError(f"{path}: not a rubber-atlas atlas: {e}") from None
-    if ds.attrs.get("program") != "rubber-atlas" or "scene" not in ds.attrs or "cell_status" not in ds:
+        raise ValueError(f"{path}: not a rubber-atlas atlas: {_one_line(e)}") from None
+    if not _is_atlas(ds):
         ds.close()
         raise ValueError(f"{path}: not a rubber-atlas atlas (a file of `rubber-atlas run` or `merge` has the "
                          "attributes program and scene and the variable cell_status)")
     return ds
+
+
+def _file(path) -> Path:
+    """`path` as a Path to a file that exists, refused in one line otherwise."""
+    try:
+        path = Path(path)
+    except TypeError:
+        raise TypeError(f"path must be a file's name (str or pathlib.Path), not {path!r}") from None
+    if path.is_dir():
+        raise ValueError(f"{path}: a folder, not a file")
+    if not path.exists():
+        raise ValueError(f"{path}: no such file")
+    return path
+
+
+def _is_atlas(ds: xr.Dataset) -> bool:
+    """Whether `ds` is a file of ``rubber-atlas run`` or ``merge``."""
+    return ds.attrs.get("program") == "rubber-atlas" and "scene" in ds.attrs and "cell_status" in ds
+
+
+@contextlib.contextmanager
+def _reading(ds: xr.Dataset):
+    """Says which file is damaged when HDF5 cannot read the values of a lazily opened one (a
+    corrupted chunk): a ValueError naming it, not HDF5's OSError."""
+    try:
+        yield
+    except OSError as e:
+        source = ds.encoding.get("source", "the dataset's file")
+        raise ValueError(f"{source}: the file is damaged: its values cannot be read ({_one_line(e)}); "
+                         "compute it again") from None
+
+
+def _cells_dataset(ds, what: str) -> None:
+    """Refuses what is not an atlas or a `cells` result (they have ``cell_status``)."""
+    if not isinstance(ds, xr.Dataset) or "cell_status" not in ds:
+        raise ValueError(f"{what} reads an atlas (open_atlas) or a cells result; this is not one (it has no "
+                         "cell_status)")
 
 
 def flag_names(variable: xr.DataArray) -> dict[int, str]:
@@ -790,6 +1002,8 @@ def flag_names(variable: xr.DataArray) -> dict[int, str]:
     ------
     ValueError
         The variable has no ``flag_values``.
+    TypeError
+        `variable` is not a DataArray.
 
     Examples
     --------
@@ -798,6 +1012,9 @@ def flag_names(variable: xr.DataArray) -> dict[int, str]:
     >>> ra.flag_names(ds.cell_status)
     {0: 'ok', 1: 'no_motion', 2: 'failed', 3: 'not_computed'}
     """
+    if not isinstance(variable, xr.DataArray):
+        raise TypeError(f"flag_names takes a flag variable of a dataset (an xarray.DataArray), not "
+                        f"{type(variable).__name__}")
     if "flag_values" not in variable.attrs:
         raise ValueError(f"{variable.name} is not a flag variable (it has no flag_values)")
     values = np.atleast_1d(variable.attrs["flag_values"])
@@ -856,7 +1073,13 @@ def components(ds: xr.Dataset, alpha: float | None = None, beta: float | None = 
     ------
     KeyError
         The cell is not given by exactly the dataset's dimensions, or a value is not a grid
-        value (or an index out of range).
+        value (NaN and ±inf never are) or an index out of range; the exception is a
+        ValueError too.
+    TypeError
+        A value that is not one number.
+    ValueError
+        `ds` is not an atlas or a `cells` result (it has no ``cell_status``), or the file
+        behind it is damaged.
 
     Examples
     --------
@@ -867,6 +1090,7 @@ def components(ds: xr.Dataset, alpha: float | None = None, beta: float | None = 
     0.0354 0.7233 0.5321 libration
     2.0334 3.1166 -0.5442 libration
     """
+    _cells_dataset(ds, "components")
     cell = {("lambda" if k == "lambda_" else k): v for k, v in cell.items()}
     if alpha is not None:
         cell["alpha"] = alpha
@@ -874,21 +1098,37 @@ def components(ds: xr.Dataset, alpha: float | None = None, beta: float | None = 
         cell["beta"] = beta
     dims = [d for d in ds.cell_status.dims]
     if sorted(cell) != sorted(dims):
-        raise KeyError(f"give the cell by {', '.join(dims)} (this dataset's dimensions), not {', '.join(cell) or 'nothing'}")
+        raise NotInDataset(f"give the cell by {', '.join(dims)} (this dataset's dimensions), not "
+                            f"{', '.join(cell) or 'nothing'}")
     index = {}
     for name, value in cell.items():
+        shown = _KEYWORDS.get(name, name)
         if name not in ds.coords:
+            if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+                raise TypeError(f"{shown} is {value!r}: give an index along {name} (a whole number)")
             size = ds.sizes[name]
-            if not float(value).is_integer() or not 0 <= int(value) < size:
-                raise KeyError(f"{name} = {value} is not an index of the dimension {name} (0 … {size - 1})")
+            whole = isinstance(value, numbers.Integral) or float(value).is_integer()
+            if not whole or not 0 <= int(value) < size:
+                raise NotInDataset(f"{shown} = {_shown(value)} is not an index of the dimension {name} "
+                                    f"(0 … {size - 1})")
             index[name] = int(value)
             continue
-        axis = ds[name].values
-        i = int(np.argmin(np.abs(axis - value)))
-        if abs(axis[i] - value) > 1e-12 * max(1.0, abs(value)):
-            raise KeyError(f"{name} = {value} is not a grid value (nearest {axis[i]})")
+        value = _real(shown, value)
+        if not np.isfinite(value):
+            raise NotInDataset(f"{shown} = {_shown(value)} is not a grid value: give a finite number")
+        with _reading(ds):
+            axis = np.asarray(ds[name].values, dtype=np.float64)
+        with np.errstate(invalid="ignore", over="ignore"):
+            distance = np.abs(axis - value)
+        # (NaN in the axis is near nothing.)
+        distance[np.isnan(distance)] = np.inf
+        i = int(np.argmin(distance)) if distance.size else -1
+        if i < 0 or not distance[i] <= 1e-12 * max(1.0, abs(value)):
+            nearest = f" (nearest {_shown(float(axis[i]))})" if i >= 0 else ""
+            raise NotInDataset(f"{shown} = {_shown(value)} is not a grid value{nearest}")
         index[name] = i
-    one = ds.isel(index)
+    with _reading(ds):
+        one = ds.isel(index).load()
     flags = {name: flag_names(ds[name]) for name in ("status", "motion", "family")
              if name in ds and "flag_values" in ds[name].attrs}
     out = []
@@ -943,8 +1183,11 @@ def read_table(path: str | Path) -> xr.Dataset:
 
     Raises
     ------
-    OSError, ValueError
-        The file is missing or not a table.
+    ValueError
+        The file is missing, a folder, not a table (an atlas: `open_atlas` opens those), or
+        damaged; the message names it.
+    TypeError
+        `path` is not a file's name.
 
     Examples
     --------
@@ -958,27 +1201,42 @@ def read_table(path: str | Path) -> xr.Dataset:
     >>> back.sizes["t"], bool((back.theta == t.theta).all())
     (21, True)
     """
-    path = Path(path)
-    if path.suffix.lower() == ".csv":
-        import pandas as pd
+    path = _file(path)
+    tables = "read_table reads the tables of trajectory, diagram --out and resonance --out"
+    try:
+        if path.suffix.lower() == ".csv":
+            return _read_csv(path)
+        ds = xr.open_dataset(path, engine="h5netcdf")
+    except (OSError, ValueError) as e:
+        raise ValueError(f"{path}: not a table ({_one_line(e)}); {tables}") from None
+    with ds:
+        if _is_atlas(ds):
+            raise ValueError(f"{path}: an atlas (a file of rubber-atlas run or merge), not a table; {tables}, "
+                             "and open_atlas opens an atlas")
+        with _reading(ds):
+            return ds.load()
 
-        attrs: dict = {}
-        with path.open() as f:
-            for line in f:
-                if not line.startswith("# "):
-                    break
-                key, _, value = line[2:].rstrip("\n").partition(": ")
-                try:
-                    attrs[key] = float(value)
-                except ValueError:
-                    attrs[key] = value
-        frame = pd.read_csv(path, comment="#")
-        dim = frame.columns[0]
-        ds = xr.Dataset.from_dataframe(frame.set_index(dim))
-        ds.attrs.update(attrs)
-        return ds
-    with xr.open_dataset(path, engine="h5netcdf") as ds:
-        return ds.load()
+
+def _read_csv(path: Path) -> xr.Dataset:
+    """A CSV table: its leading ``# key: value`` lines as attributes (numbers parsed), the
+    columns along the first one."""
+    import pandas as pd
+
+    attrs: dict = {}
+    with path.open() as f:
+        for line in f:
+            if not line.startswith("# "):
+                break
+            key, _, value = line[2:].rstrip("\n").partition(": ")
+            try:
+                attrs[key] = float(value)
+            except ValueError:
+                attrs[key] = value
+    frame = pd.read_csv(path, comment="#")
+    dim = frame.columns[0]
+    ds = xr.Dataset.from_dataframe(frame.set_index(dim))
+    ds.attrs.update(attrs)
+    return ds
 
 
 def diagram(alpha: float, beta: float, nu: float = 0.5, eta: float = 0.5, *, samples: int = 2000,
@@ -1015,6 +1273,9 @@ def diagram(alpha: float, beta: float, nu: float = 0.5, eta: float = 0.5, *, sam
     ------
     ValueError
         A parameter out of range, or too many samples without `allow_large`.
+    TypeError
+        A parameter that is not one number, `samples` not a whole number, `allow_large`
+        not True or False.
 
     Examples
     --------
@@ -1025,12 +1286,11 @@ def diagram(alpha: float, beta: float, nu: float = 0.5, eta: float = 0.5, *, sam
     >>> summary["diagram_type"], round(summary["energy_min"], 5)
     ('c', 3.04651)
     """
-    table, summary = _core.diagram(float(alpha), float(beta), float(nu), float(eta), int(samples), float(kappa_max),
-                                   bool(allow_large))
+    body = _reals(alpha=alpha, beta=beta, nu=nu, eta=eta)
+    table, summary = _core.diagram(*body.values(), _count("samples", samples), _real("kappa_max", kappa_max),
+                                   _switch("allow_large", allow_large))
     arguments = dict(alpha=alpha, beta=beta, nu=nu, eta=eta, samples=samples, kappa_max=kappa_max)
-    attrs = _root_attrs("diagram", arguments,
-                        alpha=float(alpha), beta=float(beta), nu=float(nu), eta=float(eta),
-                        critical_set_json=summary)
+    attrs = _root_attrs("diagram", arguments, **body, critical_set_json=summary)
     return _table(table, attrs)
 
 
@@ -1082,6 +1342,9 @@ def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, e
     ValueError
         A parameter out of range, no motion at `energy`, a component that does not exist,
         not exactly one of `energy`/`theta0` or of `periods`/`t_end`.
+    TypeError
+        A parameter that is not one number, `component` or `samples` not a whole number,
+        `allow_large` not True or False.
 
     Examples
     --------
@@ -1094,23 +1357,31 @@ def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, e
     >>> round(float(t.theta[0]), 4) == round(float(t.attrs["theta0"]), 4)
     True
     """
+    body = _reals(alpha=alpha, beta=beta, nu=nu, eta=eta)
+    tol = _real("tol", tol)
     table, (k, e, t0, td0) = _core.trajectory(
-        float(alpha), float(beta), float(nu), float(eta), float(kappa),
-        None if energy is None else float(energy), int(component),
-        None if theta0 is None else float(theta0), float(theta_dot0),
-        None if periods is None else float(periods), None if t_end is None else float(t_end),
-        int(samples), str(model), float(tol), bool(allow_large))
+        *body.values(), _real("kappa", kappa), _optional_real("energy", energy), _count("component", component),
+        _optional_real("theta0", theta0), _real("theta_dot0", theta_dot0), _optional_real("periods", periods),
+        _optional_real("t_end", t_end), _count("samples", samples), str(model), tol,
+        _switch("allow_large", allow_large))
     arguments = dict(alpha=alpha, beta=beta, nu=nu, eta=eta, kappa=kappa, energy=energy, component=component,
                      theta0=theta0, theta_dot0=theta_dot0, periods=periods, t_end=t_end, samples=samples,
                      model=model, tol=tol)
-    attrs = _root_attrs("trajectory", arguments, model=str(model),
-                        alpha=float(alpha), beta=float(beta), nu=float(nu), eta=float(eta),
-                        kappa=k, energy=e, theta0=t0, theta_dot0=td0, tolerance=float(tol))
+    attrs = _root_attrs("trajectory", arguments, model=str(model), **body,
+                        kappa=k, energy=e, theta0=t0, theta_dot0=td0, tolerance=tol)
     return _table(table, attrs)
 
 
 def _rotation_number(value) -> float:
-    return float(Fraction(value)) if isinstance(value, str) else float(value)
+    """A number, or a fraction "p/q" as text."""
+    if not isinstance(value, str):
+        return _real("rotation_number", value)
+    try:
+        return float(Fraction(value))
+    except (ValueError, ZeroDivisionError, OverflowError):
+        shown = repr(value) if len(value) <= 40 else repr(value[:30]) + f" … ({len(value)} characters)"
+        raise ValueError(f"invalid rotation_number = {shown}: give a number or a fraction \"p/q\" with q != 0, "
+                         "e.g. \"-1/7\"") from None
 
 
 def resonance(alpha: float, beta: float, nu: float, eta: float, rotation_number, *, kappa_min: float = 0.01,
@@ -1147,7 +1418,10 @@ def resonance(alpha: float, beta: float, nu: float, eta: float, rotation_number,
     Raises
     ------
     ValueError
-        A parameter out of range or an empty window.
+        A parameter out of range, an empty window, or a `rotation_number` that is not a
+        number or a fraction "p/q" (q ≠ 0).
+    TypeError
+        A parameter that is not one number, `grid` not a whole number.
 
     Examples
     --------
@@ -1159,17 +1433,18 @@ def resonance(alpha: float, beta: float, nu: float, eta: float, rotation_number,
     [0, 1]
     """
     target = _rotation_number(rotation_number)
-    table, e_min = _core.resonance(float(alpha), float(beta), float(nu), float(eta), target, float(kappa_min),
-                                   float(kappa_max), None if energy_min is None else float(energy_min),
-                                   float(energy_max), int(grid), float(tol))
+    body = _reals(alpha=alpha, beta=beta, nu=nu, eta=eta)
+    window = _reals(kappa_min=kappa_min, kappa_max=kappa_max, energy_max=energy_max)
+    tol = _real("tol", tol)
+    table, e_min = _core.resonance(*body.values(), target, window["kappa_min"], window["kappa_max"],
+                                   _optional_real("energy_min", energy_min), window["energy_max"],
+                                   _count("grid", grid), tol)
     arguments = dict(alpha=alpha, beta=beta, nu=nu, eta=eta, rotation_number=rotation_number,
                      kappa_min=kappa_min, kappa_max=kappa_max, energy_min=energy_min,
                      energy_max=energy_max, grid=grid, tol=tol)
-    attrs = _root_attrs("resonance", arguments,
-                        alpha=float(alpha), beta=float(beta), nu=float(nu), eta=float(eta),
-                        rotation_number=target, tolerance=float(tol),
-                        kappa_window=np.array([kappa_min, kappa_max], dtype=float),
-                        energy_window=np.array([e_min, energy_max], dtype=float))
+    attrs = _root_attrs("resonance", arguments, **body, rotation_number=target, tolerance=tol,
+                        kappa_window=np.array([window["kappa_min"], window["kappa_max"]], dtype=float),
+                        energy_window=np.array([e_min, window["energy_max"]], dtype=float))
     return _table(table, attrs)
 
 
@@ -1185,6 +1460,12 @@ def _padded(rows: list[list], fill, dtype, shape: tuple, width: int) -> np.ndarr
     for i, row in enumerate(rows):
         out[i, :len(row)] = row
     return out.reshape(shape + (width,))
+
+
+# The variables and dimension of `verdict`'s result besides the bodies' dimensions.
+_VERDICT_OUTPUTS = ("holds", "case", "kappa_max", "kappa_max_error", "fail_margin", "counterexamples", "kappa",
+                    "energy", "rotation_number", "theta_min", "theta_max", "family", "component", "drift",
+                    "verdict_json", "counterexample")
 
 
 def verdict(alpha, beta, nu, eta, *, tol: float = 1e-10, resolution: int = 64,
@@ -1232,7 +1513,11 @@ def verdict(alpha, beta, nu, eta, *, tol: float = 1e-10, resolution: int = 64,
     Raises
     ------
     ValueError
-        A parameter out of range, or inputs that do not broadcast.
+        A parameter out of range, inputs that do not broadcast, or a dimension named after
+        a variable of the result.
+    TypeError
+        An input that is not real numbers (as in `cells`), `resolution` or `threads` not a
+        whole number.
 
     See Also
     --------
@@ -1250,10 +1535,14 @@ def verdict(alpha, beta, nu, eta, *, tol: float = 1e-10, resolution: int = 64,
     ([1.0, 1.5], True)
     """
     given = {"alpha": alpha, "beta": beta, "nu": nu, "eta": eta}
-    dims, layout, coords = _broadcast(given)
+    tol, resolution, threads = _real("tol", tol), _count("resolution", resolution), _optional_count("threads", threads)
+    dims, layout, coords, places = _broadcast(given, outputs=_VERDICT_OUTPUTS)
     shape = layout[0].shape
     flat = [np.asarray(a, dtype=np.float64).reshape(-1).tolist() for a in layout]
-    found = [json.loads(v) for v in _core.verdicts(*flat, float(tol), int(resolution), threads)]
+    try:
+        found = [json.loads(v) for v in _core.verdicts(*flat, tol, resolution, threads)]
+    except ValueError as e:
+        raise _located(e, shape, places, {}) from None
 
     def column(get, dtype):
         return np.array([get(v) for v in found], dtype=dtype).reshape(shape)
@@ -1320,7 +1609,7 @@ def verdict(alpha, beta, nu, eta, *, tol: float = 1e-10, resolution: int = 64,
         coords[name] = xr.Variable(cdims, cvalues, _coordinate_attrs(name), {"_FillValue": None})
     arguments = dict(given, tol=tol, resolution=resolution)
     attrs = _root_attrs("verdict", arguments, title="rubber-atlas verdicts of the boundedness hypothesis",
-                        tolerance=float(tol), resolution=int(resolution))
+                        tolerance=tol, resolution=resolution)
     return xr.Dataset(data_vars, coords, attrs)
 
 
@@ -1366,6 +1655,9 @@ def boundaries(alpha: float, nu: float, eta: float, *, beta_min: float = 0.05, b
     ------
     ValueError
         A parameter out of range.
+    TypeError
+        A parameter that is not one number, `scan`, `resolution` or `threads` not a whole
+        number.
 
     Examples
     --------
@@ -1377,8 +1669,10 @@ def boundaries(alpha: float, nu: float, eta: float, *, beta_min: float = 0.05, b
     >>> names[int(b.holds_below[0])], names[int(b.holds_above[0])]
     ('fails', 'holds')
     """
-    found = json.loads(_core.boundaries(float(alpha), float(nu), float(eta), float(beta_min), float(beta_max),
-                                        int(scan), float(tol), int(resolution), threads))
+    numbers = _reals(alpha=alpha, nu=nu, eta=eta, beta_min=beta_min, beta_max=beta_max)
+    tol = _real("tol", tol)
+    found = json.loads(_core.boundaries(*numbers.values(), _count("scan", scan), tol, _count("resolution", resolution),
+                                        _optional_count("threads", threads)))
     holds = lambda h: 255 if h is None else int(h)  # noqa: E731
     holds_attrs = _flag([0, 1, 255], "fails holds no_value")
     case_attrs = _flag([0, 1, 2], "case_1 case_2 not_covered")
@@ -1408,7 +1702,7 @@ def boundaries(alpha: float, nu: float, eta: float, *, beta_min: float = 0.05, b
     arguments = dict(alpha=alpha, nu=nu, eta=eta, beta_min=beta_min, beta_max=beta_max, scan=scan, tol=tol,
                      resolution=resolution)
     attrs = _root_attrs("boundaries", arguments, title="rubber-atlas boundaries of the boundedness hypothesis",
-                        alpha=float(alpha), nu=float(nu), eta=float(eta),
-                        beta_range=np.asarray(found["beta_range"], dtype=float), tolerance=float(tol),
+                        alpha=numbers["alpha"], nu=numbers["nu"], eta=numbers["eta"],
+                        beta_range=np.asarray(found["beta_range"], dtype=float), tolerance=tol,
                         resolution=int(resolution), boundaries_json=json.dumps(found))
     return xr.Dataset(data_vars, attrs=attrs)

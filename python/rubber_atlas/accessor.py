@@ -3,6 +3,7 @@ of a session, one call each."""
 
 from __future__ import annotations
 
+import functools
 from fractions import Fraction
 
 import numpy as np
@@ -58,6 +59,17 @@ def _family_codes(ds: xr.Dataset) -> dict[str, int]:
     return {name: code for code, name in _api.flag_names(ds["family"]).items() if name != "no_value"}
 
 
+def _reads(method):
+    """The method reading a damaged file says so, naming the file (see `_api._reading`)."""
+
+    @functools.wraps(method)
+    def reading(self, *args, **kwargs):
+        with _api._reading(self._ds):
+            return method(self, *args, **kwargs)
+
+    return reading
+
+
 @xr.register_dataset_accessor("rubber")
 class RubberAccessor:
     """The ``.rubber`` accessor of atlases (`open_atlas`) and `cells` results.
@@ -76,6 +88,7 @@ class RubberAccessor:
     def __init__(self, ds: xr.Dataset):
         self._ds = ds
 
+    @_reads
     def components(self, alpha: float | None = None, beta: float | None = None, **cell) -> list[dict]:
         """The components of one cell as dicts (see `rubber_atlas.components`).
 
@@ -97,7 +110,12 @@ class RubberAccessor:
         Raises
         ------
         KeyError
-            The cell is not given by the dataset's dimensions, or is not on the grid.
+            The cell is not given by the dataset's dimensions, or is not on the grid (NaN
+            and ±inf never are); the exception is a ValueError too.
+        TypeError
+            A value that is not one number.
+        ValueError
+            The dataset is not an atlas or a `cells` result, or its file is damaged.
 
         Examples
         --------
@@ -138,6 +156,7 @@ class RubberAccessor:
         """
         return _api.flag_names(self._ds[name])
 
+    @_reads
     def families(self) -> list[str]:
         """The names of the torus families present in the dataset.
 
@@ -168,6 +187,7 @@ class RubberAccessor:
             codes = sorted(int(c) for c in np.unique(np.asarray(ds["family"].values)) if int(c) in names)
         return [names.get(c, f"family_{c}") for c in codes]
 
+    @_reads
     def family(self, name: str) -> xr.Dataset:
         """The per-component variables of one torus family, as fields over the plane.
 
@@ -248,6 +268,7 @@ class RubberAccessor:
         out.attrs = dict(ds.attrs, family=name)
         return out
 
+    @_reads
     def plot_trajectory(self):
         """Draws a trajectory (from `trajectory`, or a file of `rubber-atlas trajectory` read
         with `read_table`): the paths of the centre of mass and of the contact point on the
@@ -265,7 +286,8 @@ class RubberAccessor:
         Raises
         ------
         ValueError
-            The dataset is not a trajectory (it lacks t, theta, x_c, y_c, x_p or y_p).
+            The dataset is not a trajectory (it lacks t, theta, x_c, y_c, x_p or y_p), or
+            has no rows.
 
         Examples
         --------
@@ -284,6 +306,8 @@ class RubberAccessor:
         if missing:
             raise ValueError(f"plot_trajectory draws a trajectory; this dataset lacks {', '.join(missing)}")
         cols = {k: np.asarray(ds[k].values) for k in ("t", "theta", "x_c", "y_c", "x_p", "y_p")}
+        if not cols["t"].size:
+            raise ValueError("the trajectory is empty (t has no values): nothing to draw")
         fig, (ax_xy, ax_t) = plt.subplots(1, 2, figsize=(11, 5), gridspec_kw={"width_ratios": [1, 1.2]},
                                           layout="constrained")
         ax_xy.plot(cols["x_p"], cols["y_p"], lw=0.6, color="tab:orange", label="contact point")
@@ -311,6 +335,7 @@ class RubberAccessor:
         fig.suptitle(f"{attrs.get('model', '')} model: {title}", fontsize=9)
         return fig
 
+    @_reads
     def plot_slice(self, alpha_index: int = 0, beta_index: int = 0, max_q: int = 7):
         """A matplotlib Figure of the rotation number of each torus family over a plane.
 
@@ -343,7 +368,13 @@ class RubberAccessor:
         ------
         ValueError
             The dataset is not an atlas or a `cells` result over two dimensions (besides
-            α and β), or has neither a finite rotation_number nor drift_radius.
+            α and β); an index beyond ``alpha`` or ``beta`` (a dataset without that
+            dimension has index 0 only); `max_q` < 1; a slice that is empty or whose axes
+            are not finite; nothing to draw: neither rotation_number nor drift_radius (the
+            fields left them out), or no finite value of them (the message counts the
+            cells by ``cell_status``, e.g. "12 no_motion"); a damaged file.
+        TypeError
+            An index or `max_q` that is not a whole number.
 
         Examples
         --------
@@ -361,11 +392,17 @@ class RubberAccessor:
         import matplotlib.pyplot as plt
 
         ds = self._ds
-        if "cell_status" not in ds:
-            raise ValueError("plot_slice draws an atlas slice or a cells result over a plane of two dimensions; "
-                             "this dataset has no cell_status")
+        _api._cells_dataset(ds, "plot_slice")
+        max_q = _api._count("max_q", max_q)
+        if max_q < 1:
+            raise ValueError(f"invalid max_q = {max_q}: must be >= 1")
         cut = ds
         for name, index in (("alpha", alpha_index), ("beta", beta_index)):
+            index = _api._count(f"{name}_index", index)
+            size = ds.sizes[name] if name in ds.cell_status.dims else 1
+            if not -size <= index < size:
+                raise ValueError(f"invalid {name}_index = {index}: the dataset has {size} value{'s' * (size != 1)} "
+                                 f"of {name} (index 0 … {size - 1})")
             if name in ds.cell_status.dims:
                 cut = cut.isel({name: index})
         plane = list(cut.cell_status.dims)
@@ -375,7 +412,15 @@ class RubberAccessor:
                              "For a grid give cells kappa and energy as DataArrays along 'kappa' and 'energy' "
                              "(or numpy vectors of different lengths): vectors of one length are paired cell "
                              "by cell")
+        empty = [d for d in plane if cut.sizes[d] == 0]
+        if empty:
+            raise ValueError(f"the slice is empty: {' and '.join(empty)} {'has' if len(empty) == 1 else 'have'} "
+                             "no values")
         x, y = (cut[d].values if d in cut.coords else np.arange(cut.sizes[d]) for d in plane)
+        for d, axis in zip(plane, (x, y)):
+            if axis.dtype.kind not in "iuf" or not np.isfinite(axis).all():
+                raise ValueError(f"the axis {d} has values that are not finite numbers: plot_slice draws over "
+                                 "finite axes")
         panels = []  # (title, N over the plane)
         if "rotation_number" in cut:
             if "family" in cut:
@@ -392,8 +437,14 @@ class RubberAccessor:
                         panels.append((f"component {slot}: N", n))
         drift = "drift_radius" in cut and bool(np.isfinite(cut.drift_radius).any())
         if not panels and not drift:
-            raise ValueError("no finite rotation_number and no drift_radius to draw "
-                             "(the scene's [outputs] fields left them out)")
+            if "rotation_number" not in cut and "drift_radius" not in cut:
+                raise ValueError("this dataset has neither rotation_number nor drift_radius to draw (the scene's "
+                                 "[outputs] fields, or cells' fields=, left them out)")
+            names = _api.flag_names(cut.cell_status)
+            codes, counts = np.unique(np.asarray(cut.cell_status.values), return_counts=True)
+            shown = ", ".join(f"{n} {names.get(int(c), c)}" for c, n in zip(codes, counts))
+            raise ValueError("nothing to draw: no torus of this slice has a finite rotation_number (rolling over "
+                             f"the top, N = 0, has no panel) or drift_radius; its cells: {shown}")
         count = len(panels) + drift
         fig, axes = plt.subplots(1, count, figsize=(4.6 * count, 4.0), squeeze=False, layout="constrained")
         denominators = []

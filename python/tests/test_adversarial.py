@@ -1,0 +1,320 @@
+"""Adversarial inputs of the package (issue 22): every bad input gets one line, a ValueError,
+TypeError or KeyError of the package naming the input; never a raw numpy, matplotlib or OS
+error, never a silently wrong result."""
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+import pytest
+import xarray as xr
+
+import rubber_atlas as ra
+
+BODY = (0.5, 3.0, 0.5, 0.5)
+ATLAS_BODY = dict(alpha=0.5, beta=3.0)
+
+
+def refused(error, call, *words):
+    """`call()` raises `error` (itself, not a subclass from numpy, matplotlib or the OS) in one
+    line holding `words`; returns the message."""
+    with pytest.raises(error) as e:
+        call()
+    message = str(e.value)
+    assert type(e.value).__module__ in ("builtins", "rubber_atlas._api"), (type(e.value), message)
+    assert not isinstance(e.value, OSError), message
+    assert "\n" not in message, message
+    for w in words:
+        assert w in message, (w, message)
+    return message
+
+
+@pytest.fixture(scope="module")
+def grid():
+    return ra.cells(*BODY, kappa=np.array([0.0, 0.5, 0.8]), energy=np.array([2.0, 2.5]))
+
+
+# 4. Wrong results, silently: a cell looked up at NaN or ±inf.
+
+@pytest.mark.parametrize("value", [np.nan, np.inf, -np.inf])
+def test_components_refuse_a_coordinate_that_is_not_finite(grid, slice_atlas, value):
+    with ra.open_atlas(slice_atlas) as atlas:
+        for ds, body in ((grid, {}), (atlas, ATLAS_BODY)):
+            refused(ValueError, lambda: ds.rubber.components(**body, kappa=value, energy=2.5), "kappa")
+            refused(ValueError, lambda: ds.rubber.components(**body, kappa=0.5, energy=value), "energy")
+        refused(ValueError, lambda: atlas.rubber.components(alpha=value, beta=3.0, kappa=0.5, energy=2.5),
+                "alpha")
+
+
+def test_components_refuse_an_off_grid_coordinate_as_a_value_error_and_a_key_error(grid):
+    message = refused(ValueError, lambda: grid.rubber.components(kappa=0.77, energy=2.5), "kappa = 0.77")
+    assert "not a grid value" in message
+    # As documented (and as xarray's lookups): a KeyError too.
+    with pytest.raises(KeyError):
+        grid.rubber.components(kappa=0.77, energy=2.5)
+    # A coordinate with a NaN in it is no nearer to any value.
+    holed = grid.assign_coords(kappa=[np.nan, 0.5, 0.8])
+    refused(ValueError, lambda: holed.rubber.components(kappa=0.9, energy=2.5), "kappa = 0.9")
+    assert len(holed.rubber.components(kappa=0.8, energy=2.5)) == len(grid.rubber.components(kappa=0.8,
+                                                                                            energy=2.5))
+
+
+def test_components_refuse_what_is_not_a_number_naming_it(grid):
+    refused(TypeError, lambda: grid.rubber.components(kappa="0.8", energy=2.5), "kappa")
+    refused(TypeError, lambda: grid.rubber.components(kappa=[0.5, 0.8], energy=2.5), "kappa")
+    refused(ValueError, lambda: grid.rubber.components(kappa=2**1100, energy=2.5), "kappa")
+    cells = ra.cells(*BODY, [0.5, 0.7], 2.5)
+    refused(TypeError, lambda: cells.rubber.components(cell="x"), "cell")
+    refused(KeyError, lambda: cells.rubber.components(cell=2**1100), "cell")
+    refused(KeyError, lambda: cells.rubber.components(cell=np.nan), "cell")
+
+
+def test_components_of_a_dataset_that_is_not_an_atlas_say_so():
+    other = xr.Dataset({"a": ("x", [1.0, 2.0])})
+    refused(ValueError, lambda: other.rubber.components(x=0), "cell_status")
+    refused(ValueError, lambda: ra.components(other, x=0), "cell_status")
+
+
+# 6. Accepted but should be refused.
+
+@pytest.mark.parametrize("kappa, error", [
+    (np.array(["2020-01-01"], dtype="datetime64[D]"), TypeError),
+    (np.datetime64("2020-01-01"), TypeError),
+    (np.array([1, 2], dtype="timedelta64[s]"), TypeError),
+    (xr.DataArray(np.array(["2020-01-01"], dtype="datetime64[ns]"), dims="kappa"), TypeError),
+    (True, TypeError),
+    (np.array([0.5, 0.6]) > 0.55, TypeError),
+    ("0.8", TypeError),
+    ("x", TypeError),
+    ([0.5, "x"], TypeError),
+    ([0.5, None], TypeError),
+    ({"a": 1}, TypeError),
+    ([[0.5, 0.6], [0.7]], ValueError),
+    pytest.param(2**1100, ValueError, id="2**1100"),
+    pytest.param([0.5, -(2**1100)], ValueError, id="[0.5, -2**1100]"),
+])
+def test_cells_refuse_a_kappa_that_is_not_real_numbers(kappa, error):
+    refused(error, lambda: ra.cells(*BODY, kappa, 2.5), "kappa")
+
+
+def test_a_value_too_large_for_a_float_is_named_where_it_is():
+    message = refused(ValueError, lambda: ra.cells(*BODY, [0.5, 2**1100], 2.5), "kappa[1]", "1.36e+331")
+    assert len(message) < 300, message
+
+
+@pytest.mark.parametrize("value", ["no", "False", 0, 1, None, [True]])
+def test_switches_take_only_true_or_false(value):
+    refused(TypeError, lambda: ra.cells(*BODY, 0.8, 2.5, allow_large=value), "allow_large")
+    refused(TypeError, lambda: ra.diagram(0.5, 3.0, samples=10, allow_large=value), "allow_large")
+    if value is not None:  # progress=None is the default: decide by the terminal
+        refused(TypeError, lambda: ra.cells(*BODY, 0.8, 2.5, progress=value), "progress")
+
+
+@pytest.mark.parametrize("dim", ["cell_status", "rotation_number", "n_components", "family", "component"])
+def test_cells_refuse_a_dimension_named_after_an_output(dim):
+    kappa = xr.DataArray([0.5, 0.8], dims=dim)
+    refused(ValueError, lambda: ra.cells(*BODY, kappa, 2.5), repr(dim))
+
+
+@pytest.mark.parametrize("dim", ["case", "holds", "kappa", "counterexample"])
+def test_verdict_refuses_a_dimension_named_after_an_output(dim):
+    beta = xr.DataArray([0.5, 3.0], dims=dim)
+    refused(ValueError, lambda: ra.verdict(0.5, beta, 0.5, 0.5, resolution=8), repr(dim))
+
+
+def test_read_table_refuses_an_atlas_in_one_line(slice_atlas):
+    message = refused(ValueError, lambda: ra.read_table(slice_atlas), str(slice_atlas), "atlas", "open_atlas")
+    assert "read_table reads" in message
+
+
+# 7. Sizes checked before the inputs are materialised.
+
+LIMITED = """
+import resource, sys
+import numpy as np, rubber_atlas as ra
+# A 4 GB address space: materialising the request would fail at once (MemoryError).
+resource.setrlimit(resource.RLIMIT_AS, (4 * 2**30, 4 * 2**30))
+try:
+    {call}
+except ValueError as e:
+    print("refused:", e)
+print("peak MB", resource.getrusage(resource.RUSAGE_SELF).ru_maxrss // 1024)
+"""
+
+
+@pytest.mark.parametrize("call", [
+    "ra.cells(0.5, 3.0, 0.5, 0.5, kappa=np.broadcast_to(0.8, (10**5, 10**4)), energy=2.5)",
+    "ra.cells(0.5, 3.0, 0.5, 0.5, kappa=np.broadcast_to(np.int64(1), (10**5, 10**4)), energy=2.5)",
+    "ra.cells(0.5, 3.0, 0.5, 0.5, kappa=np.linspace(0, 2, 10**5), energy=np.linspace(0.5, 4.5, 10**5 + 1))",
+    "ra.cells(0.5, 3.0, 0.5, 0.5, lambda_=np.linspace(0.1, 1, 10**5), s=np.linspace(0.1, 1, 10**5 + 1))",
+])
+def test_a_request_beyond_memory_is_refused_before_its_inputs_are_materialised(call, tmp_path):
+    out = subprocess.run([sys.executable, "-c", LIMITED.format(call=call)], cwd=tmp_path, capture_output=True,
+                         text=True, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert "refused:" in out.stdout and "needs about" in out.stdout and "allow_large" in out.stdout, out.stdout
+    peak = int(out.stdout.split("peak MB")[1])
+    assert peak < 1000, out.stdout
+
+
+# 8. Wrong exception classes and unclear words.
+
+@pytest.mark.parametrize("call, error, words", [
+    (lambda: ra.cells(*BODY, 0.8, 2.5, threads=2**70), ValueError, ["threads"]),
+    (lambda: ra.cells(*BODY, 0.8, 2.5, threads=2.5), TypeError, ["threads"]),
+    (lambda: ra.cells(*BODY, 0.8, 2.5, threads="x"), TypeError, ["threads"]),
+    (lambda: ra.cells(*BODY, 0.8, 2.5, threads=True), TypeError, ["threads"]),
+    (lambda: ra.cells(*BODY, 0.8, 2.5, tol="x"), TypeError, ["tol"]),
+    (lambda: ra.cells(*BODY, 0.8, 2.5, tol=None), TypeError, ["tol"]),
+    (lambda: ra.cells(*BODY, 0.8, 2.5, tol=2**1100), ValueError, ["tol"]),
+    (lambda: ra.cells(*BODY, 0.8, 2.5, fields=3), TypeError, ["fields"]),
+    (lambda: ra.trajectory(0.5, 3, 0.5, 0.5, 2**1100, 2.5, periods=1), ValueError, ["kappa"]),
+    (lambda: ra.trajectory("x", 3, 0.5, 0.5, 0.8, 2.5, periods=1), TypeError, ["alpha"]),
+    (lambda: ra.trajectory([0.5, 0.4], 3, 0.5, 0.5, 0.8, 2.5, periods=1), TypeError, ["alpha"]),
+    (lambda: ra.trajectory(0.5, 3, 0.5, 0.5, 0.8, 2.5, periods=1, samples=2**70), ValueError, ["samples"]),
+    (lambda: ra.trajectory(0.5, 3, 0.5, 0.5, 0.8, 2.5, periods="1"), TypeError, ["periods"]),
+    (lambda: ra.diagram(0.5, 3, samples=2.5), TypeError, ["samples"]),
+    (lambda: ra.diagram(0.5, 3, kappa_max=2**1100), ValueError, ["kappa_max"]),
+    (lambda: ra.resonance(0.5, 3, 0.5, 0.5, "1/0"), ValueError, ["rotation_number", "1/0"]),
+    (lambda: ra.resonance(0.5, 3, 0.5, 0.5, "x"), ValueError, ["rotation_number", "'x'"]),
+    (lambda: ra.resonance(0.5, 3, 0.5, 0.5, None), TypeError, ["rotation_number"]),
+    (lambda: ra.resonance(0.5, 3, 0.5, 0.5, "-1/7", grid=2**70), ValueError, ["grid"]),
+    (lambda: ra.verdict(0.5, 3, 0.5, 0.5, resolution=2.5), TypeError, ["resolution"]),
+    (lambda: ra.verdict(0.5, 3, 0.5, 0.5, threads=2**70), ValueError, ["threads"]),
+    (lambda: ra.boundaries(0.5, 0.5, 0.5, scan=2**70), ValueError, ["scan"]),
+    (lambda: ra.boundaries(0.5, 0.5, 0.5, beta_min="x"), TypeError, ["beta_min"]),
+    (lambda: ra.flag_names(np.array([1, 2])), TypeError, ["flag_names"]),
+])
+def test_bad_options_are_named_in_one_line_of_the_right_class(call, error, words):
+    refused(error, call, *words)
+
+
+def test_inputs_that_do_not_broadcast_are_named_not_numbered():
+    for call, words in (
+            (lambda: ra.verdict([0.5, 0.2], [3.0, 3.0, 3.0], 0.5, 0.5), ["alpha (2,)", "beta (3,)"]),
+            (lambda: ra.cells(*BODY, np.zeros((2, 3)), np.zeros(4)), ["kappa (2, 3)", "energy (4,)"]),
+            (lambda: ra.cells(*BODY, np.ones(3), excess_energy=np.ones((4, 2))),
+             ["kappa (3,)", "excess_energy (4, 2)"]),
+            (lambda: ra.cells(*BODY, xr.DataArray(np.ones(3), dims="x"), xr.DataArray(np.ones(4), dims="x")),
+             ["kappa", "energy", "'x'"])):
+        message = refused(ValueError, call, *words)
+        assert "arg " not in message, message
+
+
+def test_a_bad_value_in_a_2d_input_is_named_by_its_index_in_that_input():
+    kappa = np.full((2, 4), 0.8)
+    kappa[1, 2] = np.nan
+    refused(ValueError, lambda: ra.cells(*BODY, kappa, 2.5), "kappa[1, 2] = NaN")
+    refused(ValueError, lambda: ra.cells(*BODY, xr.DataArray(kappa, dims=("a", "b")), 2.5), "kappa[1, 2] = NaN")
+    # Broadcast against an input of other dimensions, in another order.
+    energy = xr.DataArray(np.full((2, 4), 2.5), dims=("a", "b"))
+    energy[1, 2] = np.inf
+    refused(ValueError, lambda: ra.cells(*BODY, xr.DataArray(np.full((4, 2), 0.8), dims=("b", "a")), energy),
+            "energy[1, 2] = inf")
+    # Along numpy's broadcasting: a row against a column.
+    column = np.full((3, 1), 0.5)
+    column[2, 0] = 1.5
+    refused(ValueError, lambda: ra.cells(column, 3.0, 0.5, 0.5, np.full((1, 4), 0.8), 2.5), "alpha[2, 0] = 1.5")
+    # A scalar is named without an index; a 1-D input by its index.
+    message = refused(ValueError, lambda: ra.cells(1.5, 3.0, 0.5, 0.5, [0.5, 0.8], 2.5), "invalid alpha = 1.5")
+    assert "cell" not in message
+    refused(ValueError, lambda: ra.cells(*BODY, [0.5, np.inf], 2.5), "invalid kappa[1] = inf")
+    # A value computed from the inputs is named with the inputs it comes from.
+    refused(ValueError, lambda: ra.cells(*BODY, lambda_=[0.5, 1e300], s=1e-10), "kappa", "lambda_[1]", "s")
+
+
+def test_an_empty_numpy_input_gives_an_empty_result():
+    ds = ra.cells(*BODY, np.full((0, 4), 0.8), np.linspace(1.0, 4.0, 4)[None, :])
+    assert ds.cell_status.size == 0
+
+
+def test_plot_slice_refuses_indices_it_does_not_have(slice_atlas):
+    import matplotlib
+    matplotlib.use("Agg")
+    with ra.open_atlas(slice_atlas) as atlas:
+        refused(ValueError, lambda: atlas.rubber.plot_slice(alpha_index=5), "alpha_index = 5")
+        refused(ValueError, lambda: atlas.rubber.plot_slice(beta_index=-2), "beta_index = -2")
+        refused(TypeError, lambda: atlas.rubber.plot_slice(alpha_index="x"), "alpha_index")
+        refused(ValueError, lambda: atlas.rubber.plot_slice(max_q=0), "max_q")
+    cells = ra.cells(*BODY, kappa=np.linspace(0.1, 1.0, 4), energy=np.linspace(1.5, 3.5, 3))
+    refused(ValueError, lambda: cells.rubber.plot_slice(alpha_index=1), "alpha_index = 1")
+
+
+def test_plot_slice_on_empty_thin_and_motionless_slices(slice_atlas, tmp_path):
+    import matplotlib
+    matplotlib.use("Agg")
+    with ra.open_atlas(slice_atlas) as atlas:
+        refused(ValueError, lambda: atlas.isel(energy=slice(0, 0)).rubber.plot_slice(), "empty", "energy")
+        refused(ValueError, lambda: atlas.isel(kappa=slice(0, 0)).rubber.plot_slice(), "empty", "kappa")
+        for one in (atlas.isel(energy=[8]), atlas.isel(kappa=[8]), atlas.isel(kappa=[8], energy=[8])):
+            one.rubber.plot_slice().savefig(tmp_path / "one.png")
+        holed = atlas.assign_coords(kappa=atlas.kappa.where(atlas.kappa > 0.05))
+        refused(ValueError, lambda: holed.rubber.plot_slice(), "kappa")
+    still = ra.cells(*BODY, xr.DataArray([0.5, 0.8], dims="kappa"), xr.DataArray([-5.0, -4.0], dims="energy"))
+    message = refused(ValueError, lambda: still.rubber.plot_slice(), "no_motion")
+    assert "fields" not in message, message
+    bare = ra.cells(*BODY, xr.DataArray([0.5, 0.8], dims="kappa"), xr.DataArray([2.5, 3.0], dims="energy"),
+                    fields=["theta_min"])
+    refused(ValueError, lambda: bare.rubber.plot_slice(), "fields")
+
+
+def test_plot_trajectory_refuses_an_empty_table():
+    import matplotlib
+    matplotlib.use("Agg")
+    path = ra.trajectory(*BODY, kappa=0.8, energy=2.5, periods=1, samples=10)
+    refused(ValueError, lambda: path.isel(t=slice(0, 0)).rubber.plot_trajectory(), "empty")
+
+
+def test_files_that_cannot_be_read_are_refused_in_one_line(tmp_path, slice_atlas):
+    folder = tmp_path / "folder.h5"
+    folder.mkdir()
+    (tmp_path / "folder.csv").mkdir()
+    garbage = tmp_path / "garbage.h5"
+    garbage.write_bytes(b"not hdf5 at all")
+    binary = tmp_path / "binary.csv"
+    binary.write_bytes(b"# a: b\n\xff\xfe\x00\x01")
+    for path, words in ((folder, ["folder"]), (tmp_path / "folder.csv", ["folder"]),
+                        (tmp_path / "missing.h5", ["no such file"]), (tmp_path / "missing.csv", ["no such file"]),
+                        (garbage, ["garbage.h5"]), (binary, ["binary.csv"])):
+        refused(ValueError, lambda: ra.read_table(path), str(path), *words)
+    for path in (folder, tmp_path / "missing.h5", garbage):
+        refused(ValueError, lambda: ra.open_atlas(path), str(path))
+    refused(TypeError, lambda: ra.read_table(3), "path")
+    refused(TypeError, lambda: ra.open_atlas(None), "path")
+
+
+def test_a_damaged_atlas_is_named_as_damaged_by_the_accessor(slice_atlas, tmp_path):
+    import matplotlib
+    matplotlib.use("Agg")
+    damaged = tmp_path / "damaged.h5"
+    shutil.copy(slice_atlas, damaged)
+    with h5py.File(damaged, "r") as f:
+        chunk = f["rotation_number"].id.get_chunk_info(0)
+    with open(damaged, "r+b") as f:
+        f.seek(chunk.byte_offset + 2)
+        f.write(b"\xff" * min(64, chunk.size - 4))
+    with ra.open_atlas(damaged) as atlas:
+        # (family() stays lazy: its values are read, as the file's, when they are used.)
+        for call in (lambda: atlas.rubber.components(**ATLAS_BODY, kappa=0.5, energy=2.5),
+                     lambda: atlas.rubber.plot_slice()):
+            refused(ValueError, call, str(damaged), "damaged")
+
+
+def test_dataarray_coordinates_that_would_be_misread_are_refused():
+    named = xr.DataArray([0.5, 0.8], dims="x", coords={"rotation_number": ("x", [1.0, 2.0])})
+    refused(ValueError, lambda: ra.cells(*BODY, named, 2.5), "'rotation_number'", "kappa")
+    slot = xr.DataArray([0.5, 0.8], dims="x", coords={"component": ("x", [1, 2])})
+    refused(ValueError, lambda: ra.cells(*BODY, slot, 2.5), "'component'")
+    labelled = xr.DataArray([0.5, 0.8], dims="kappa", coords={"kappa": ["a", "b"]})
+    refused(ValueError, lambda: ra.cells(*BODY, labelled, 2.5), "coordinate differs from its values")
+    # The verdict's variables are the ones it refuses as dimension names.
+    v = ra.verdict(xr.DataArray([0.5], dims="body"), 3.0, 0.5, 0.5, resolution=8)
+    assert set(v.data_vars) | {"counterexample"} <= set(ra._api._VERDICT_OUTPUTS)
+
+
+def test_a_long_text_is_shown_short():
+    message = refused(ValueError, lambda: ra.resonance(*BODY, "1" + "0" * 400 + "/3"), "rotation_number")
+    assert len(message) < 200, message
