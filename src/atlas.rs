@@ -476,25 +476,50 @@ pub fn rows_per_unit(shape: [usize; 4]) -> usize {
     UNIT_CELLS.div_ceil(ne.max(1)).clamp(1, nk.max(1))
 }
 
-/// The grid's work units, slice after slice (α slowest), each of about [`UNIT_CELLS`] cells
-/// (whole κ-rows). The split depends on the grid alone, never on threads or shards.
-pub fn units(shape: [usize; 4]) -> Vec<Unit> {
+/// The number of work units of a grid of shape `shape` (see [`unit`]).
+pub fn unit_count(shape: [usize; 4]) -> usize {
     let [na, nb, nk, _] = shape;
+    na * nb * nk.div_ceil(rows_per_unit(shape))
+}
+
+/// Work unit `index` of the grid's units, slice after slice (α slowest), each of about
+/// [`UNIT_CELLS`] cells (whole κ-rows). The split depends on the grid alone, never on
+/// threads or shards. Made on demand: a grid of many small slices has many units.
+pub fn unit(shape: [usize; 4], index: usize) -> Unit {
+    let [_, nb, nk, _] = shape;
     let rows_per_unit = rows_per_unit(shape);
-    let mut out = Vec::new();
-    for ia in 0..na {
-        for ib in 0..nb {
-            for start in (0..nk).step_by(rows_per_unit) {
-                out.push(Unit {
-                    index: out.len(),
-                    alpha_index: ia,
-                    beta_index: ib,
-                    rows: start..(start + rows_per_unit).min(nk),
-                });
+    let per_slice = nk.div_ceil(rows_per_unit);
+    let (slice, block) = (index / per_slice, index % per_slice);
+    let start = block * rows_per_unit;
+    Unit {
+        index,
+        alpha_index: slice / nb,
+        beta_index: slice % nb,
+        rows: start..(start + rows_per_unit).min(nk),
+    }
+}
+
+/// The grid's work units in order ([`unit`]).
+pub fn units(shape: [usize; 4]) -> impl Iterator<Item = Unit> {
+    (0..unit_count(shape)).map(move |i| unit(shape, i))
+}
+
+/// The divisors of `n` in increasing order (O(√n): shard counts may be large).
+fn divisors(n: usize) -> Vec<usize> {
+    let mut low = Vec::new();
+    let mut high = Vec::new();
+    let mut i = 1;
+    while i <= n / i {
+        if n.is_multiple_of(i) {
+            low.push(i);
+            if i != n / i {
+                high.push(n / i);
             }
         }
+        i += 1;
     }
-    out
+    low.extend(high.into_iter().rev());
+    low
 }
 
 /// Shard `index` of `count` (1-based, as `--shard I/N`).
@@ -541,13 +566,11 @@ impl Shard {
         let n = self.count;
         let mut best: Option<(usize, [usize; 3])> = None;
         // Larger counts of the slower axes first: the first of equal layouts is kept.
-        for a in (1..=lengths[0].min(n))
-            .rev()
-            .filter(|&a| n.is_multiple_of(a))
-        {
-            for b in (1..=lengths[1].min(n / a))
+        for a in divisors(n).into_iter().rev().filter(|&a| a <= lengths[0]) {
+            for b in divisors(n / a)
+                .into_iter()
                 .rev()
-                .filter(|&b| (n / a).is_multiple_of(b))
+                .filter(|&b| b <= lengths[1])
             {
                 let k = n / a / b;
                 if k > lengths[2] {
@@ -591,10 +614,21 @@ impl Shard {
         }
     }
 
-    /// This shard's work units among `all` (the grid's [`units`]), in their order.
-    pub fn units<'u>(&self, all: &'u [Unit], shape: [usize; 4]) -> Vec<&'u Unit> {
+    /// This shard's work units (among the grid's [`units`]), in their order, made on demand.
+    pub fn units(&self, shape: [usize; 4]) -> impl Iterator<Item = Unit> {
         let region = self.region(shape);
-        all.iter().filter(|u| region.holds(u)).collect()
+        let per_slice = shape[2].div_ceil(rows_per_unit(shape));
+        let rows_per_unit = rows_per_unit(shape);
+        let blocks = region.rows.start / rows_per_unit..region.rows.end.div_ceil(rows_per_unit);
+        let nb = shape[1];
+        region.alpha.clone().flat_map(move |ia| {
+            let blocks = blocks.clone();
+            region.beta.clone().flat_map(move |ib| {
+                blocks
+                    .clone()
+                    .map(move |b| unit(shape, (ia * nb + ib) * per_slice + b))
+            })
+        })
     }
 
     /// Checks that the grid of shape `shape` splits into this many shards: boxes, one per
@@ -664,6 +698,13 @@ impl Region {
     /// be larger than its dataset).
     pub fn chunk_rows(&self, grid: [usize; 4]) -> usize {
         rows_per_unit(grid).min(self.rows.len()).max(1)
+    }
+
+    /// The work units in this region of a grid of shape `grid`.
+    pub fn unit_count(&self, grid: [usize; 4]) -> usize {
+        let rows_per_unit = rows_per_unit(grid);
+        let blocks = self.rows.end.div_ceil(rows_per_unit) - self.rows.start / rows_per_unit;
+        self.alpha.len() * self.beta.len() * blocks
     }
 
     /// Whether `unit` lies in this region (units never straddle shards' regions).
@@ -872,23 +913,32 @@ pub fn cell_bodies(points: &[CellPoint]) -> Result<Vec<crate::EllipsoidBody>> {
 /// Computes `points` with their `bodies` ([`cell_bodies`]) on the current rayon pool, into
 /// one block laid out as the atlas file lays out a row (the Python package's `cells`). Each
 /// cell is solved as `rubber-atlas cell` and `run` solve it, so the values are the same bit
-/// for bit.
+/// for bit. Given up when `stop` says so (polled between cells): then an empty block.
 pub fn compute_cells(
     points: &[CellPoint],
     bodies: &[crate::EllipsoidBody],
     variables: &[Variable],
     axis: &ComponentAxis,
     options: &crate::cell::CellOptions,
+    stop: &(dyn Fn() -> bool + Sync),
 ) -> Block {
     let blocks: Vec<Block> = points
         .par_chunks(POINTS_PER_TASK)
         .zip(bodies.par_chunks(POINTS_PER_TASK))
         .map(|(points, bodies)| {
+            // Asked to stop: nothing more is allocated or solved.
+            if stop() {
+                return Block::empty(variables, 0, axis.len());
+            }
             let mut block = Block::empty(variables, points.len(), axis.len());
             // Consecutive cells of one body and κ (a row of a grid) share V's critical
             // points, as the cells of an atlas row do: found once.
             let mut row: Option<(usize, EffectivePotential<'_, _>)> = None;
             for (j, (p, body)) in points.iter().zip(bodies).enumerate() {
+                // Asked to stop: the rest stays fill (the caller drops the block).
+                if stop() {
+                    break;
+                }
                 let same_row = |i: usize| {
                     let key =
                         |q: &CellPoint| [q.alpha, q.beta, q.nu, q.eta, q.kappa].map(f64::to_bits);
@@ -905,6 +955,9 @@ pub fn compute_cells(
             block
         })
         .collect();
+    if stop() {
+        return Block::empty(variables, 0, axis.len());
+    }
     Block::concat(variables, axis.len(), blocks)
 }
 
@@ -1007,11 +1060,13 @@ mod tests {
     #[test]
     fn units_cover_the_grid_once_and_shards_partition_them() {
         let shape = [2, 3, 50, 100];
-        let all = units(shape);
+        let all: Vec<Unit> = units(shape).collect();
         let cells: usize = all.iter().map(|u| u.rows.len() * shape[3]).sum();
         assert_eq!(cells, 2 * 3 * 50 * 100);
         for shape in [shape, [7, 2, 50, 100], [1, 1, 6000, 3], [3, 9, 10, 4000]] {
-            let all = units(shape);
+            let all: Vec<Unit> = units(shape).collect();
+            assert_eq!(all.len(), unit_count(shape));
+            assert!(all.iter().enumerate().all(|(i, u)| u.index == i));
             let units_total = all.len();
             let mut tiled = 0;
             for count in 1..=units_total.min(24) {
@@ -1025,8 +1080,10 @@ mod tests {
                     let shard = Shard { index, count };
                     shard.check_against(shape).unwrap();
                     let region = shard.region(shape);
-                    let mine = shard.units(&all, shape);
+                    let mine: Vec<Unit> = shard.units(shape).collect();
                     assert!(!mine.is_empty());
+                    assert!(mine.iter().all(|u| region.holds(u)));
+                    assert_eq!(mine.len(), all.iter().filter(|u| region.holds(u)).count());
                     for u in mine {
                         seen[u.index] += 1;
                         // A unit lies in its shard's region whole.

@@ -7,7 +7,7 @@
 //! `hier2002`). A new body (a torus, a truncated sphere, a disk with a rounded rim) is one new
 //! implementation of [`Shape`]; every derived quantity has a generic default built from χ1, χ2.
 
-use crate::error::{check_range, Result};
+use crate::error::{check_range, AtlasError, Result};
 use nalgebra::Vector3;
 
 /// An angle θ given by its sine and cosine, both to full relative precision. Near θ = π a
@@ -471,6 +471,14 @@ impl<S: Shape> Body<S> {
             "must satisfy 0 < nu <= 2 (i3 <= i1 + i2 = 2 i1)",
         )?;
         check_range("eta", eta, Some((0.0, false)), None, "must be > 0")?;
+        // The inertia 1/η must be a number: below 5.6e-309 it overflows to infinity.
+        if !(1.0 / eta).is_finite() {
+            return Err(AtlasError::InvalidParameter {
+                name: "eta",
+                value: eta,
+                reason: "is so small that 1/eta overflows: eta must be >= 5.6e-309",
+            });
+        }
         Ok(Self { shape, nu, eta })
     }
 

@@ -287,7 +287,17 @@ pub fn solve_component<S: Shape>(
     options: &CellOptions,
 ) -> Result<ComponentResult> {
     if component.kind == MotionKind::FixedPoint {
-        return Ok(fixed_point(potential, component, options));
+        let result = fixed_point(potential, component, options);
+        // Linearised limits that overflowed or lost every digit (extreme η, β, κ) are no
+        // values: say so rather than carry inf or NaN into N and the bounded flag.
+        let defined = result.rotation_number.is_finite()
+            && result.period.is_finite()
+            && result.error_estimate.is_finite();
+        return Ok(if defined {
+            result
+        } else {
+            unresolved(component)
+        });
     }
     if let Some(saddle) = separatrix(component, energy) {
         return Ok(on_separatrix(potential, component, &saddle, options));
@@ -299,6 +309,14 @@ pub fn solve_component<S: Shape>(
         Err(AtlasError::Integration { .. }) if options.method == Method::Ode => {
             return Ok(unresolved(component));
         }
+        // Where ε − V rounds to ≤ 0 at a node inside the turning points (κ and ε so large
+        // that their difference has no digit left there), the integrals have no value: the
+        // component says so (and far out on ε, N is still the high-energy limit's).
+        Err(AtlasError::NotPeriodic { .. }) => {
+            let mut result = unresolved(component);
+            far_out(potential, energy, component, options, &mut result);
+            return Ok(result);
+        }
         Err(e) => return Err(e),
     };
     let offset = level_offset_error(potential, energy, component, &raw, options);
@@ -307,7 +325,68 @@ pub fn solve_component<S: Shape>(
     if let Some(d) = raw.drift.as_mut() {
         d.error += offset.drift;
     }
-    Ok(finish(component, raw, options))
+    let mut result = finish(component, raw, options);
+    far_out(potential, energy, component, options, &mut result);
+    Ok(result)
+}
+
+/// ε above this many times Ū² (Ū the scale of U) is "far out": N(κ, ε) is the high-energy
+/// limit N∞(κ/√ε) up to O(Ū/ε), far below double precision, while the quadrature's ψ
+/// advance, built from two near-π jumps at turning points within λ/√2 of the poles, loses
+/// its digits (at κ = 0.8, ε = 1e50: N = 9e-8 ± 7e-8 against the true −5e-26).
+const FAR_OUT: f64 = 1e24;
+
+/// Far out on ε ([`FAR_OUT`]), N of a libration is checked against the high-energy limit
+/// N∞(λ), λ = |κ|/√ε, an integral computed apart (`limits`, docs/hypothesis.md): where the
+/// quadrature's N lies beyond its own estimate plus the limit's bound (the limit's
+/// quadrature error, and 1e3·Ū·λ/ε for the O(Ū/ε) it leaves out) from the limit, or has no
+/// value, N and its error are the limit's (and ω_ψ = −N ω_θ follows).
+fn far_out<S: Shape>(
+    potential: &EffectivePotential<'_, S>,
+    energy: f64,
+    component: &Component,
+    options: &CellOptions,
+    result: &mut ComponentResult,
+) {
+    let kappa = potential.kappa;
+    let shape = &potential.body.shape;
+    let scale = 1.0
+        + [0.0, 0.5 * PI, PI]
+            .iter()
+            .map(|&t| shape.potential(t).abs())
+            .fold(0.0, f64::max);
+    if kappa == 0.0
+        || component.kind != MotionKind::Libration
+        || energy.is_nan()
+        || energy < FAR_OUT * scale * scale
+    {
+        return;
+    }
+    let lambda = kappa.abs() / energy.sqrt();
+    let limit =
+        match crate::limits::high_energy_rotation_number(potential.body, lambda, options.tol) {
+            Ok(limit) if limit.value.is_finite() && limit.error.is_finite() => limit,
+            _ => return,
+        };
+    let n = kappa.signum() * limit.value;
+    let bound = limit.error + 1e3 * scale * lambda / energy + 2.0 * f64::EPSILON * n.abs();
+    let own = result.errors.rotation_number;
+    let contradicted =
+        !result.rotation_number.is_finite() || (result.rotation_number - n).abs() > own + bound;
+    if !contradicted {
+        return;
+    }
+    result.rotation_number = n;
+    result.error_estimate = bound;
+    result.errors.rotation_number = bound;
+    if result.omega_theta.is_finite() {
+        result.omega_psi = -n * result.omega_theta;
+        result.errors.omega_psi = n.abs() * result.errors.omega_theta + bound * result.omega_theta;
+    }
+    let settled = result.errors.period <= options.tol * result.period && bound <= options.tol;
+    if result.status == Status::ToleranceNotReached && settled && !options.drift {
+        result.status = Status::Ok;
+    }
 }
 
 /// T, Δψ and Δζ of a libration or rotation by the chosen method.
@@ -513,6 +592,18 @@ fn level_offset_error<S: Shape>(
 }
 
 fn finish(component: &Component, raw: PeriodIntegrals, options: &CellOptions) -> ComponentResult {
+    // Integrals that overflowed or lost every digit (extreme η, ε or κ) are no values: the
+    // component says so rather than carry NaN into N, its error and the bounded flag.
+    let drift_defined = raw
+        .drift
+        .is_none_or(|d| d.value.iter().all(|v| v.is_finite()) && !d.error.is_nan());
+    let defined = [raw.period, raw.psi_advance].iter().all(|v| v.is_finite())
+        && raw.period > 0.0
+        && !raw.period_error.is_nan()
+        && !raw.psi_advance_error.is_nan();
+    if !(defined && drift_defined) {
+        return unresolved(component);
+    }
     let t = raw.period;
     let omega_theta = TAU / t;
     let omega_psi = raw.psi_advance / t;

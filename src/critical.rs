@@ -242,6 +242,7 @@ impl CriticalSet {
                 reason: "must be a finite number > 0",
             });
         }
+        crate::error::check_samples(samples)?;
         let samples = samples.max(16);
         let diagram_type = DiagramType::of(alpha, beta);
         let theta_star = inclined_equilibrium(alpha, beta);

@@ -16,14 +16,16 @@ pub enum AtlasError {
     },
     /// The energy is below every value of the effective potential: no motion at all.
     #[error(
-        "no motion: energy {energy} is below the minimum {minimum} of the effective potential"
+        "no motion: energy {} is below the minimum {} of the effective potential",
+        show(*energy),
+        show(*minimum)
     )]
     NoMotion { energy: f64, minimum: f64 },
     /// An initial angle outside the allowed set (κ ≠ 0 needs 0 < θ < π).
-    #[error("invalid theta0 = {theta0}: {reason}")]
+    #[error("invalid theta0 = {}: {reason}", show(*theta0))]
     InvalidInitialAngle { theta0: f64, reason: &'static str },
     /// The ODE integrator gave up.
-    #[error("integration failed at t = {time}: {reason}")]
+    #[error("integration failed at t = {}: {reason}", show(*time))]
     Integration { time: f64, reason: String },
     /// A quantity that needs an oscillating component (a period) was asked of a fixed point
     /// or of motion that is not periodic in θ.
@@ -52,6 +54,9 @@ pub enum AtlasError {
     /// journal and a resumed run continues from them.
     #[error("{path}: interrupted with {done} of {total} cells computed and kept")]
     Interrupted { path: String, done: u64, total: u64 },
+    /// A computation given up because its caller asked it to stop (Ctrl-C in Python).
+    #[error("stopped on request")]
+    Stopped,
 }
 
 impl AtlasError {
@@ -67,11 +72,37 @@ impl AtlasError {
 
 /// A number as a person reads it in a message: exponent notation far from 1 (1e200, not
 /// two hundred digits).
-fn show(value: f64) -> String {
+pub fn show(value: f64) -> String {
     if value != 0.0 && value.is_finite() && !(1e-4..1e16).contains(&value.abs()) {
         format!("{value:e}")
     } else {
         format!("{value}")
+    }
+}
+
+/// The most rows a table (`diagram`, `trajectory`) may have, whatever memory the machine
+/// has: at a few hundred bytes a row, 1e8 rows are tens of GB already.
+pub const MAX_SAMPLES: usize = 100_000_000;
+
+/// Refuses a table of `samples` rows outside 1 ..= [`MAX_SAMPLES`].
+pub(crate) fn check_samples(samples: usize) -> Result<()> {
+    if samples == 0 || samples > MAX_SAMPLES {
+        return Err(AtlasError::InvalidParameter {
+            name: "samples",
+            value: samples as f64,
+            reason: "must be between 1 and 1e8",
+        });
+    }
+    Ok(())
+}
+
+/// A number with `digits` digits after the point as a person reads it: exponent notation far
+/// from 1 (1.5e300, not three hundred digits), fixed notation near it.
+pub fn show_digits(value: f64, digits: usize) -> String {
+    if value != 0.0 && value.is_finite() && !(1e-4..1e6).contains(&value.abs()) {
+        format!("{value:.digits$e}")
+    } else {
+        format!("{value:.digits$}")
     }
 }
 

@@ -312,6 +312,21 @@ pub fn high_energy_pair<S: Shape>(body: &Body<S>, lambda: f64, tol: f64) -> (Est
 }
 
 impl HighEnergyLimit {
+    /// The limit not computed: every value NaN (null in JSON).
+    pub fn not_computed() -> Self {
+        Self {
+            slope: f64::NAN,
+            n_min: f64::NAN,
+            lambda_at_min: f64::NAN,
+            n_max: f64::NAN,
+            lambda_at_max: f64::NAN,
+            normalized_min: f64::NAN,
+            normalized_max: f64::NAN,
+            slope_error: f64::NAN,
+            extrema_error: f64::NAN,
+        }
+    }
+
     /// Slope and extrema of N∞ and Ñ to the accuracy `tol` (values; λ to 1e-7, which moves
     /// an extremum's value by N″·1e-14).
     pub fn of<S: Shape>(body: &Body<S>, tol: f64) -> Result<Self> {

@@ -11,12 +11,68 @@ pub fn show_bytes(bytes: f64) -> String {
     }
 }
 
-/// Memory the kernel could give this process now (MemAvailable), if it says.
+/// Memory the kernel could give this process now, if it says: the least of the machine's
+/// MemAvailable, what the process's control group may still use (cgroup v2 memory.max less
+/// memory.current) and what its address-space limit (ulimit -v) leaves beyond its size now.
 pub fn available_memory() -> Option<f64> {
-    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    [
+        machine_available(),
+        cgroup_available(),
+        address_space_available(),
+    ]
+    .into_iter()
+    .flatten()
+    .reduce(f64::min)
+}
+
+/// A "Key:   N kB" line of a /proc file, in bytes.
+fn kb_field(text: &str, key: &str) -> Option<f64> {
+    let line = text.lines().find(|l| l.starts_with(key))?;
     let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kb * 1024.0)
+}
+
+fn machine_available() -> Option<f64> {
+    kb_field(
+        &std::fs::read_to_string("/proc/meminfo").ok()?,
+        "MemAvailable:",
+    )
+}
+
+/// memory.max − memory.current of this process's cgroup (v2), where it has a limit.
+fn cgroup_available() -> Option<f64> {
+    let cgroup = std::fs::read_to_string("/proc/self/cgroup").ok()?;
+    let path = cgroup.lines().find_map(|l| l.strip_prefix("0::"))?;
+    let dir = std::path::Path::new("/sys/fs/cgroup").join(path.trim_start_matches('/'));
+    let read = |name: &str| -> Option<f64> {
+        std::fs::read_to_string(dir.join(name))
+            .ok()?
+            .trim()
+            .parse()
+            .ok()
+    };
+    // "max" (no limit) does not parse.
+    let max = read("memory.max")?;
+    Some((max - read("memory.current").unwrap_or(0.0)).max(0.0))
+}
+
+/// RLIMIT_AS less the process's address space now (VmSize), where there is a limit.
+fn address_space_available() -> Option<f64> {
+    let mut limit = libc::rlimit {
+        rlim_cur: 0,
+        rlim_max: 0,
+    };
+    // SAFETY: getrlimit fills the struct it is given.
+    if unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut limit) } != 0
+        || limit.rlim_cur == libc::RLIM_INFINITY
+    {
+        return None;
+    }
+    let size = kb_field(
+        &std::fs::read_to_string("/proc/self/status").ok()?,
+        "VmSize:",
+    )?;
+    Some((limit.rlim_cur as f64 - size).max(0.0))
 }
 
 /// Free space for an unprivileged user in the folder that will hold `out`.

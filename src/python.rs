@@ -20,9 +20,8 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-/// Cells per thread in a batch of `cells` (milliseconds of work): Ctrl-C is heard between
-/// batches.
-const BATCH_PER_THREAD: usize = 512;
+/// How often a running computation looks for Ctrl-C.
+const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(20);
 
 fn value_error(e: AtlasError) -> PyErr {
     PyValueError::new_err(e.to_string())
@@ -73,12 +72,6 @@ fn pool(threads: Option<i64>) -> PyResult<Option<rayon::ThreadPool>> {
         .map_err(|e| bad(e.to_string()))
 }
 
-/// The threads of `pool` (or of rayon's global pool).
-fn threads_of(pool: &Option<rayon::ThreadPool>) -> usize {
-    pool.as_ref()
-        .map_or_else(rayon::current_num_threads, |p| p.current_num_threads())
-}
-
 /// Runs `work` on `pool` (or rayon's global pool) with the GIL released.
 fn in_pool<T: Send>(
     py: Python<'_>,
@@ -89,6 +82,58 @@ fn in_pool<T: Send>(
         Some(pool) => py.detach(|| pool.install(work)),
         None => py.detach(work),
     }
+}
+
+/// Sets its flag when dropped: a worker's "done", also when it panics.
+struct SetOnDrop<'a>(&'a std::sync::atomic::AtomicBool);
+
+impl Drop for SetOnDrop<'_> {
+    fn drop(&mut self) {
+        self.0.store(true, std::sync::atomic::Ordering::Release);
+    }
+}
+
+/// Runs `work` on `pool` (or rayon's global pool) with the GIL released, looking for Ctrl-C
+/// every [`SIGNAL_POLL`] meanwhile. On one, the `stop` that `work` is given says so; `work`
+/// polls it between cells (or a verdict's components) and returns early, and the
+/// KeyboardInterrupt is raised then: the latency is one cell's (or component's) time.
+fn interruptible<T: Send>(
+    py: Python<'_>,
+    pool: &Option<rayon::ThreadPool>,
+    work: impl FnOnce(&(dyn Fn() -> bool + Sync)) -> T + Send,
+) -> PyResult<T> {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let stop = AtomicBool::new(false);
+    let done = AtomicBool::new(false);
+    let asked_to_stop = || stop.load(Ordering::Relaxed);
+    std::thread::scope(|scope| {
+        let worker = scope.spawn(|| {
+            let _done = SetOnDrop(&done);
+            match pool {
+                Some(pool) => pool.install(|| work(&asked_to_stop)),
+                None => work(&asked_to_stop),
+            }
+        });
+        let mut interrupt = None;
+        while !done.load(Ordering::Acquire) {
+            py.detach(|| {
+                let start = std::time::Instant::now();
+                while !done.load(Ordering::Acquire) && start.elapsed() < SIGNAL_POLL {
+                    std::thread::sleep(std::time::Duration::from_millis(1));
+                }
+            });
+            if interrupt.is_none() {
+                if let Err(e) = py.check_signals() {
+                    stop.store(true, Ordering::Relaxed);
+                    interrupt = Some(e);
+                }
+            }
+        }
+        let out = worker
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        interrupt.map_or(Ok(out), Err)
+    })
 }
 
 /// Refuses a request of about `bytes` of memory that the machine cannot hold, unless
@@ -214,18 +259,10 @@ fn cells<'py>(
     };
     options.validate().map_err(value_error)?;
     let bodies = atlas::cell_bodies(&points).map_err(value_error)?;
-    // In batches, between which Ctrl-C (KeyboardInterrupt) is heard; each cell is solved
-    // on its own, so the batches do not change a value.
-    let batch = (BATCH_PER_THREAD * threads_of(&pool)).max(1);
-    let mut blocks = Vec::with_capacity(n.div_ceil(batch));
-    for (chunk, chunk_bodies) in points.chunks(batch).zip(bodies.chunks(batch)) {
-        let block = in_pool(py, &pool, || {
-            atlas::compute_cells(chunk, chunk_bodies, &vars, &room, &options)
-        });
-        blocks.push(block);
-        py.check_signals()?;
-    }
-    let block = atlas::Block::concat(&vars, room.len(), blocks);
+    // Ctrl-C (KeyboardInterrupt) is heard within a cell's time.
+    let block = interruptible(py, &pool, |stop| {
+        atlas::compute_cells(&points, &bodies, &vars, &room, &options, stop)
+    })?;
     // The slots some cell holds.
     let family = block
         .flags(&vars, "family")
@@ -501,8 +538,16 @@ fn verdicts(
     if [beta.len(), nu.len(), eta.len()].iter().any(|&m| m != n) {
         return Err(bad("alpha, beta, nu and eta must have one length".into()));
     }
+    // A bad body is named by its position, as `cells` names a bad cell.
     let bodies = (0..n)
-        .map(|i| body(alpha[i], beta[i], nu[i], eta[i]))
+        .map(|i| {
+            EllipsoidBody::ellipsoid(alpha[i], beta[i], nu[i], eta[i]).map_err(|e| {
+                value_error(AtlasError::Atlas {
+                    path: format!("cell {i}"),
+                    reason: e.to_string(),
+                })
+            })
+        })
         .collect::<PyResult<Vec<_>>>()?;
     let options = VerdictOptions {
         tol,
@@ -510,23 +555,18 @@ fn verdicts(
         counterexamples: true,
         coarse_first: true,
     };
-    // A body per thread at a time: Ctrl-C is heard between the batches.
-    let mut out = Vec::with_capacity(n);
-    for chunk in bodies.chunks(threads_of(&pool).max(1)) {
-        let found = in_pool(py, &pool, || {
-            chunk
-                .par_iter()
-                .with_max_len(1)
-                .map(|b| verdict::verdict(b, &options))
-                .collect::<Vec<_>>()
-        });
-        for v in found {
-            let v = v.map_err(value_error)?;
-            out.push(serde_json::to_string(&v).map_err(|e| bad(e.to_string()))?);
-        }
-        py.check_signals()?;
-    }
-    Ok(out)
+    // Ctrl-C (KeyboardInterrupt) is heard within a component's time.
+    let found = interruptible(py, &pool, |stop| {
+        bodies
+            .par_iter()
+            .with_max_len(1)
+            .map(|b| verdict::verdict_until(b, &options, stop))
+            .collect::<Vec<_>>()
+    })?;
+    found
+        .into_iter()
+        .map(|v| serde_json::to_string(&v.map_err(value_error)?).map_err(|e| bad(e.to_string())))
+        .collect()
 }
 
 /// The β at which the verdict changes along β at one α (`verdict --boundaries`), as the
@@ -560,8 +600,10 @@ fn boundaries(
             coarse_first: false,
         },
     };
-    let found = in_pool(py, &pool, || verdict::boundaries(alpha, nu, eta, &options))
-        .map_err(value_error)?;
+    let found = interruptible(py, &pool, |stop| {
+        verdict::boundaries_until(alpha, nu, eta, &options, stop)
+    })?
+    .map_err(value_error)?;
     serde_json::to_string(&found).map_err(|e| bad(e.to_string()))
 }
 

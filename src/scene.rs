@@ -3,7 +3,7 @@
 //! value and names the file, the key and the reason of the first problem it finds.
 
 use crate::cell::{CellOptions, Method};
-use crate::error::{AtlasError, Result};
+use crate::error::{show, AtlasError, Result};
 use crate::family::Layout;
 use crate::EllipsoidBody;
 use std::path::Path;
@@ -292,13 +292,20 @@ impl Reader<'_> {
                 if stop < start {
                     return Err(self.error(
                         &full,
-                        format!("inverted axis: stop {stop} is below start {start}"),
+                        format!(
+                            "inverted axis: stop {} is below start {}",
+                            show(stop),
+                            show(start)
+                        ),
                     ));
                 }
                 if num > 1 && stop == start {
                     return Err(self.error(
                         &full,
-                        format!("empty axis: start = stop = {start} with num = {num}"),
+                        format!(
+                            "empty axis: start = stop = {} with num = {num}",
+                            show(start)
+                        ),
                     ));
                 }
                 if num == 1 && stop != start {
@@ -310,7 +317,7 @@ impl Reader<'_> {
                 if log && start <= 0.0 {
                     return Err(self.error(
                         &join(&full, "start"),
-                        format!("{start} must be > 0 for log spacing"),
+                        format!("{} must be > 0 for log spacing", show(start)),
                     ));
                 }
                 if log {
@@ -341,8 +348,8 @@ impl Reader<'_> {
                 &full,
                 format!(
                     "values must be strictly increasing ({} is followed by {})",
-                    values[i],
-                    values[i + 1]
+                    show(values[i]),
+                    show(values[i + 1])
                 ),
             ));
         }
@@ -362,7 +369,7 @@ fn join(prefix: &str, key: &str) -> String {
 fn parameter_error(reader: &Reader<'_>, key: &str, e: AtlasError) -> AtlasError {
     match e {
         AtlasError::InvalidParameter { value, reason, .. } => {
-            reader.error(key, format!("{value} {reason}"))
+            reader.error(key, format!("{} {reason}", show(value)))
         }
         e => reader.error(key, e.to_string()),
     }
@@ -484,17 +491,29 @@ impl Scene {
                 "axes.kappa",
                 format!(
                     "{} is above {MAX_KAPPA:e} (kappa^2 would overflow)",
-                    largest(&kappa)
+                    show(largest(&kappa))
                 ),
             ));
         }
         if plane == Plane::Compact {
             let s_min = smallest_positive(&energy);
-            if s_min < MIN_S || largest(&kappa) / s_min > MAX_KAPPA {
+            if s_min < MIN_S {
                 return Err(reader.error(
                     "axes.s",
                     format!(
-                        "{s_min:e} is too small: energy = 1/s^2 must stay below 1e300 and kappa = lambda/s below {MAX_KAPPA:e} (s = 0 is the limit energy = infinity itself)"
+                        "{} is below {MIN_S:e}: energy = 1/s^2 must stay below 1e300 (s = 0 is the limit energy = infinity itself)",
+                        show(s_min)
+                    ),
+                ));
+            }
+            if largest(&kappa) / s_min > MAX_KAPPA {
+                return Err(reader.error(
+                    "axes.lambda",
+                    format!(
+                        "lambda = {} at s = {} gives kappa = lambda/s = {}, above {MAX_KAPPA:e} (kappa^2 would overflow): keep lambda/s below it",
+                        show(largest(&kappa)),
+                        show(s_min),
+                        show(largest(&kappa) / s_min)
                     ),
                 ));
             }
@@ -509,14 +528,17 @@ impl Scene {
                     "axes.lambda",
                     format!(
                         "{} must be >= 0 (lambda = kappa / sqrt(energy))",
-                        kappa.values[0]
+                        show(kappa.values[0])
                     ),
                 ));
             }
             if energy.values[0] < 0.0 {
                 return Err(reader.error(
                     "axes.s",
-                    format!("{} must be >= 0 (s = 1 / sqrt(energy))", energy.values[0]),
+                    format!(
+                        "{} must be >= 0 (s = 1 / sqrt(energy))",
+                        show(energy.values[0])
+                    ),
                 ));
             }
         }

@@ -192,8 +192,9 @@ pub struct Footprint {
     /// Disk at the peak: the journal and the file side by side, uncompressed (an upper
     /// bound: the file's chunks are deflated).
     pub disk_bytes: f64,
-    /// Memory at the peak: the list of work units, and the largest run of units of one
-    /// (α, β) slice, computed and encoded before it is written, plus one unit per thread.
+    /// Memory at the peak: the largest batch of units (a slice, or several small ones),
+    /// computed and encoded before it is written, plus one unit per thread, and the list of
+    /// the journal's units.
     pub memory_bytes: f64,
 }
 
@@ -221,12 +222,13 @@ pub fn footprint(scene: &Scene, shard: Shard, threads: usize) -> Footprint {
         .map(|v| v.kind.bytes_per_cell(slots))
         .sum::<usize>() as f64;
     let cells = share * unit_cells;
-    let slice_run = share.min(per_slice) * unit_cells;
+    let batch = (share.min(per_slice) * unit_cells).max((BATCH_CELLS as f64).min(cells));
+    // A BTreeSet<usize> of the journal's units: about 3 words an entry.
+    let journal_list = share * 24.0;
     Footprint {
         cells,
         disk_bytes: 2.0 * cells * bytes_per_cell,
-        memory_bytes: total * std::mem::size_of::<atlas::Unit>() as f64
-            + (2.0 * slice_run + threads as f64 * unit_cells) * bytes_per_cell,
+        memory_bytes: journal_list + (2.0 * batch + threads as f64 * unit_cells) * bytes_per_cell,
     }
 }
 
@@ -316,43 +318,41 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
 
     let variables = atlas::scene_variables(scene);
     let shape = scene.shape();
-    let all_units = atlas::units(shape);
     let region = request.shard.region(shape);
     let chunk_rows = region.chunk_rows(shape);
-    let mine: Vec<Unit> = request
-        .shard
-        .units(&all_units, shape)
-        .into_iter()
-        .cloned()
-        .collect();
-    let mine = &mine[..];
     let cells_of = |u: &Unit| u.rows.len() * scene.energy.len();
     // Units with a file in the journal; each is checked when it is read, below, and computed
     // again if its file turns out damaged.
     let listed = journal.listed_units()?;
-    let done: Vec<bool> = mine.iter().map(|u| listed.contains(&u.index)).collect();
-    let total: u64 = mine.iter().map(|u| cells_of(u) as u64).sum();
-    let done_cells: u64 = mine
-        .iter()
-        .zip(&done)
-        .filter(|(_, &d)| d)
-        .map(|(u, _)| cells_of(u) as u64)
-        .sum();
+    let units_total = atlas::unit_count(shape);
+    let kept_cells = |listed: &std::collections::BTreeSet<usize>| -> u64 {
+        listed
+            .iter()
+            .filter(|&&i| i < units_total)
+            .map(|&i| atlas::unit(shape, i))
+            .filter(|u| region.holds(u))
+            .map(|u| cells_of(&u) as u64)
+            .sum()
+    };
+    let total = region.shape().iter().product::<usize>() as u64;
+    let done_cells = kept_cells(&listed);
     let mut summary = Summary {
-        units: mine.len(),
+        units: region.unit_count(shape),
         ..Summary::default()
     };
     progress.begin(total, done_cells);
 
-    // Unit by unit, the units of one (α, β) slice in parallel (and within each unit its κ-rows,
-    // one at a time, so that no thread idles at a slice's end): compute, keep in the journal,
-    // encode as the file stores it; then the slice's chunks are written in order. The file is
-    // written afresh by every invocation: the journal, not the file, survives a kill.
+    // Batch by batch, the units of a batch in parallel (and within each unit its κ-rows, one
+    // at a time, so that no thread idles at a batch's end): compute, keep in the journal,
+    // encode as the file stores it; then the batch's chunks are written in order. A batch
+    // is a slice, or several small slices (a grid of one-cell slices keeps every thread
+    // busy). The file is written afresh by every invocation: the journal, not the file,
+    // survives a kill.
     let tmp = temporary_path(out);
     if tmp.exists() {
         std::fs::remove_file(&tmp).map_err(|e| AtlasError::atlas(&tmp, e))?;
     }
-    let mut attributes = scene_attributes(scene, request.shard, all_units.len());
+    let mut attributes = scene_attributes(scene, request.shard, units_total);
     attributes.extend(request.attributes.iter().cloned());
     let advance = |cells: usize| progress.advance(cells as u64);
     let written = (|| -> Result<()> {
@@ -364,17 +364,13 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
             &axis,
             &borrowed(&attributes),
         )?;
-        let mut first = 0;
-        for run in slice_runs(mine) {
-            let run_done = &done[first..first + run.len()];
-            first += run.len();
-            let encoded = run
+        for batch in batches(request.shard.units(shape), shape) {
+            let encoded = batch
                 .par_iter()
-                .zip(run_done)
-                .map(|(u, &was_done)| -> Result<Option<(EncodedUnit, Summary)>> {
+                .map(|u| -> Result<Option<(EncodedUnit, Summary)>> {
                     // A unit of the journal is taken as it was stored; a damaged one (torn by
                     // a power loss) is computed again.
-                    if was_done {
+                    if listed.contains(&u.index) {
                         if let Some((chunks, words)) =
                             journal.read(u.index, variables.len(), Summary::WORDS)
                         {
@@ -412,7 +408,7 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
                     total,
                 });
             }
-            for (u, (chunks, part)) in run.iter().zip(encoded.into_iter().flatten()) {
+            for (u, (chunks, part)) in batch.iter().zip(encoded.into_iter().flatten()) {
                 file.write_encoded(u, &chunks)?;
                 summary.add(&part);
             }
@@ -424,12 +420,7 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
         let _ = std::fs::remove_file(&tmp);
         if let AtlasError::Interrupted { path, total, .. } = e {
             // What a resumed run will find: the units the journal holds now.
-            let kept = journal.listed_units().unwrap_or_default();
-            let done = mine
-                .iter()
-                .filter(|u| kept.contains(&u.index))
-                .map(|u| cells_of(u) as u64)
-                .sum();
+            let done = kept_cells(&journal.listed_units().unwrap_or_default());
             return Err(AtlasError::Interrupted { path, done, total });
         }
         return Err(e);
@@ -474,7 +465,6 @@ pub fn merge(
     let scene = Scene::parse(&scene_text, &first.display().to_string())?;
     let variables = atlas::scene_variables(&scene);
     let shape = scene.shape();
-    let all_units = atlas::units(shape);
     let fingerprint = format!("{:016x}", scene.fingerprint());
     let axis = AtlasFile::read_axis(first)?;
     let mut by_index: Vec<Option<(PathBuf, AtlasFile)>> = Vec::new();
@@ -558,7 +548,7 @@ pub fn merge(
     if tmp.exists() {
         std::fs::remove_file(&tmp).map_err(|e| AtlasError::atlas(&tmp, e))?;
     }
-    let mut attributes = scene_attributes(&scene, Shard::WHOLE, all_units.len());
+    let mut attributes = scene_attributes(&scene, Shard::WHOLE, atlas::unit_count(shape));
     let whole = Region::whole(shape);
     let chunk_rows = whole.chunk_rows(shape);
     // Provenance of the computation: the first shard's program and commit.
@@ -581,7 +571,7 @@ pub fn merge(
     ));
     attributes.extend(extra_attributes.iter().cloned());
     let mut summary = Summary {
-        units: all_units.len(),
+        units: atlas::unit_count(shape),
         ..Summary::default()
     };
     let n = by_index.len();
@@ -600,11 +590,11 @@ pub fn merge(
                 index: i + 1,
                 count: n,
             };
-            for u in shard.units(&all_units, shape) {
-                let block = source.read_unit(u)?;
+            for u in shard.units(shape) {
+                let block = source.read_unit(&u)?;
                 summary.count(&variables, &block);
                 let encoded = encode_unit(&variables, &block, chunk_rows, scene.energy.len());
-                file.write_encoded(u, &encoded)?;
+                file.write_encoded(&u, &encoded)?;
             }
         }
         file.close()
@@ -618,9 +608,32 @@ pub fn merge(
     Ok(summary)
 }
 
-/// Consecutive runs of units of one (α, β) slice.
-fn slice_runs(units: &[Unit]) -> impl Iterator<Item = &[Unit]> {
-    units.chunk_by(|a, b| (a.alpha_index, a.beta_index) == (b.alpha_index, b.beta_index))
+/// Cells of a batch of small slices: enough work for every thread, little memory.
+const BATCH_CELLS: usize = 1 << 16;
+
+/// `units` in batches computed in parallel and then written: each slice whole (its units
+/// end together), and consecutive slices together until a batch holds [`BATCH_CELLS`] cells.
+fn batches(
+    units: impl Iterator<Item = Unit>,
+    shape: [usize; 4],
+) -> impl Iterator<Item = Vec<Unit>> {
+    let slice_cells = shape[2] * shape[3];
+    let mut units = units.peekable();
+    std::iter::from_fn(move || {
+        let mut batch: Vec<Unit> = Vec::new();
+        let mut cells = 0;
+        while let Some(u) = units.peek() {
+            let new_slice = batch
+                .last()
+                .is_none_or(|b| (b.alpha_index, b.beta_index) != (u.alpha_index, u.beta_index));
+            if new_slice && !batch.is_empty() && cells + slice_cells > BATCH_CELLS {
+                break;
+            }
+            cells += u.rows.len() * shape[3];
+            batch.push(units.next().expect("peeked"));
+        }
+        (!batch.is_empty()).then_some(batch)
+    })
 }
 
 /// A shard file's `shard_index` and `shard_count`, checked (they are the file's word).

@@ -214,13 +214,7 @@ impl Request {
                 reason: "must satisfy 0 < tol < 1",
             });
         }
-        if self.samples == 0 {
-            return Err(AtlasError::InvalidParameter {
-                name: "samples",
-                value: 0.0,
-                reason: "must be >= 1",
-            });
-        }
+        crate::error::check_samples(self.samples)?;
         let start = self.start(body)?;
         let positive = |name, value| {
             crate::error::check_range(

@@ -42,6 +42,28 @@ pub const KAPPA_CEIL: f64 = 1e4;
 const HIGH_ENERGY_TAIL: [f64; 3] = [1e-3, 1e-4, 1e-6];
 /// Relative offsets of the energies probed on either side of every separatrix level.
 const SEPARATRIX_PROBES: [f64; 8] = [1e-1, 1e-2, 1e-3, 1e-5, 1e-7, 1e-9, 1e-11, 1e-13];
+/// The bodies the verdict decides: β and η within these bounds (α ∈ [0, 1) and ν ∈ (0, 2]
+/// throughout). There the κ-lines from [`KAPPA_FLOOR`] to [`KAPPA_CEIL`] span the critical set
+/// and the resonances the limits do not cover, and a verdict takes about a second at most
+/// (`cargo bench --bench verdict`, docs/hypothesis.md). Beyond them the body's features move
+/// off that range (the critical set's κ grows like √β, its ε like β) and the sampling no
+/// longer rests on anything checked: the verdict is `undecided`, with the reason, at once.
+pub const BETA_RANGE: [f64; 2] = [1e-3, 1e3];
+pub const ETA_RANGE: [f64; 2] = [1e-3, 1e3];
+
+/// Why the verdict does not decide a body outside [`BETA_RANGE`] × [`ETA_RANGE`], if so.
+pub fn outside_checked_range(beta: f64, eta: f64) -> Option<String> {
+    let outside = |name: &str, value: f64, [lo, hi]: [f64; 2]| {
+        (!(lo..=hi).contains(&value)).then(|| {
+            format!(
+                "{name} = {} is outside {lo:e} <= {name} <= {hi:e}, the bodies over which the verdict's sampling is checked",
+                crate::error::show(value)
+            )
+        })
+    };
+    outside("beta", beta, BETA_RANGE).or_else(|| outside("eta", eta, ETA_RANGE))
+}
+
 /// At most this many counterexamples per integer, and integers reported.
 const PER_INTEGER: usize = 2;
 const INTEGERS_REPORTED: usize = 6;
@@ -228,6 +250,9 @@ struct Sampler<'a> {
     body: &'a EllipsoidBody,
     cell: CellOptions,
     energies: usize,
+    /// Asked to stop: no new component is solved (the verdict then returns
+    /// [`AtlasError::Stopped`]).
+    stop: &'a (dyn Fn() -> bool + Sync),
 }
 
 impl Sampler<'_> {
@@ -265,6 +290,9 @@ impl Sampler<'_> {
         let shape = (minima.len(), levels.len());
         let mut out = Vec::with_capacity(energies.len() * 2);
         for (energy, grid) in energies {
+            if (self.stop)() {
+                return out;
+            }
             let Ok(components) = potential.components(energy) else {
                 continue;
             };
@@ -310,6 +338,9 @@ impl Sampler<'_> {
         of: &Sample,
         drift: bool,
     ) -> Option<(usize, crate::cell::ComponentResult)> {
+        if (self.stop)() {
+            return None;
+        }
         let potential = EffectivePotential::new(self.body, kappa);
         let minima = potential.minimum_sites();
         let levels = potential.separatrix_levels();
@@ -558,6 +589,23 @@ fn polish_fold(
 
 /// The verdict for one body with α ≥ 0.
 pub fn verdict(body: &EllipsoidBody, options: &VerdictOptions) -> Result<Verdict> {
+    verdict_until(body, options, &|| false)
+}
+
+/// [`verdict`], given up when `stop` says so (polled between components and phases): then
+/// [`AtlasError::Stopped`].
+pub fn verdict_until(
+    body: &EllipsoidBody,
+    options: &VerdictOptions,
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Result<Verdict> {
+    let stopped = || -> Result<()> {
+        if stop() {
+            Err(AtlasError::Stopped)
+        } else {
+            Ok(())
+        }
+    };
     let (alpha, beta) = (body.shape.alpha, body.shape.beta);
     if alpha < 0.0 {
         return Err(AtlasError::InvalidParameter {
@@ -581,7 +629,13 @@ pub fn verdict(body: &EllipsoidBody, options: &VerdictOptions) -> Result<Verdict
         });
     }
     let case = Case::of(alpha, beta);
-    let high_energy = HighEnergyLimit::of(body, options.tol.min(1e-12))?;
+    // Beyond the checked bodies even the limit is not computed (at β = 1e10 its quadrature
+    // takes a minute and means nothing): its values are null there.
+    let outside = outside_checked_range(beta, body.eta).filter(|_| case != Case::NotCovered);
+    let high_energy = match outside {
+        Some(_) => HighEnergyLimit::not_computed(),
+        None => HighEnergyLimit::of(body, options.tol.min(1e-12))?,
+    };
     let diagram_type = DiagramType::of(alpha, beta);
     let mut verdict = Verdict {
         alpha,
@@ -613,19 +667,24 @@ pub fn verdict(body: &EllipsoidBody, options: &VerdictOptions) -> Result<Verdict
     if case == Case::NotCovered {
         return Ok(verdict);
     }
+    if let Some(reason) = outside {
+        verdict.evidence.undecided = Some(reason);
+        return Ok(verdict);
+    }
     let cell = CellOptions {
         tol: options.tol,
         drift: false,
         ..CellOptions::default()
     };
     // The critical set, untruncated (its cusp bounds the fold's window).
+    stopped()?;
     let set = CriticalSet::of(body, 400, 1e6)?;
     let cusp_kappa = set.cusp.map(|c| c.kappa);
     // The region of the hypothesis: κ > 0 (case 1) or κ > κ_max (case 2).
     let mut undecided = None;
     let lo = match case {
         Case::Two => match kappa_max(body, &set, options.tol)? {
-            Some((k, err)) => {
+            Some((k, err)) if k.is_finite() && err.is_finite() => {
                 verdict.kappa_max = Some(k);
                 verdict.kappa_max_error = Some(err);
                 // Just above the fold: its own error, and a relative step past it.
@@ -634,16 +693,27 @@ pub fn verdict(body: &EllipsoidBody, options: &VerdictOptions) -> Result<Verdict
             // No fold found: the region of the hypothesis is unknown below some κ. Only the
             // lines beyond every window tried are examined, and only a failure there (or one
             // the high-energy limit proves) decides; otherwise the verdict is undecided.
-            None => {
-                undecided = Some(
-                    "kappa_max not found: no N = 0 fold was traced beside sigma_u near the cusp"
+            unresolved => {
+                undecided = Some(match unresolved {
+                    Some((k, _)) => format!(
+                        "kappa_max not resolved: the N = 0 curve beside sigma_u tops out near kappa = {} without a finite error bar",
+                        crate::error::show(k)
+                    ),
+                    None => "kappa_max not found: no N = 0 fold was traced beside sigma_u near the cusp"
                         .to_string(),
-                );
+                });
                 2.0 * cusp_kappa.unwrap_or(1.0) + 1.0
             }
         },
         _ => KAPPA_FLOOR,
     };
+    if lo >= KAPPA_CEIL {
+        verdict.evidence.undecided = Some(format!(
+            "the region of the hypothesis starts at kappa = {}, above the last kappa-line ({KAPPA_CEIL:e})",
+            crate::error::show(lo)
+        ));
+        return Ok(verdict);
+    }
     let linear_top = (3.0 * lo).max(4.0).max(3.0 * cusp_kappa.unwrap_or(0.0));
     // A failure needs one confirmed counterexample: with `coarse_first`, half the
     // resolution is searched first, and the full one only if that finds none (a verdict that
@@ -657,6 +727,7 @@ pub fn verdict(body: &EllipsoidBody, options: &VerdictOptions) -> Result<Verdict
             body,
             cell,
             energies: half,
+            stop,
         };
         let lines: Vec<Vec<Sample>> = kappas.par_iter().map(|&k| sampler.line(k)).collect();
         if !counterexamples(&sampler, &brackets(&lines, options.tol))
@@ -667,16 +738,19 @@ pub fn verdict(body: &EllipsoidBody, options: &VerdictOptions) -> Result<Verdict
             coarse = Some((kappas, lines));
         }
     }
+    stopped()?;
     let sampler = Sampler {
         body,
         cell,
         energies: resolution,
+        stop,
     };
     let (kappas, lines) = coarse.unwrap_or_else(|| {
         let kappas = kappa_lines(lo, linear_top, resolution);
         let lines: Vec<Vec<Sample>> = kappas.par_iter().map(|&k| sampler.line(k)).collect();
         (kappas, lines)
     });
+    stopped()?;
     let candidates = brackets(&lines, options.tol);
     let all: Vec<&Sample> = lines.iter().flatten().collect();
     let (n_lo, n_hi) = all
@@ -737,7 +811,9 @@ pub fn verdict(body: &EllipsoidBody, options: &VerdictOptions) -> Result<Verdict
     } else {
         Some(true)
     };
+    stopped()?;
     let margins = fail_margin(&sampler, &lines, &high_energy, n_lo, n_hi);
+    stopped()?;
     verdict.fail_margin = margins.value();
     verdict.margins = Some(margins);
     verdict.evidence = Evidence {
@@ -1198,6 +1274,17 @@ fn key(v: &Verdict) -> (Case, Option<bool>) {
 /// checked by the verdict on both sides of the root; a change no limit explains is located
 /// by bisection on the verdict itself.
 pub fn boundaries(alpha: f64, nu: f64, eta: f64, options: &BoundaryOptions) -> Result<Boundaries> {
+    boundaries_until(alpha, nu, eta, options, &|| false)
+}
+
+/// [`boundaries`], given up when `stop` says so: then [`AtlasError::Stopped`].
+pub fn boundaries_until(
+    alpha: f64,
+    nu: f64,
+    eta: f64,
+    options: &BoundaryOptions,
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Result<Boundaries> {
     let (b0, b1) = (options.beta_min, options.beta_max);
     if !(b0.is_finite() && b0 > 0.0) {
         return Err(AtlasError::InvalidParameter {
@@ -1213,6 +1300,24 @@ pub fn boundaries(alpha: f64, nu: f64, eta: f64, options: &BoundaryOptions) -> R
             reason: "must be finite and above beta-min",
         });
     }
+    // Only bodies the verdict decides: a boundary is a change between two decided verdicts.
+    for (name, value) in [("beta-min", b0), ("beta-max", b1)] {
+        if !(BETA_RANGE[0]..=BETA_RANGE[1]).contains(&value) {
+            return Err(AtlasError::InvalidParameter {
+                name,
+                value,
+                reason:
+                    "must lie in 1e-3 ... 1e3, the bodies the verdict decides (docs/hypothesis.md)",
+            });
+        }
+    }
+    if !(ETA_RANGE[0]..=ETA_RANGE[1]).contains(&eta) {
+        return Err(AtlasError::InvalidParameter {
+            name: "eta",
+            value: eta,
+            reason: "must lie in 1e-3 ... 1e3 for the boundaries, the bodies the verdict decides (docs/hypothesis.md)",
+        });
+    }
     if !(4..=10_000).contains(&options.scan) {
         return Err(AtlasError::InvalidParameter {
             name: "scan",
@@ -1223,13 +1328,14 @@ pub fn boundaries(alpha: f64, nu: f64, eta: f64, options: &BoundaryOptions) -> R
     // Validates α, ν, η once.
     EllipsoidBody::ellipsoid(alpha, 1.0, nu, eta)?;
     let body = |beta: f64| EllipsoidBody::ellipsoid(alpha, beta, nu, eta);
-    let run = |beta: f64| -> Result<Verdict> { verdict(&body(beta)?, &options.verdict) };
+    let run =
+        |beta: f64| -> Result<Verdict> { verdict_until(&body(beta)?, &options.verdict, stop) };
     // Inside the root-finding only the margin is needed.
     let margin_only = VerdictOptions {
         counterexamples: false,
         ..options.verdict
     };
-    let margin = |beta: f64| -> Result<Verdict> { verdict(&body(beta)?, &margin_only) };
+    let margin = |beta: f64| -> Result<Verdict> { verdict_until(&body(beta)?, &margin_only, stop) };
     let mut betas: Vec<f64> = (0..options.scan)
         .map(|i| (b0.ln() + (b1.ln() - b0.ln()) * i as f64 / (options.scan - 1) as f64).exp())
         .collect();

@@ -765,7 +765,7 @@ def cells(
         with excess_energy, or lambda_ with s; `allow_large` or `progress` not True or
         False; `threads` not a whole number.
     KeyboardInterrupt
-        Ctrl-C stops a call within milliseconds.
+        Ctrl-C stops a call within one cell's time (0.2 s measured on 4 million cells).
 
     See Also
     --------

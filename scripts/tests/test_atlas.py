@@ -164,7 +164,7 @@ def test_the_plot_script_says_what_is_missing_instead_of_a_traceback(make_atlas,
     out = subprocess.run([sys.executable, str(ROOT / "scripts" / "plot_atlas.py"), str(atlas), "--out",
                           str(tmp_path / "x.png")], capture_output=True, text=True)
     assert out.returncode != 0
-    assert "no finite rotation_number" in out.stderr and "Traceback" not in out.stderr
+    assert "neither rotation_number nor drift_radius" in out.stderr and "Traceback" not in out.stderr
 
 
 @pytest.mark.parametrize("script", ["figures", "hypothesis", "plot_atlas", "plot_trajectory", "plot_work_precision",

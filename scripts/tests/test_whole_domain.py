@@ -52,6 +52,20 @@ def test_reproductions_are_right_or_honest(case):
     assert not outcome.problems, outcome.problems
 
 
+def test_stored_references_are_the_reference():
+    """whole_domain_references.json (the references of the sample below, kept because they
+    take a second each) holds what reference.py computes: six cells of it, spread over the
+    file, computed afresh, and the stored file covers the sample the next test checks."""
+    data = whole_domain.stored()
+    cases = whole_domain.reproductions() + whole_domain.sample(12, CELLS)
+    bodies = [(c.alpha, c.beta, c.nu, c.eta, c.kappa) for c in cases]
+    assert all(whole_domain._key(*b) in data["levels"] for b in bodies), "run whole_domain.py --write-references"
+    for case in cases[:: max(1, len(cases) // 6)][:6]:
+        key, levels, cell_key, comps = whole_domain._computed(case)
+        assert data["levels"][key] == levels
+        assert data["components"][cell_key] == comps
+
+
 def test_whole_domain_is_honest():
     """A seeded random sample over the domain of issue 12 (seed 12)."""
     outcomes = whole_domain.check_all(whole_domain.sample(12, CELLS))

@@ -75,12 +75,12 @@ pub(super) fn cell(args: CellArgs) -> Result<()> {
     }
     println!(
         "cell alpha={} beta={} nu={} eta={} kappa={} energy={} ({}, tol {:e}): {}",
-        args.level.shape.alpha,
-        args.level.shape.beta,
-        args.level.nu,
-        args.level.eta,
-        args.level.kappa,
-        energy,
+        show(args.level.shape.alpha),
+        show(args.level.shape.beta),
+        show(args.level.nu),
+        show(args.level.eta),
+        show(args.level.kappa),
+        show(energy),
         json_name(&options.method),
         args.tol,
         if result.components.is_empty() {

@@ -30,7 +30,7 @@ pub struct DiagramArgs {
     #[arg(long)]
     pub force: bool,
     /// Samples of θ0 per half (θ0 < π/2, θ0 > π/2) of the fixed-point curves.
-    #[arg(long, default_value_t = 2000)]
+    #[arg(long, default_value_t = 2000, allow_hyphen_values = true)]
     pub samples: usize,
     #[command(flatten)]
     pub limits: Limits,
@@ -50,7 +50,7 @@ pub(super) fn diagram(args: DiagramArgs) -> Result<()> {
         per_sample,
         args.out.as_ref().map(|_| per_sample),
         args.out.as_deref(),
-        "use fewer --samples",
+        &|| "use fewer --samples".into(),
     )?;
     let body = EllipsoidBody::ellipsoid(args.shape.alpha, args.shape.beta, args.nu, args.eta)?;
     let set = CriticalSet::of(&body, args.samples, args.kappa_max)?;
@@ -81,30 +81,32 @@ pub(super) fn print_diagram(set: &CriticalSet) {
         set.diagram_type.label()
     );
     println!(
-        "  eps_min (roll over the top at kappa = 0) = {:.12}",
-        set.energy_min
+        "  eps_min (roll over the top at kappa = 0) = {}",
+        digits(set.energy_min, 12)
     );
     if let Some(t) = set.theta_star {
         println!("  inclined equilibrium theta* = {t:.12}");
     }
     for e in &set.equilibria {
         println!(
-            "  equilibrium {:<10} theta = {:.12}  eps = {:.12}  {}{}",
+            "  equilibrium {:<10} theta = {:.12}  eps = {}  {}{}",
             e.name,
             e.theta,
-            e.energy,
+            digits(e.energy, 12),
             if e.stable { "stable" } else { "unstable" },
             if e.isolated { ", isolated" } else { "" }
         );
     }
     if let Some(c) = &set.cusp {
         println!(
-            "  cusp theta_c = {:.12}  kappa_c = {:.12}  eps_c = {:.12}",
-            c.theta, c.kappa, c.energy
+            "  cusp theta_c = {:.12}  kappa_c = {}  eps_c = {}",
+            c.theta,
+            digits(c.kappa, 12),
+            digits(c.energy, 12)
         );
     }
     if let Some(k) = set.kappa_c_equator {
-        println!("  equator sigma_pi2 stable for |kappa| > {k:.12}");
+        println!("  equator sigma_pi2 stable for |kappa| > {}", digits(k, 12));
     }
     for b in &set.branches {
         let bottom = b
@@ -112,15 +114,15 @@ pub(super) fn print_diagram(set: &CriticalSet) {
             .map(|[lo, hi]| format!("  N at the bottom in [{lo:.6}, {hi:.6}]"))
             .unwrap_or_default();
         println!(
-            "  branch {:<10} {:<8} theta0 in [{:.6}, {:.6}]  kappa in [{:.6}, {:.6}]  eps in [{:.6}, {:.6}]{bottom}",
+            "  branch {:<10} {:<8} theta0 in [{:.6}, {:.6}]  kappa in [{}, {}]  eps in [{}, {}]{bottom}",
             b.name,
             if b.stable { "stable" } else { "unstable" },
             b.theta0_range[0],
             b.theta0_range[1],
-            b.kappa_range[0],
-            b.kappa_range[1],
-            b.energy_range[0],
-            b.energy_range[1]
+            digits(b.kappa_range[0], 6),
+            digits(b.kappa_range[1], 6),
+            digits(b.energy_range[0], 6),
+            digits(b.energy_range[1], 6)
         );
     }
 }

@@ -13,7 +13,7 @@ mod verdict;
 use anyhow::{Context, Result};
 use clap::{ArgGroup, Args, Parser, Subcommand, ValueEnum};
 use rubber_atlas::cf::AttrValue;
-use rubber_atlas::error::AtlasError;
+use rubber_atlas::error::{show, show_digits as digits, AtlasError};
 use rubber_atlas::machine::{disk_short, memory_short};
 use rubber_atlas::trajectory::Start;
 use rubber_atlas::EllipsoidBody;
@@ -110,7 +110,7 @@ impl Limits {
         memory: f64,
         disk: Option<f64>,
         out: Option<&std::path::Path>,
-        remedy: &str,
+        remedy: &dyn Fn() -> String,
     ) -> Result<()> {
         if self.allow_large {
             return Ok(());
@@ -125,8 +125,9 @@ impl Limits {
         Err(AtlasError::Atlas {
             path: out.map_or("the request".into(), |o| o.display().to_string()),
             reason: format!(
-                "needs {}; {remedy}; --allow-large runs it anyway",
-                short.join(" and ")
+                "needs {}; {}; --allow-large runs it anyway",
+                short.join(" and "),
+                remedy()
             ),
         }
         .into())

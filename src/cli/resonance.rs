@@ -37,7 +37,7 @@ pub struct ResonanceArgs {
     pub energy_max: f64,
     /// Rows of κ (and energies per row) of the seed scan; curves are also followed between
     /// rows, but a closed curve that crosses no row is missed.
-    #[arg(long, default_value_t = 48)]
+    #[arg(long, default_value_t = 48, allow_hyphen_values = true)]
     pub grid: usize,
     /// Tolerance of the cell solver (N on the curve equals P/Q to this).
     #[arg(long, default_value_t = 1e-10, allow_hyphen_values = true)]
@@ -160,9 +160,16 @@ pub(super) fn resonance(args: ResonanceArgs) -> Result<()> {
         return Ok(());
     }
     println!(
-        "N = {target} for alpha={} beta={} nu={} eta={}: {} curve(s) in kappa [{}, {}], energy [{:.6}, {}]",
-        args.shape.alpha, args.shape.beta, args.nu, args.eta, curves.len(),
-        options.kappa.0, options.kappa.1, options.energy.0, options.energy.1
+        "N = {target} for alpha={} beta={} nu={} eta={}: {} curve(s) in kappa [{}, {}], energy [{}, {}]",
+        show(args.shape.alpha),
+        show(args.shape.beta),
+        show(args.nu),
+        show(args.eta),
+        curves.len(),
+        show(options.kappa.0),
+        show(options.kappa.1),
+        digits(options.energy.0, 6),
+        show(options.energy.1)
     );
     if curves.is_empty() {
         println!(
@@ -185,10 +192,14 @@ pub(super) fn resonance(args: ResonanceArgs) -> Result<()> {
                 (a.min(p.energy), b.max(p.energy))
             });
         println!(
-            "[{i}] {} points{}, well theta = {:.6}, kappa in [{kmin:.6}, {kmax:.6}], energy in [{emin:.6}, {emax:.6}]",
+            "[{i}] {} points{}, well theta = {:.6}, kappa in [{}, {}], energy in [{}, {}]",
             c.points.len(),
             if c.closed { " (closed)" } else { "" },
-            c.points[0].well
+            c.points[0].well,
+            digits(kmin, 6),
+            digits(kmax, 6),
+            digits(emin, 6),
+            digits(emax, 6)
         );
     }
     Ok(())

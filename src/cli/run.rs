@@ -48,7 +48,7 @@ pub struct RunArgs {
     #[arg(long, value_name = "PATH")]
     pub out: Option<PathBuf>,
     /// Worker threads [default: RAYON_NUM_THREADS if set, else every core].
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_hyphen_values = true)]
     pub threads: Option<usize>,
     /// Continue an interrupted run of the same scene and output (finished units are kept).
     #[arg(long)]
@@ -136,11 +136,14 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
         need.memory_bytes,
         Some(need.disk_bytes),
         Some(&out),
-        &format!(
-            "the run has {:.3e} cells: {}use fewer kappa or energy points",
-            need.cells,
-            shards_to_fit(&scene, threads)
-        ),
+        // (The shard count is searched only for a refusal.)
+        &|| {
+            format!(
+                "the run has {:.3e} cells: {}use fewer kappa or energy points",
+                need.cells,
+                shards_to_fit(&scene, threads)
+            )
+        },
     )?;
     // The global pool, so that the run's serial parts (file creation, writing) stay on the
     // main thread: on a pool thread glibc grows that thread's heap a page at a time, and
@@ -199,7 +202,7 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
 
 /// The smallest shard count that tiles the grid and whose shards each fit in half the
 /// available memory, as a phrase for the refusal (the general advice when no count up to
-/// 2^20 does; "" when the machine's memory is unknown).
+/// 4096 does; "" when the machine's memory is unknown).
 pub(super) fn shards_to_fit(scene: &Scene, threads: usize) -> String {
     let Some(free) = rubber_atlas::machine::available_memory() else {
         return String::new();
@@ -208,7 +211,7 @@ pub(super) fn shards_to_fit(scene: &Scene, threads: usize) -> String {
     let most: usize = rubber_atlas::atlas::Region::positions(shape)
         .iter()
         .product();
-    (2..=most.min(1 << 20))
+    (2..=most.min(1 << 12))
         .map(|count| Shard { index: 1, count })
         .find(|s| {
             s.check_against(shape).is_ok()

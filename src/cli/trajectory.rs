@@ -19,7 +19,7 @@ pub struct TrajectoryArgs {
     pub start: StartArgs,
     /// Which component of the level set (κ, ε) to start on, counted from the smallest θ
     /// (with --energy) [default: 0].
-    #[arg(long, requires = "energy")]
+    #[arg(long, requires = "energy", allow_hyphen_values = true)]
     pub component: Option<usize>,
     /// Length in θ-periods of the starting component.
     #[arg(long, allow_hyphen_values = true)]
@@ -28,7 +28,7 @@ pub struct TrajectoryArgs {
     #[arg(long, allow_hyphen_values = true)]
     pub t_end: Option<f64>,
     /// Number of output intervals (the file has SAMPLES + 1 rows).
-    #[arg(long, default_value_t = 2000)]
+    #[arg(long, default_value_t = 2000, allow_hyphen_values = true)]
     pub samples: usize,
     #[command(flatten)]
     pub limits: Limits,
@@ -61,12 +61,10 @@ pub(super) fn trajectory(args: TrajectoryArgs) -> Result<()> {
     // Measured: 135 bytes of memory per sample at the peak; a CSV row of 10 columns is
     // under 250 bytes.
     let rows = args.samples as f64 + 1.0;
-    args.limits.check(
-        160.0 * rows,
-        Some(250.0 * rows),
-        Some(&args.out),
-        "use fewer --samples",
-    )?;
+    args.limits
+        .check(160.0 * rows, Some(250.0 * rows), Some(&args.out), &|| {
+            "use fewer --samples".into()
+        })?;
     let model = match args.model {
         ModelArg::Reduced => Model::Reduced,
         ModelArg::Full => Model::Full,

@@ -3,7 +3,7 @@
 
 use anyhow::Result;
 use clap::Args;
-use rubber_atlas::error::AtlasError;
+use rubber_atlas::error::{show, show_digits as digits, AtlasError};
 use rubber_atlas::verdict::{self, VerdictOptions};
 use rubber_atlas::EllipsoidBody;
 
@@ -38,14 +38,14 @@ pub struct VerdictArgs {
     pub beta_max: Option<f64>,
     /// Log-spaced β of the scan behind --boundaries (the line β² = 1 + α is added)
     /// [default: 48].
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub scan: Option<usize>,
     /// Tolerance of the cell solver (N at a counterexample equals the integer to this).
     #[arg(long, default_value_t = 1e-10, allow_hyphen_values = true)]
     pub tol: f64,
     /// κ-lines of each kind and energies per line of the sampling (doubling it halves the
     /// spacing).
-    #[arg(long, default_value_t = 64)]
+    #[arg(long, default_value_t = 64, allow_hyphen_values = true)]
     pub resolution: usize,
     /// Print one JSON object (docs/hypothesis.md contract).
     #[arg(long)]
@@ -131,10 +131,10 @@ pub(super) fn print_verdict(v: &verdict::Verdict) {
     use verdict::Case;
     println!(
         "ellipsoid alpha = {}, beta = {} (nu = {}, eta = {}): diagram type ({})",
-        v.alpha,
-        v.beta,
-        v.nu,
-        v.eta,
+        show(v.alpha),
+        show(v.beta),
+        show(v.nu),
+        show(v.eta),
         v.diagram_type.label()
     );
     let case = match v.case {
@@ -146,10 +146,16 @@ pub(super) fn print_verdict(v: &verdict::Verdict) {
     };
     println!("  hypothesis: {case}");
     if let (Some(k), Some(e)) = (v.kappa_max, v.kappa_max_error) {
-        println!("  kappa_max = {k:.10} (+- {e:.1e}), the fold of the N = 0 curve beside sigma_u");
+        println!(
+            "  kappa_max = {} (+- {e:.1e}), the fold of the N = 0 curve beside sigma_u",
+            digits(k, 10)
+        );
     }
     let h = &v.high_energy;
-    println!(
+    if h.slope.is_nan() {
+        println!("  high energy: not computed");
+    } else {
+        println!(
         "  high energy: N_inf(lambda) ~ {:.6e} lambda at lambda -> 0; min {:.10} at lambda = {:.6}; max {:.10} at lambda = {:.6}",
         h.slope,
         h.n_min,
@@ -157,6 +163,7 @@ pub(super) fn print_verdict(v: &verdict::Verdict) {
         h.n_max,
         h.lambda_at_max
     );
+    }
     match v.holds {
         None => match &v.evidence.undecided {
             Some(why) => println!("  verdict: UNDECIDED ({why})"),
@@ -170,15 +177,15 @@ pub(super) fn print_verdict(v: &verdict::Verdict) {
     }
     for c in &v.counterexamples {
         println!(
-            "  counterexample: N = {} at kappa = {:.12}, energy = {:.12} (N = {:.3e} +- {:.1e}, theta in [{:.6}, {:.6}], drift {:.6} per period)",
+            "  counterexample: N = {} at kappa = {}, energy = {} (N = {:.3e} +- {:.1e}, theta in [{:.6}, {:.6}], drift {} per period)",
             c.integer,
-            c.kappa,
-            c.energy,
+            digits(c.kappa, 12),
+            digits(c.energy, 12),
             c.rotation_number,
             c.error_estimate,
             c.theta_min,
             c.theta_max,
-            c.drift
+            digits(c.drift, 6)
         );
     }
     if v.holds.is_some() {

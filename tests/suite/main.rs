@@ -4,6 +4,7 @@
 mod cell;
 mod cli;
 mod critical;
+mod domain;
 mod family;
 mod limits;
 mod model;

@@ -1,0 +1,193 @@
+//! The whole declared input domain of a cell and of the verdict (issue 22): every input in the
+//! stated ranges gets an answer or a one-line refusal, never a panic or a hang; a component
+//! without a value says so (no `bounded` without N, no NaN error estimate); far out on ε the
+//! cell agrees with the independent high-energy limit N∞(κ/√ε) within its error estimate;
+//! and the verdict answers extreme bodies at once, with its reason.
+
+use proptest::prelude::*;
+use proptest::test_runner::RngSeed;
+use rubber_atlas::cell::{solve_cell, CellOptions, Status};
+use rubber_atlas::limits::high_energy_rotation_number;
+use rubber_atlas::verdict::{self, verdict, verdict_until, BoundaryOptions, VerdictOptions};
+use rubber_atlas::{AtlasError, EllipsoidBody};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// 10^u: a number spread evenly over its decades.
+fn decades(lo: f64, hi: f64) -> impl Strategy<Value = f64> {
+    (lo..hi).prop_map(|u| 10f64.powf(u))
+}
+
+/// α over (−1, 1), with its ends (1 − α down to 1e-15) as likely as its middle.
+fn any_alpha() -> impl Strategy<Value = f64> {
+    prop_oneof![
+        -0.999_999f64..0.999_999,
+        decades(-15.0, -1.0).prop_map(|d| 1.0 - d),
+        decades(-15.0, -1.0).prop_map(|d| d - 1.0),
+        decades(-300.0, -1.0),
+    ]
+}
+
+/// Checks one solved cell: the properties every answer must have, whatever the input.
+fn check_answer(alpha: f64, beta: f64, nu: f64, eta: f64, kappa: f64, energy: f64) {
+    let Ok(body) = EllipsoidBody::ellipsoid(alpha, beta, nu, eta) else {
+        panic!("a body inside the stated ranges was refused: {alpha} {beta} {nu} {eta}");
+    };
+    let options = CellOptions {
+        drift: true,
+        ..CellOptions::default()
+    };
+    let cell = match solve_cell(&body, kappa, energy, &options) {
+        Ok(cell) => cell,
+        // A refusal must name an input (one line), never an internal step.
+        Err(e) => {
+            let text = e.to_string();
+            assert!(
+                !text.contains('\n') && !text.contains("node"),
+                "{text} at {alpha} {beta} {nu} {eta} {kappa} {energy}"
+            );
+            return;
+        }
+    };
+    let json = serde_json::to_string(&cell).expect("a cell serialises");
+    assert!(!json.contains("NaN"), "{json}");
+    for c in &cell.components {
+        let at = format!(
+            "{c:?} at alpha {alpha} beta {beta} nu {nu} eta {eta} kappa {kappa} energy {energy}"
+        );
+        if !c.rotation_number.is_finite() && c.status != Status::Separatrix {
+            assert_eq!(c.bounded, None, "bounded without N: {at}");
+        }
+        assert!(!c.error_estimate.is_nan(), "NaN error estimate: {at}");
+        if c.status == Status::Ok {
+            assert!(
+                c.rotation_number.is_finite() && c.period.is_finite() && c.period > 0.0,
+                "ok without values: {at}"
+            );
+            assert!(c.error_estimate <= options.tol, "ok beyond tol: {at}");
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: 200,
+        rng_seed: RngSeed::Fixed(20_261_124),
+        ..ProptestConfig::default()
+    })]
+
+    /// Cells over the whole declared domain: α ∈ (−1, 1), β and η over (0, ∞) as doubles
+    /// allow (η down to where 1/η overflows), ν ∈ (0, 2], |κ| ≤ 1e150, ε from the bottom of
+    /// the well to 1e300; each parameter at its extremes one time in four (a cell with
+    /// every parameter extreme takes seconds: 600 such cells took 7 minutes).
+    #[test]
+    fn every_cell_of_the_domain_answers_honestly(
+        alpha in any_alpha(),
+        beta in prop_oneof![3 => decades(-3.0, 3.0), 1 => decades(-300.0, 300.0)],
+        nu in prop_oneof![3 => decades(-3.0, 0.301), 1 => decades(-300.0, 0.301)],
+        eta in prop_oneof![3 => decades(-3.0, 3.0), 1 => decades(-308.0, 300.0), 1 => Just(5.6e-309)],
+        kappa in prop_oneof![1 => Just(0.0), 3 => decades(-4.0, 4.0), 1 => decades(-300.0, 150.0), 1 => decades(-300.0, 150.0).prop_map(|k| -k)],
+        lift in prop_oneof![3 => decades(-15.0, 6.0), 1 => decades(6.0, 300.0), 1 => Just(0.0)],
+    ) {
+        let nu = nu.min(2.0);
+        let Ok(body) = EllipsoidBody::ellipsoid(alpha, beta, nu, eta) else {
+            panic!("refused: {alpha} {beta} {nu} {eta}");
+        };
+        let bottom = rubber_atlas::torus::EffectivePotential::new(&body, kappa)
+            .lowest_minimum()
+            .unwrap_or(0.0);
+        let energy = (bottom + lift * bottom.abs().max(1.0)).min(1e300);
+        // Not a benchmark: a guard against hangs, far above any cell's time (milliseconds).
+        let started = std::time::Instant::now();
+        check_answer(alpha, beta, nu, eta, kappa, energy);
+        let seconds = started.elapsed().as_secs_f64();
+        prop_assert!(seconds < 10.0, "{seconds} s at {alpha:e} {beta:e} {nu:e} {eta:e} {kappa:e} {energy:e}");
+    }
+
+    /// Far out on ε (1e20 … 1e300) at fixed λ = κ/√ε the cell tends to N∞(λ), an integral
+    /// computed apart from the cell solver (docs/model.md): N stays within its error
+    /// estimate of N∞(λ) plus the O(1/ε) of the limit.
+    #[test]
+    fn cells_far_out_agree_with_the_high_energy_limit(
+        alpha in 0.0f64..0.95,
+        beta in decades(-1.0, 1.0),
+        lambda in prop_oneof![0.05f64..1.35, decades(-30.0, -1.0)],
+        energy in decades(20.0, 300.0),
+    ) {
+        let body = EllipsoidBody::ellipsoid(alpha, beta, 0.5, 0.5).unwrap();
+        let kappa = lambda * energy.sqrt();
+        prop_assume!(kappa <= 1e150);
+        let limit = high_energy_rotation_number(&body, lambda, 1e-13).unwrap();
+        let cell = solve_cell(&body, kappa, energy, &CellOptions::default()).unwrap();
+        let oscillating: Vec<_> = cell
+            .components
+            .iter()
+            .filter(|c| c.rotation_number.is_finite())
+            .collect();
+        prop_assert_eq!(oscillating.len(), 1);
+        let c = oscillating[0];
+        let gap = (c.rotation_number - limit.value).abs();
+        prop_assert!(
+            gap <= c.error_estimate + limit.error + 1e3 / energy,
+            "N = {} ± {:e} ({:?}) against N∞ = {} at lambda {lambda}, energy {energy:e}",
+            c.rotation_number, c.error_estimate, c.status, limit.value
+        );
+    }
+}
+
+/// The cells the adversary of issue 22 found, one by one.
+#[test]
+fn the_cells_issue_22_found_answer_honestly() {
+    // 1/η overflows: refused, naming η.
+    let refused = EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 5e-324).unwrap_err();
+    assert!(
+        refused.to_string().starts_with("invalid eta = 5e-324"),
+        "{refused}"
+    );
+    check_answer(0.5, 3.0, 0.5, 0.5, 6.7e129, 4.4e299);
+    for energy in [1e50, 1e100, 1e250, 1e300] {
+        check_answer(0.5, 3.0, 0.5, 0.5, 0.8, energy);
+    }
+}
+
+/// Bodies beyond the checked β and η answer at once, undecided, saying why; the edges of the
+/// checked range are decided.
+#[test]
+fn extreme_bodies_are_undecided_with_the_reason() {
+    let options = VerdictOptions::default();
+    for (alpha, beta, eta) in [
+        (0.5, 1e10, 0.5),
+        (0.5, 1e8, 0.5),
+        (0.5, 1e7, 0.5),
+        (0.5, 1e300, 0.5),
+        (0.5, 1e-10, 0.5),
+        (0.5, 1e-300, 0.5),
+        (0.5, 3.0, 1e-300),
+        (0.5, 3.0, 1e300),
+    ] {
+        let body = EllipsoidBody::ellipsoid(alpha, beta, 0.5, eta).unwrap();
+        let v = verdict(&body, &options).unwrap();
+        assert_eq!(v.holds, None, "beta {beta} eta {eta}");
+        let reason = v.evidence.undecided.clone().expect("a reason");
+        assert!(reason.contains("outside"), "{reason}");
+        let json = serde_json::to_string(&v).unwrap();
+        assert!(!json.contains("NaN"), "{json}");
+    }
+    // The boundaries are searched only where verdicts are decided.
+    let beyond = BoundaryOptions {
+        beta_min: 5e7,
+        beta_max: 1e8,
+        ..BoundaryOptions::default()
+    };
+    let refused = verdict::boundaries(0.5, 0.5, 0.5, &beyond).unwrap_err();
+    assert!(refused.to_string().contains("beta-min"), "{refused}");
+}
+
+/// A verdict asked to stop gives up between components (Ctrl-C in Python).
+#[test]
+fn a_verdict_stops_when_asked() {
+    let body = EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 0.5).unwrap();
+    let polls = AtomicUsize::new(0);
+    let stop = || polls.fetch_add(1, Ordering::Relaxed) >= 50;
+    let stopped = verdict_until(&body, &VerdictOptions::default(), &stop);
+    assert_eq!(stopped.unwrap_err(), AtlasError::Stopped);
+}
