@@ -8,8 +8,8 @@ within rounding of a critical level.
 
     python scripts/whole_domain.py --cells 300 --seed 12 [--out summary.csv]
 
-The references take about a second of CPU each: those of the reproductions and of the first
-300 cells of seed 12 are kept in `whole_domain_references.json` (the test suite checks
+The references take about a second of CPU each: those of the reproductions, of the first
+300 cells of seed 12 and of the tiny-κ cells of the tests are kept in `whole_domain_references.json` (the test suite checks
 samples of that file against the reference computed afresh), and made again by
 
     python scripts/whole_domain.py --cells 300 --seed 12 --write-references
@@ -240,6 +240,11 @@ FOUND = [
 ]
 
 
+def tiny_kappa() -> list[Case]:
+    """|κ| from 1e-60 to 1e-300 at a pole of the paper's body (the turning point as close)."""
+    return [Case(0.5, 3.0, 0.5, 0.5, kappa, 2.0, "tiny kappa") for kappa in (1e-60, 1e-160, 1e-200, 1e-300)]
+
+
 def reproductions() -> list[Case]:
     """The issue's reproductions and the cells found since (`FOUND`)."""
     issue = [Case(*r, origin=f"issue 12 #{label}") for label, r in zip(LABELS, REPRODUCTIONS)]
@@ -355,6 +360,7 @@ def main():
     args = parser.parse_args()
     cases = reproductions() + sample(args.seed, args.cells)
     if args.write_references:
+        cases += tiny_kappa()
         global _stored
         _stored = {"levels": {}, "components": {}}
         write_references(cases)

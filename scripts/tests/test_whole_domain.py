@@ -57,7 +57,7 @@ def test_stored_references_are_the_reference():
     take a second each) holds what reference.py computes: six cells of it, spread over the
     file, computed afresh, and the stored file covers the sample the next test checks."""
     data = whole_domain.stored()
-    cases = whole_domain.reproductions() + whole_domain.sample(12, CELLS)
+    cases = whole_domain.reproductions() + whole_domain.sample(12, CELLS) + whole_domain.tiny_kappa()
     bodies = [(c.alpha, c.beta, c.nu, c.eta, c.kappa) for c in cases]
     assert all(whole_domain._key(*b) in data["levels"] for b in bodies), "run whole_domain.py --write-references"
     for case in cases[:: max(1, len(cases) // 6)][:6]:
@@ -89,9 +89,10 @@ def test_ode_method_marks_a_component_it_cannot_integrate():
 def test_tiny_kappa_is_right_or_says_it_is_not():
     """|κ| from 1e-60 to 1e-300 at a pole (the turning point as close to it): T is right to
     its estimate, and N = ±½ lies within N's estimate whatever the status."""
-    for kappa in (1e-60, 1e-160, 1e-200, 1e-300):
-        truth = reference(0.5, 3.0, 0.5, 0.5, kappa, 2.0)
-        result = whole_domain.run_cell(whole_domain.Case(0.5, 3.0, 0.5, 0.5, kappa, 2.0, "tiny kappa"))
+    for case in whole_domain.tiny_kappa():
+        kappa = case.kappa
+        truth = whole_domain.reference(case.alpha, case.beta, case.nu, case.eta, kappa, case.energy)
+        result = whole_domain.run_cell(case)
         assert len(result["components"]) == len(truth) == 2
         for comp, ref in zip(result["components"], truth):
             assert abs(comp["period"] - ref.period) <= comp["errors"]["period"] + 4 * ref.period_error, kappa
