@@ -631,7 +631,7 @@ pub fn verdict_until(
     let case = Case::of(alpha, beta);
     // Beyond the checked bodies even the limit is not computed (at β = 1e10 its quadrature
     // takes a minute and means nothing): its values are null there.
-    let outside = outside_checked_range(beta, body.eta).filter(|_| case != Case::NotCovered);
+    let outside = outside_checked_range(beta, body.eta);
     let high_energy = match outside {
         Some(_) => HighEnergyLimit::not_computed(),
         None => HighEnergyLimit::of(body, options.tol.min(1e-12))?,

@@ -172,6 +172,11 @@ fn extreme_bodies_are_undecided_with_the_reason() {
         let json = serde_json::to_string(&v).unwrap();
         assert!(!json.contains("NaN"), "{json}");
     }
+    // A body the hypothesis does not cover answers at once too (α = 0, β = 1e6 took 39 s).
+    let body = EllipsoidBody::ellipsoid(0.0, 1e6, 0.5, 0.5).unwrap();
+    let v = verdict(&body, &options).unwrap();
+    assert_eq!((v.case, v.holds), (verdict::Case::NotCovered, None));
+    assert!(v.high_energy.slope.is_nan());
     // The boundaries are searched only where verdicts are decided.
     let beyond = BoundaryOptions {
         beta_min: 5e7,
