@@ -617,8 +617,8 @@ impl Shard {
     /// This shard's work units (among the grid's [`units`]), in their order, made on demand.
     pub fn units(&self, shape: [usize; 4]) -> impl Iterator<Item = Unit> {
         let region = self.region(shape);
-        let per_slice = shape[2].div_ceil(rows_per_unit(shape));
         let rows_per_unit = rows_per_unit(shape);
+        let per_slice = shape[2].div_ceil(rows_per_unit);
         let blocks = region.rows.start / rows_per_unit..region.rows.end.div_ceil(rows_per_unit);
         let nb = shape[1];
         region.alpha.clone().flat_map(move |ia| {

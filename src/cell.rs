@@ -349,17 +349,21 @@ fn far_out<S: Shape>(
     result: &mut ComponentResult,
 ) {
     let kappa = potential.kappa;
+    // Ū ≥ 1: ordinary cells leave here before U is evaluated (this runs for every libration).
+    if kappa == 0.0
+        || component.kind != MotionKind::Libration
+        || energy.is_nan()
+        || energy < FAR_OUT
+    {
+        return;
+    }
     let shape = &potential.body.shape;
     let scale = 1.0
         + [0.0, 0.5 * PI, PI]
             .iter()
             .map(|&t| shape.potential(t).abs())
             .fold(0.0, f64::max);
-    if kappa == 0.0
-        || component.kind != MotionKind::Libration
-        || energy.is_nan()
-        || energy < FAR_OUT * scale * scale
-    {
+    if energy < FAR_OUT * scale * scale {
         return;
     }
     let lambda = kappa.abs() / energy.sqrt();
