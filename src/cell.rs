@@ -6,6 +6,7 @@
 use crate::body::{Body, Shape};
 use crate::error::{AtlasError, Result};
 use crate::family::Family;
+use crate::limits::Estimate;
 use crate::period_ode;
 use crate::torus::{
     Component, CriticalKind, CriticalPoint, EffectivePotential, MotionKind, PeriodIntegrals,
@@ -313,9 +314,8 @@ pub fn solve_component<S: Shape>(
         // that their difference has no digit left there), the integrals have no value: the
         // component says so (and far out on ε, N is still the high-energy limit's).
         Err(AtlasError::NotPeriodic { .. }) => {
-            let mut result = unresolved(component);
-            far_out(potential, energy, component, options, &mut result);
-            return Ok(result);
+            let limit = far_out(potential, energy, component, options, f64::NAN, 0.0);
+            return Ok(unresolved_but(component, limit));
         }
         Err(e) => return Err(e),
     };
@@ -325,9 +325,15 @@ pub fn solve_component<S: Shape>(
     if let Some(d) = raw.drift.as_mut() {
         d.error += offset.drift;
     }
-    let mut result = finish(component, raw, options);
-    far_out(potential, energy, component, options, &mut result);
-    Ok(result)
+    let limit = far_out(
+        potential,
+        energy,
+        component,
+        options,
+        -raw.psi_advance / TAU,
+        raw.psi_advance_error / TAU,
+    );
+    Ok(finish(component, raw, limit, options))
 }
 
 /// ε above this many times Ū² (Ū the scale of U) is "far out": N(κ, ε) is the high-energy
@@ -337,17 +343,19 @@ pub fn solve_component<S: Shape>(
 const FAR_OUT: f64 = 1e24;
 
 /// Far out on ε ([`FAR_OUT`]), N of a libration is checked against the high-energy limit
-/// N∞(λ), λ = |κ|/√ε, an integral computed apart (`limits`, docs/hypothesis.md): where the
-/// quadrature's N lies beyond its own estimate plus the limit's bound (the limit's
-/// quadrature error, and 1e3·Ū·λ/ε for the O(Ū/ε) it leaves out) from the limit, or has no
-/// value, N and its error are the limit's (and ω_ψ = −N ω_θ follows).
+/// N∞(λ), λ = |κ|/√ε, an integral computed apart (`limits`, docs/hypothesis.md). Its bound is
+/// the limit's quadrature error plus 1e3·Ū·λ/ε for the O(Ū/ε) it leaves out. Returns the
+/// limit (signed as κ, with that bound) where it should replace the quadrature's `n` ± `n_error`:
+/// where that has no value, lies beyond both bounds from the limit, or misses the tolerance
+/// the limit meets.
 fn far_out<S: Shape>(
     potential: &EffectivePotential<'_, S>,
     energy: f64,
     component: &Component,
     options: &CellOptions,
-    result: &mut ComponentResult,
-) {
+    n: f64,
+    n_error: f64,
+) -> Option<Estimate> {
     let kappa = potential.kappa;
     // Ū ≥ 1: ordinary cells leave here before U is evaluated (this runs for every libration).
     if kappa == 0.0
@@ -355,7 +363,7 @@ fn far_out<S: Shape>(
         || energy.is_nan()
         || energy < FAR_OUT
     {
-        return;
+        return None;
     }
     let shape = &potential.body.shape;
     let scale = 1.0
@@ -364,33 +372,21 @@ fn far_out<S: Shape>(
             .map(|&t| shape.potential(t).abs())
             .fold(0.0, f64::max);
     if energy < FAR_OUT * scale * scale {
-        return;
+        return None;
     }
     let lambda = kappa.abs() / energy.sqrt();
-    let limit =
-        match crate::limits::high_energy_rotation_number(potential.body, lambda, options.tol) {
-            Ok(limit) if limit.value.is_finite() && limit.error.is_finite() => limit,
-            _ => return,
-        };
-    let n = kappa.signum() * limit.value;
-    let bound = limit.error + 1e3 * scale * lambda / energy + 2.0 * f64::EPSILON * n.abs();
-    let own = result.errors.rotation_number;
-    let contradicted =
-        !result.rotation_number.is_finite() || (result.rotation_number - n).abs() > own + bound;
-    if !contradicted {
-        return;
-    }
-    result.rotation_number = n;
-    result.error_estimate = bound;
-    result.errors.rotation_number = bound;
-    if result.omega_theta.is_finite() {
-        result.omega_psi = -n * result.omega_theta;
-        result.errors.omega_psi = n.abs() * result.errors.omega_theta + bound * result.omega_theta;
-    }
-    let settled = result.errors.period <= options.tol * result.period && bound <= options.tol;
-    if result.status == Status::ToleranceNotReached && settled && !options.drift {
-        result.status = Status::Ok;
-    }
+    let limit = crate::limits::high_energy_rotation_number(potential.body, lambda, options.tol)
+        .ok()
+        .filter(|l| l.value.is_finite() && l.error.is_finite())?;
+    let value = kappa.signum() * limit.value;
+    let bound = limit.error + 1e3 * scale * lambda / energy + 2.0 * f64::EPSILON * value.abs();
+    let replace = !(n.is_finite() && n_error.is_finite())
+        || (n - value).abs() > n_error + bound
+        || (n_error > options.tol && bound <= options.tol);
+    replace.then_some(Estimate {
+        value,
+        error: bound,
+    })
 }
 
 /// T, Δψ and Δζ of a libration or rotation by the chosen method.
@@ -595,7 +591,12 @@ fn level_offset_error<S: Shape>(
     .plus(tilted)
 }
 
-fn finish(component: &Component, raw: PeriodIntegrals, options: &CellOptions) -> ComponentResult {
+fn finish(
+    component: &Component,
+    raw: PeriodIntegrals,
+    far_out: Option<Estimate>,
+    options: &CellOptions,
+) -> ComponentResult {
     // Integrals that overflowed or lost every digit (extreme η, ε or κ) are no values: the
     // component says so rather than carry NaN into N, its error and the bounded flag.
     let drift_defined = raw
@@ -606,14 +607,29 @@ fn finish(component: &Component, raw: PeriodIntegrals, options: &CellOptions) ->
         && !raw.period_error.is_nan()
         && !raw.psi_advance_error.is_nan();
     if !(defined && drift_defined) {
-        return unresolved(component);
+        return unresolved_but(component, far_out);
     }
     let t = raw.period;
     let omega_theta = TAU / t;
-    let omega_psi = raw.psi_advance / t;
-    let n = -raw.psi_advance / TAU;
     let rel_t = raw.period_error / t;
-    let n_err = raw.psi_advance_error / TAU;
+    // Far out on ε, N is the high-energy limit's and ω_ψ = −N ω_θ follows.
+    let (n, n_err, omega_psi, omega_psi_err) = match far_out {
+        Some(limit) => (
+            limit.value,
+            limit.error,
+            -limit.value * omega_theta,
+            limit.value.abs() * omega_theta * rel_t + limit.error * omega_theta,
+        ),
+        None => {
+            let omega_psi = raw.psi_advance / t;
+            (
+                -raw.psi_advance / TAU,
+                raw.psi_advance_error / TAU,
+                omega_psi,
+                omega_psi.abs() * rel_t + raw.psi_advance_error / t,
+            )
+        }
+    };
     // A libration with ψ ≡ 0 (κ = 0) retraces its way out on the way back: Δζ = 0 exactly,
     // whatever the rounding (quadrature) or truncation (ODE method) of its integral.
     let planar = component.kind == MotionKind::Libration
@@ -624,21 +640,27 @@ fn finish(component: &Component, raw: PeriodIntegrals, options: &CellOptions) ->
         Some(d) => (d.value[0].hypot(d.value[1]), d.error, d.value),
         None => (f64::NAN, f64::NAN, [f64::NAN; 2]),
     };
-    let rotating = component.kind == MotionKind::Rotation;
     let (drift_radius, radius_error) = drift_radius(drift, drift_error, n, n_err);
-    let bounded = raw.drift.map(|d| {
-        if rotating {
-            return false;
-        }
-        let off = (n - n.round()).abs();
-        let resonant = off <= options.resonance_tol.max(n_err);
-        let moving = drift > d.error.max(64.0 * f64::EPSILON * d.scale);
-        !(resonant && moving)
+    let bounded = raw.drift.and_then(|d| {
+        let drift = Estimate {
+            value: drift,
+            error: drift_error,
+        };
+        let rotation = Estimate {
+            value: n,
+            error: n_err,
+        };
+        let rounding = if planar {
+            0.0
+        } else {
+            64.0 * f64::EPSILON * d.scale
+        };
+        boundedness(component.kind, rotation, drift, rounding, options)
     });
     let errors = ErrorEstimates {
         period: raw.period_error,
         omega_theta: omega_theta * rel_t,
-        omega_psi: omega_psi.abs() * rel_t + raw.psi_advance_error / t,
+        omega_psi: omega_psi_err,
         rotation_number: n_err,
         drift: drift_error,
         drift_radius: radius_error,
@@ -647,7 +669,9 @@ fn finish(component: &Component, raw: PeriodIntegrals, options: &CellOptions) ->
         || raw
             .drift
             .is_none_or(|d| d.error <= options.tol * d.scale.max(f64::MIN_POSITIVE));
-    let ok = raw.converged && rel_t <= options.tol && n_err <= options.tol && drift_ok;
+    // The limit's N does not need the ψ integral to have converged.
+    let converged = raw.converged || far_out.is_some();
+    let ok = converged && rel_t <= options.tol && n_err <= options.tol && drift_ok;
     ComponentResult {
         theta_min: component.theta_min(),
         theta_max: component.theta_max(),
@@ -670,6 +694,46 @@ fn finish(component: &Component, raw: PeriodIntegrals, options: &CellOptions) ->
         drift_vector,
         work: raw.work,
     }
+}
+
+/// Whether the path on the plane stays bounded (docs/model.md): a rotation (κ = 0, over the
+/// top) never; anything else unless N is an integer and Δζ ≠ 0. N counts as an integer
+/// within the resonance tolerance, or within its error estimate if that is larger; Δζ counts
+/// as 0 when it and its error are below `rounding`. `None` where the numbers cannot tell:
+/// N counts as an integer but Δζ is not told from 0, or N is known to no better than ±1/2.
+fn boundedness(
+    motion: MotionKind,
+    rotation_number: Estimate,
+    drift: Estimate,
+    rounding: f64,
+    options: &CellOptions,
+) -> Option<bool> {
+    if motion == MotionKind::Rotation {
+        return Some(false);
+    }
+    let n = rotation_number.value;
+    let off = (n - n.round()).abs();
+    if off > options.resonance_tol.max(rotation_number.error) {
+        return Some(true);
+    }
+    if drift.value <= rounding && drift.error <= rounding {
+        return Some(true);
+    }
+    if rotation_number.error >= 0.5 {
+        return None;
+    }
+    (drift.value > drift.error.max(rounding)).then_some(false)
+}
+
+/// [`unresolved`], with N from the high-energy limit where [`far_out`] gives it.
+fn unresolved_but(component: &Component, far_out: Option<Estimate>) -> ComponentResult {
+    let mut result = unresolved(component);
+    if let Some(limit) = far_out {
+        result.rotation_number = limit.value;
+        result.error_estimate = limit.error;
+        result.errors.rotation_number = limit.error;
+    }
+    result
 }
 
 /// A component whose integrals could not be computed: no values (NaN), unbounded errors,
@@ -703,27 +767,35 @@ fn unresolved(component: &Component) -> ComponentResult {
     }
 }
 
-/// R = |Δζ| / (2 |sin πN|) and its error; R = 0 when Δζ = 0 exactly (κ = 0 librations),
-/// with the error |δΔζ| / (2 |sin πN|): unbounded (∞) at N = 0, where any drift the
-/// rounding hides would be a straight line.
+/// R = |Δζ| / (2 |sin πN|) and a bound on its error over every |Δζ| and N within their
+/// errors: ∞ where N's error reaches an integer (a drift there would be a straight line),
+/// 0 when both Δζ and its error are 0 (κ = 0 librations).
 fn drift_radius(drift: f64, drift_error: f64, n: f64, n_error: f64) -> (f64, f64) {
-    if drift.is_nan() {
+    if drift.is_nan() || n.is_nan() {
         return (f64::NAN, f64::NAN);
     }
-    let s = (PI * n).sin().abs();
-    if drift == 0.0 {
-        return (
-            0.0,
-            if drift_error == 0.0 {
-                0.0
-            } else {
-                drift_error / (2.0 * s)
-            },
-        );
+    if drift == 0.0 && drift_error == 0.0 {
+        return (0.0, 0.0);
     }
-    let r = drift / (2.0 * s);
-    let rel = drift_error / drift + PI * n_error * (PI * n).cos().abs() / s;
-    (r, r * rel)
+    let s = (PI * n).sin().abs();
+    let r = if drift == 0.0 { 0.0 } else { drift / (2.0 * s) };
+    // |sin πx| over N ± δN: 0 if that holds an integer, else its smaller end (|sin πx| is
+    // concave between integers); at most |sin πN| + π δN. Less the rounding of sin(πN).
+    let rounding = 4.0 * f64::EPSILON * (1.0 + PI * n.abs());
+    let s_min = if (n - n.round()).abs() <= n_error {
+        0.0
+    } else {
+        let ends = (PI * (n - n_error))
+            .sin()
+            .abs()
+            .min((PI * (n + n_error)).sin().abs());
+        (ends - rounding).max(0.0)
+    };
+    let s_max = (s + PI * n_error + rounding).min(1.0);
+    let largest = (drift + drift_error) / (2.0 * s_min);
+    let smallest = (drift - drift_error).max(0.0) / (2.0 * s_max);
+    let error = (largest - r).max(r - smallest) + 2.0 * f64::EPSILON * r;
+    (r, if error.is_nan() { f64::INFINITY } else { error })
 }
 
 /// A maximum inside the component or at one of its ends whose computed level is ε itself.

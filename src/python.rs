@@ -434,7 +434,7 @@ fn trajectory<'py>(
     model: &str,
     tol: f64,
     allow_large: bool,
-) -> PyResult<(Bound<'py, PyDict>, [f64; 4])> {
+) -> PyResult<(Bound<'py, PyDict>, [f64; 5])> {
     let component = count("component", component, 0)?;
     let samples = count("samples", samples, 1)?;
     // As the command measured it: 135 bytes per sample at the peak.
@@ -467,12 +467,15 @@ fn trajectory<'py>(
         model,
         tol,
     };
-    let (start, traj) = py.detach(|| request.run(&body)).map_err(value_error)?;
+    // Ctrl-C is heard between integrator runs (at most 100,000 steps each).
+    let (start, traj) =
+        interruptible(py, &None, |stop| request.run_until(&body, stop))?.map_err(value_error)?;
     let start = [
         start.kappa,
         start.energy(&body),
         start.theta0,
         start.theta_dot0,
+        traj.energy_drift,
     ];
     Ok((table_dict(py, crate::table::trajectory(&traj))?, start))
 }

@@ -345,7 +345,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         let innermost = if self.kappa == 0.0 {
             cell
         } else {
-            (1e-3 * self.kappa.abs().sqrt()).max(f64::MIN_POSITIVE.sqrt())
+            1e-3 * self.kappa.abs().sqrt()
         };
         let mut logs = Vec::new();
         let mut x = innermost;
@@ -1515,17 +1515,21 @@ fn safe_newton(
             hi = x;
         }
         let newton = x - fx / dfx;
+        // A slope that overflowed (V′ ∝ κ²/sin³θ beyond 1e308, at θ below 1e-103 for
+        // κ ~ 1) gives no Newton step, only bisection: its zero step used to be taken for
+        // convergence (θ_min stuck at 8.3e-104 for every ε above 1e207 at κ = 0.8).
+        let usable = dfx != 0.0 && dfx.is_finite();
         // A Newton correction at the rounding level: x is the root to the last bit (without
         // this check the step would fall on a bracket end and restart bisection).
-        if dfx != 0.0 && (newton - x).abs() <= 2.0 * EPS * x.abs() {
+        if usable && (newton - x).abs() <= 2.0 * EPS * x.abs() {
             return newton;
         }
-        let next =
-            if dfx != 0.0 && newton > lo && newton < hi && (newton - x).abs() < 0.5 * step_before {
-                newton
-            } else {
-                0.5 * (lo + hi)
-            };
+        let next = if usable && newton > lo && newton < hi && (newton - x).abs() < 0.5 * step_before
+        {
+            newton
+        } else {
+            0.5 * (lo + hi)
+        };
         step_before = (next - x).abs();
         if next <= lo.min(hi) || next >= hi.max(lo) || next == x {
             return x;

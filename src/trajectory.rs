@@ -206,6 +206,16 @@ impl Request {
 
     /// Checks the request and integrates it on `body`: the start and the samples.
     pub fn run<S: Shape>(&self, body: &Body<S>) -> Result<(Start, Trajectory)> {
+        self.run_until(body, &|| false)
+    }
+
+    /// [`Request::run`], giving up with [`AtlasError::Stopped`] when `stop` says so (it is
+    /// asked at least every 100,000 integrator steps).
+    pub fn run_until<S: Shape>(
+        &self,
+        body: &Body<S>,
+        stop: &dyn Fn() -> bool,
+    ) -> Result<(Start, Trajectory)> {
         let tol = self.tol;
         if !(tol.is_finite() && tol > 0.0 && tol < 1.0) {
             return Err(AtlasError::InvalidParameter {
@@ -229,7 +239,7 @@ impl Request {
             Duration::Periods(k) => positive("periods", k)? * start.period(body, 1e-13)?,
             Duration::Until(t) => positive("t-end", t)?,
         };
-        let traj = integrate(body, &start, self.model, t_end, self.samples, tol)?;
+        let traj = integrate(body, &start, self.model, t_end, self.samples, tol, stop)?;
         Ok((start, traj))
     }
 }
@@ -247,6 +257,9 @@ pub struct Trajectory {
     pub z_c: Vec<f64>,
     pub x_p: Vec<f64>,
     pub y_p: Vec<f64>,
+    /// The largest |ε(t) − ε(0)| / (1 + |ε(0)|) over the samples: how well the integrator
+    /// kept the energy (refused beyond max(1e3·tol, 1e-6)).
+    pub energy_drift: f64,
 }
 
 impl Trajectory {
@@ -291,8 +304,17 @@ impl<S: Shape> Rate<FULL_STATE_LEN> for FullSystem<'_, S> {
     }
 }
 
+/// The largest drift of the energy along a trajectory, relative to 1 + |ε(0)|, that is not
+/// taken for a lost trajectory: a thousand times the tolerance, and never below 1e-6.
+fn energy_drift_allowed(tol: f64) -> f64 {
+    (1e3 * tol).max(1e-6)
+}
+
 /// Integrates from `start` to `t_end` with DOP853 at tolerance `tol`, sampling `samples + 1`
-/// equally spaced times.
+/// equally spaced times. The energy ε (`eqsys`; in the full model the first integral
+/// T − ⟨r, γ⟩) is checked at every sample: a drift beyond [`energy_drift_allowed`] means the
+/// steps no longer resolve the motion (ε = 1e300 ended a period at θ = 0.9, not at
+/// θ_min = 8e-104), and the trajectory is refused rather than returned wrong.
 pub fn integrate<S: Shape>(
     body: &Body<S>,
     start: &Start,
@@ -300,14 +322,17 @@ pub fn integrate<S: Shape>(
     t_end: f64,
     samples: usize,
     tol: f64,
+    stop: &dyn Fn() -> bool,
 ) -> Result<Trajectory> {
     let mut out = Trajectory::default();
+    let mut energies = Vec::with_capacity(samples + 1);
     match model {
         Model::Reduced => {
             let sys = ReducedSystem::new(body, start.kappa);
             let y0 = ReducedState::from([start.theta0, start.theta_dot0, 0.0, 0.0, 0.0, 0.0]);
-            let sol = integrate_sampled(&sys, y0, t_end, samples, tol)?;
+            let sol = integrate_sampled(&sys, y0, t_end, samples, tol, stop)?;
             for (t, y) in sol.times.iter().zip(&sol.states) {
+                energies.push(sys.energy(y[0], y[1]));
                 let (dx, dy) = sys.contact_offset(y[0], y[3]);
                 out.t.push(*t);
                 out.theta.push(y[0]);
@@ -332,9 +357,10 @@ pub fn integrate<S: Shape>(
                 0.0,
                 0.0,
             );
-            let sol = integrate_sampled(&sys, y0, t_end, samples, tol)?;
+            let sol = integrate_sampled(&sys, y0, t_end, samples, tol, stop)?;
             let mut prev: Option<(f64, f64)> = None;
             for (t, y) in sol.times.iter().zip(&sol.states) {
+                energies.push(sys.integrals(y).energy);
                 let (theta, phi, psi) = FullSystem::<S>::euler_angles(y);
                 // Unwrap φ and ψ so that they are continuous in time like the reduced ones.
                 let (phi, psi) = match prev {
@@ -358,6 +384,27 @@ pub fn integrate<S: Shape>(
                 out.y_p.push(yp);
             }
         }
+    }
+    let scale = 1.0 + energies[0].abs();
+    out.energy_drift = energies
+        .iter()
+        .map(|e| (e - energies[0]).abs() / scale)
+        .fold(0.0, f64::max);
+    let allowed = energy_drift_allowed(tol);
+    if let Some(i) = energies.iter().position(|e| {
+        let d = (e - energies[0]).abs();
+        d.is_nan() || d > allowed * scale
+    }) {
+        return Err(AtlasError::Integration {
+            time: out.t[i],
+            reason: format!(
+                "the energy drifted from {} to {} (more than {} of 1 + |energy|): the steps \
+                 no longer resolve the motion",
+                crate::error::show(energies[0]),
+                crate::error::show(energies[i]),
+                crate::error::show(allowed)
+            ),
+        });
     }
     Ok(out)
 }

@@ -383,6 +383,11 @@ fn ambiguity(s: &Sample, tol: f64) -> f64 {
     s.error.max(tol).max(SIGN_FLOOR)
 }
 
+/// Whether a sample's N is within its error bar ([`ambiguity`]) of an integer.
+fn on_integer(s: &Sample, tol: f64) -> bool {
+    (s.n - s.n.round()).abs() <= ambiguity(s, tol)
+}
+
 /// Integers k strictly between the N of two samples whose N − k have reliable signs; with one
 /// sample, the integer it is on within its error bar (a body whose symmetry makes N an
 /// integer on a whole family, such as N ≡ 0 at α = 0). Only interior samples count alone: at
@@ -676,6 +681,8 @@ pub fn verdict_until(
         drift: false,
         ..CellOptions::default()
     };
+    // α = 0: V is symmetric about the equator and N ≡ 0 on every torus.
+    let symmetric = alpha == 0.0;
     // The critical set, untruncated (its cusp bounds the fold's window).
     stopped()?;
     let set = CriticalSet::of(body, 400, 1e6)?;
@@ -730,7 +737,7 @@ pub fn verdict_until(
             stop,
         };
         let lines: Vec<Vec<Sample>> = kappas.par_iter().map(|&k| sampler.line(k)).collect();
-        if !counterexamples(&sampler, &brackets(&lines, options.tol))
+        if !counterexamples(&sampler, &brackets(&lines, options.tol, symmetric))
             .0
             .is_empty()
         {
@@ -751,7 +758,7 @@ pub fn verdict_until(
         (kappas, lines)
     });
     stopped()?;
-    let candidates = brackets(&lines, options.tol);
+    let candidates = brackets(&lines, options.tol, symmetric);
     let all: Vec<&Sample> = lines.iter().flatten().collect();
     let (n_lo, n_hi) = all
         .iter()
@@ -784,7 +791,7 @@ pub fn verdict_until(
             kappa_top = *EXTRA_KAPPA_LINES.last().expect("lines");
             let mut joined = vec![lines.last().cloned().unwrap_or_default()];
             joined.extend(extra);
-            let more = brackets(&joined, options.tol);
+            let more = brackets(&joined, options.tol, symmetric);
             integer_brackets += more.len();
             let (extra_found, extra_failures) = counterexamples(&sampler, &more);
             refinement_failures += extra_failures;
@@ -804,6 +811,27 @@ pub fn verdict_until(
     } else {
         !candidates.is_empty()
     };
+    if !resonant && limit_failure.is_none() && undecided.is_none() {
+        undecided = limit_undecided(&high_energy).or_else(|| {
+            all.iter()
+                .find(|s| {
+                    s.grid.is_some_and(|i| i > 0)
+                        && s.kappa >= ON_INTEGER_KAPPA
+                        && on_integer(s, options.tol)
+                })
+                .map(|s| {
+                    format!(
+                        "N = {} +- {} at kappa = {}, energy = {} is within its error bar of the integer {}: whether N reaches it there cannot be told at tol = {}",
+                        crate::error::show(s.n),
+                        crate::error::show(ambiguity(s, options.tol)),
+                        crate::error::show(s.kappa),
+                        crate::error::show(s.energy),
+                        s.n.round(),
+                        crate::error::show(options.tol),
+                    )
+                })
+        });
+    }
     verdict.holds = if resonant || limit_failure.is_some() {
         Some(false)
     } else if undecided.is_some() {
@@ -1033,17 +1061,52 @@ fn limit_failure(h: &HighEnergyLimit, bottom_sign: f64) -> Option<(String, i64)>
     })
 }
 
+/// Why the high-energy limit cannot support a verdict that holds, if it cannot: the extremes
+/// of N∞ within their error of −1 or 1, or N∞'s sign not told apart from 0 (a sign change
+/// would be an N = 0 resonance at every large κ; [`limit_failure`] takes the proven ones).
+fn limit_undecided(h: &HighEnergyLimit) -> Option<String> {
+    let e = h.extrema_error.max(h.slope_error);
+    let show = crate::error::show;
+    if h.n_min.is_nan() || e.is_nan() || h.n_min <= -1.0 + e {
+        return Some(format!(
+            "high energy: min N_inf = {} is within its error {} of -1",
+            show(h.n_min),
+            show(e)
+        ));
+    }
+    if h.n_max.is_nan() || h.n_max >= 1.0 - e {
+        return Some(format!(
+            "high energy: max N_inf = {} is within its error {} of 1",
+            show(h.n_max),
+            show(e)
+        ));
+    }
+    let one_sign = h.normalized_max < -e || h.normalized_min > e;
+    (!one_sign).then(|| {
+        format!(
+            "high energy: N_inf/(lambda x0^2) runs from {} to {} (error {}): its sign is not told apart from 0",
+            show(h.normalized_min),
+            show(h.normalized_max),
+            show(e)
+        )
+    })
+}
+
 /// Integer brackets along each line (same family: gap and well) and across neighbouring
-/// lines at the same base energy index.
-fn brackets(lines: &[Vec<Sample>], tol: f64) -> Vec<Candidate> {
+/// lines at the same base energy index. Along a line, a sample is paired with the next one of
+/// its family whose N is off every integer by more than its error bar, so that a sample that
+/// lands on a crossing does not hide it. Single samples on an integer count only for a body
+/// whose symmetry makes N an integer on whole families (`symmetric`, α = 0: N ≡ 0); elsewhere
+/// N near an integer is a value, not a resonance, until a bracket proves one.
+fn brackets(lines: &[Vec<Sample>], tol: f64, symmetric: bool) -> Vec<Candidate> {
     let mut candidates = Vec::new();
-    let interior = |s: &Sample| s.grid.is_some_and(|i| i > 0);
+    let interior = |s: &Sample| symmetric && s.grid.is_some_and(|i| i > 0);
     for line in lines {
         for (i, a) in line.iter().enumerate() {
             integers_between(a, None, interior(a), tol, &mut candidates);
             if let Some(b) = line[i + 1..]
                 .iter()
-                .find(|b| b.gap == a.gap && b.well == a.well)
+                .find(|b| b.gap == a.gap && b.well == a.well && !on_integer(b, tol))
             {
                 integers_between(a, Some(b), false, tol, &mut candidates);
             }

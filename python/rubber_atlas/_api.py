@@ -1335,7 +1335,9 @@ def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, e
         Along ``t`` (sqrt(b3/g)): ``theta``, ``theta_dot``, ``phi``, ``psi`` (rad, rad per
         unit time), the centre of mass ``x_c``, ``y_c`` (on the plane) and ``z_c`` (its
         height) and the contact point ``x_p``, ``y_p`` (b3); attributes record the body,
-        κ, ε, θ(0), θ̇(0), the model and the tolerance.
+        κ, ε, θ(0), θ̇(0), the model, the tolerance and ``energy_drift``, the largest
+        |ε(t) − ε(0)| / (1 + |ε(0)|) over the samples (beyond max(1e3·tol, 1e-6) the
+        trajectory is refused: the steps no longer resolve the motion).
 
     Raises
     ------
@@ -1359,7 +1361,7 @@ def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, e
     """
     body = _reals(alpha=alpha, beta=beta, nu=nu, eta=eta)
     tol = _real("tol", tol)
-    table, (k, e, t0, td0) = _core.trajectory(
+    table, (k, e, t0, td0, drift) = _core.trajectory(
         *body.values(), _real("kappa", kappa), _optional_real("energy", energy), _count("component", component),
         _optional_real("theta0", theta0), _real("theta_dot0", theta_dot0), _optional_real("periods", periods),
         _optional_real("t_end", t_end), _count("samples", samples), str(model), tol,
@@ -1368,7 +1370,7 @@ def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, e
                      theta0=theta0, theta_dot0=theta_dot0, periods=periods, t_end=t_end, samples=samples,
                      model=model, tol=tol)
     attrs = _root_attrs("trajectory", arguments, model=str(model), **body,
-                        kappa=k, energy=e, theta0=t0, theta_dot0=td0, tolerance=tol)
+                        kappa=k, energy=e, theta0=t0, theta_dot0=td0, tolerance=tol, energy_drift=drift)
     return _table(table, attrs)
 
 

@@ -105,13 +105,15 @@ pub(super) fn trajectory(args: TrajectoryArgs) -> Result<()> {
         ("theta0", AttrValue::Number(start.theta0)),
         ("theta_dot0", AttrValue::Number(start.theta_dot0)),
         ("tolerance", AttrValue::Number(tol)),
+        ("energy_drift", AttrValue::Number(traj.energy_drift)),
     ]));
     write_table(&args.out, &table)?;
     eprintln!(
-        "wrote {} samples over t in [0, {}] ({} model) to {}",
+        "wrote {} samples over t in [0, {}] ({} model, energy kept to {:.1e}) to {}",
         traj.t.len(),
-        t_end,
+        show(t_end),
         json_name(&model),
+        traj.energy_drift,
         args.out.display()
     );
     Ok(())

@@ -8,6 +8,8 @@ use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use rubber_atlas::cell::{solve_cell, CellOptions, Status};
 use rubber_atlas::limits::high_energy_rotation_number;
+use rubber_atlas::torus::MotionKind;
+use rubber_atlas::trajectory::{Duration, Model, Request, StartAt};
 use rubber_atlas::verdict::{self, verdict, verdict_until, BoundaryOptions, VerdictOptions};
 use rubber_atlas::{AtlasError, EllipsoidBody};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -58,6 +60,20 @@ fn check_answer(alpha: f64, beta: f64, nu: f64, eta: f64, kappa: f64, energy: f6
             assert_eq!(c.bounded, None, "bounded without N: {at}");
         }
         assert!(!c.error_estimate.is_nan(), "NaN error estimate: {at}");
+        // A verdict on the path only where the numbers carry it: N known to better than
+        // ±1/2, and unbounded only with a drift beyond its error.
+        if c.bounded.is_some() && c.motion == MotionKind::Libration {
+            assert!(
+                c.errors.rotation_number < 0.5,
+                "bounded with N unknown: {at}"
+            );
+        }
+        if c.bounded == Some(false) && c.motion == MotionKind::Libration {
+            assert!(c.drift > c.errors.drift, "unbounded with no drift: {at}");
+        }
+        if c.drift_radius.is_finite() {
+            assert!(c.errors.drift_radius >= 0.0, "no bound on R: {at}");
+        }
         if c.status == Status::Ok {
             assert!(
                 c.rotation_number.is_finite() && c.period.is_finite() && c.period > 0.0,
@@ -147,6 +163,39 @@ fn the_cells_issue_22_found_answer_honestly() {
     for energy in [1e50, 1e100, 1e250, 1e300] {
         check_answer(0.5, 3.0, 0.5, 0.5, 0.8, energy);
     }
+    let body = EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 0.5).unwrap();
+    let options = CellOptions {
+        drift: true,
+        ..CellOptions::default()
+    };
+    let one = |kappa: f64, energy: f64| {
+        let cell = solve_cell(&body, kappa, energy, &options).unwrap();
+        assert_eq!(cell.components.len(), 1, "{cell:?}");
+        cell.components[0].clone()
+    };
+    // ε = 1e50: N is the limit's, −5e-26, an integer within the resonance tolerance, with
+    // a drift of 13.4: unbounded (it was `true`, from the quadrature's N before the limit
+    // replaced it), and R follows the final N.
+    let c = one(0.8, 1e50);
+    assert!(
+        c.rotation_number < 0.0 && c.rotation_number > -1e-25,
+        "{c:?}"
+    );
+    assert_eq!(c.bounded, Some(false), "{c:?}");
+    let r = c.drift / (2.0 * (std::f64::consts::PI * c.rotation_number).sin().abs());
+    assert!((c.drift_radius - r).abs() <= 1e-12 * r, "{c:?}");
+    // ε = 1e100: the drift (1e-12 ± 13) cannot be told from 0 on that resonance: undecided.
+    let c = one(0.8, 1e100);
+    assert!(c.errors.rotation_number < 1e-50, "{c:?}");
+    assert_eq!(c.bounded, None, "{c:?}");
+    // 0 < |κ| down to the least subnormal has motion (κ² underflows: it was `no_motion`);
+    // where N is unknown to ±1/2 the path's fate is too.
+    for kappa in [1e-100, 2.3e-308, 1e-310, 5e-324, -5e-324] {
+        let cell = solve_cell(&body, kappa, 2.5, &options).unwrap();
+        assert_eq!(cell.status, Status::Ok, "{kappa:e}: {cell:?}");
+        assert_eq!(cell.components.len(), 2, "{kappa:e}: {cell:?}");
+        check_answer(0.5, 3.0, 0.5, 0.5, kappa, 2.5);
+    }
 }
 
 /// Bodies beyond the checked β and η answer at once, undecided, saying why; the edges of the
@@ -187,6 +236,28 @@ fn extreme_bodies_are_undecided_with_the_reason() {
     assert!(refused.to_string().contains("beta-min"), "{refused}");
 }
 
+/// Nearly symmetric bodies (α → 0): N is of the order of α everywhere, so a sample within
+/// its error bar of 0 is a value, not a resonance. They used to fail on such samples
+/// (α = 1e-12, β = 100: "counterexample" N = −6e-15 ± 2.4e-13); now only a bracket proves a
+/// resonance, and where N's sign cannot be told the verdict is undecided, saying why. α = 0
+/// (N ≡ 0 by symmetry) still fails, with its counterexamples.
+#[test]
+fn nearly_symmetric_bodies_do_not_fail_on_values_near_an_integer() {
+    let options = VerdictOptions::default();
+    for (alpha, beta) in [(1e-12, 100.0), (1e-8, 100.0), (1e-14, 0.5)] {
+        let body = EllipsoidBody::ellipsoid(alpha, beta, 0.5, 0.5).unwrap();
+        let v = verdict(&body, &options).unwrap();
+        assert_eq!(v.holds, None, "alpha {alpha} beta {beta}: {v:?}");
+        assert!(v.counterexamples.is_empty(), "{v:?}");
+        assert!(v.evidence.undecided.is_some(), "{v:?}");
+    }
+    let body = EllipsoidBody::ellipsoid(0.0, 0.5, 0.5, 0.5).unwrap();
+    let v = verdict(&body, &options).unwrap();
+    assert_eq!(v.holds, Some(false), "{v:?}");
+    assert!(v.counterexamples.iter().all(|c| c.integer == 0), "{v:?}");
+    assert!(!v.counterexamples.is_empty());
+}
+
 /// A verdict asked to stop gives up between components (Ctrl-C in Python).
 #[test]
 fn a_verdict_stops_when_asked() {
@@ -194,5 +265,48 @@ fn a_verdict_stops_when_asked() {
     let polls = AtomicUsize::new(0);
     let stop = || polls.fetch_add(1, Ordering::Relaxed) >= 50;
     let stopped = verdict_until(&body, &VerdictOptions::default(), &stop);
+    assert_eq!(stopped.unwrap_err(), AtlasError::Stopped);
+}
+
+/// Far out on ε the turning point next to the pole is κ/√(2ε) to the last digits: an
+/// overflowing V′ (θ below 1e-103 at κ = 0.8) stopped Newton's method at θ = 8.3e-104 for
+/// every ε above 1e207, and a full-model trajectory started there ran on the wrong level.
+#[test]
+fn turning_points_far_out_and_the_trajectories_from_them() {
+    let body = EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 0.5).unwrap();
+    for energy in [1e200, 1e250, 1e300] {
+        let cell = solve_cell(&body, 0.8, energy, &CellOptions::default()).unwrap();
+        let theta_min = cell.components[0].theta_min;
+        let expected = 0.8 / (2.0 * energy).sqrt();
+        assert!(
+            (theta_min - expected).abs() <= 1e-14 * expected,
+            "{theta_min:e} against {expected:e} at {energy:e}"
+        );
+    }
+    // Whatever the integrator makes of it, a trajectory is either right or refused: the
+    // energy is checked along it.
+    let request = |energy: f64, model: Model| Request {
+        kappa: 0.8,
+        start: StartAt::Energy {
+            energy,
+            component: 0,
+        },
+        duration: Duration::Periods(1.0),
+        samples: 4,
+        model,
+        tol: 1e-12,
+    };
+    for model in [Model::Reduced, Model::Full] {
+        for energy in [2.5, 1e20, 1e300] {
+            match request(energy, model).run(&body) {
+                Ok((_, traj)) => assert!(traj.energy_drift <= 1e-6, "{energy:e}"),
+                Err(e) => assert!(matches!(e, AtlasError::Integration { .. }), "{e}"),
+            }
+        }
+    }
+    let (_, ordinary) = request(2.5, Model::Full).run(&body).unwrap();
+    assert!(ordinary.energy_drift < 1e-10, "{}", ordinary.energy_drift);
+    // Asked to stop, it stops (Ctrl-C in Python).
+    let stopped = request(2.5, Model::Full).run_until(&body, &|| true);
     assert_eq!(stopped.unwrap_err(), AtlasError::Stopped);
 }

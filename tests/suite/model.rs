@@ -106,8 +106,8 @@ fn start(c: &Case) -> Start {
 fn both(c: &Case, t_end: f64, samples: usize) -> (Trajectory, Trajectory) {
     let b = body(c);
     let s = start(c);
-    let red = integrate(&b, &s, Model::Reduced, t_end, samples, ODE_TOL).unwrap();
-    let full = integrate(&b, &s, Model::Full, t_end, samples, ODE_TOL).unwrap();
+    let red = integrate(&b, &s, Model::Reduced, t_end, samples, ODE_TOL, &|| false).unwrap();
+    let full = integrate(&b, &s, Model::Full, t_end, samples, ODE_TOL, &|| false).unwrap();
     (red, full)
 }
 
@@ -164,7 +164,7 @@ fn full_system_keeps_its_four_integrals() {
             i0.energy,
             e_red
         );
-        let sol = integrate_sampled(&sys, y0, 20.0, 200, ODE_TOL).unwrap();
+        let sol = integrate_sampled(&sys, y0, 20.0, 200, ODE_TOL, &|| false).unwrap();
         for y in &sol.states {
             let i = sys.integrals(y);
             // Drift of integrals of an explicit method over 20 units at tol 1e-13.
@@ -227,7 +227,7 @@ fn permanent_rotations_stay_on_their_circles_in_the_full_system() {
             theta_dot0: 0.0,
         };
         let n = 720;
-        let full = integrate(&b, &s, Model::Full, turn, n, ODE_TOL).unwrap();
+        let full = integrate(&b, &s, Model::Full, turn, n, ODE_TOL, &|| false).unwrap();
         let max_dev = full
             .theta
             .iter()
@@ -266,7 +266,7 @@ fn unstable_permanent_rotation_is_a_fixed_point_of_the_full_system() {
         theta0: 1.25,
         theta_dot0: 0.0,
     };
-    let full = integrate(&b, &s, Model::Full, 3.0, 60, ODE_TOL).unwrap();
+    let full = integrate(&b, &s, Model::Full, 3.0, 60, ODE_TOL, &|| false).unwrap();
     let dev = full
         .theta
         .iter()
@@ -298,7 +298,7 @@ fn closure_after_seven_periods(theta0: f64, model: Model) -> (f64, f64) {
         theta_dot0: 0.0,
     };
     let t_end = 7.0 * s.period(&b, 1e-14).unwrap();
-    let tr = integrate(&b, &s, model, t_end, 7000, ODE_TOL).unwrap();
+    let tr = integrate(&b, &s, model, t_end, 7000, ODE_TOL, &|| false).unwrap();
     let n = tr.t.len() - 1;
     let gap = (tr.x_c[n] - tr.x_c[0]).hypot(tr.y_c[n] - tr.y_c[0]);
     (gap, path_size(&tr.x_c, &tr.y_c))
@@ -358,7 +358,7 @@ fn quadrature_period_and_precession_match_the_ode() {
     let n = |q: &rubber_atlas::torus::PeriodIntegrals| -q.psi_advance / std::f64::consts::TAU;
     assert!(pi.converged);
     assert!((n(&pi) + 0.759).abs() < 5e-4, "N = {}", n(&pi));
-    let tr = integrate(&b, &s, Model::Reduced, pi.period, 10, ODE_TOL).unwrap();
+    let tr = integrate(&b, &s, Model::Reduced, pi.period, 10, ODE_TOL, &|| false).unwrap();
     let last = tr.t.len() - 1;
     assert!(
         (tr.theta[last] - 2.1).abs() < 1e-9,

@@ -62,7 +62,16 @@ fn check_counterexamples(body: &EllipsoidBody, v: &Verdict) {
             theta_dot0: 0.0,
         };
         let away = |periods: f64| {
-            let t = integrate(body, &start, Model::Full, periods * comp.period, 4, 1e-12).unwrap();
+            let t = integrate(
+                body,
+                &start,
+                Model::Full,
+                periods * comp.period,
+                4,
+                1e-12,
+                &|| false,
+            )
+            .unwrap();
             let n = t.t.len() - 1;
             (t.x_c[n] - t.x_c[0]).hypot(t.y_c[n] - t.y_c[0])
         };
