@@ -33,10 +33,26 @@ if ! wait "$package_pid"; then
 fi
 cat "$package_log"
 # The program cargo test built (with the dev-dependencies' features; a plain cargo build
-# would compile it again for nothing).
-phase "pytest scripts/tests"
-RUBBER_ATLAS_BIN="$root/target/release/rubber-atlas" .venv/bin/python -m pytest -q --durations=10 scripts/tests
-phase "pytest python/tests, on the installed package, from a folder outside the repository"
+# would compile it again for nothing). The two Python suites run side by side: each keeps
+# about one core busy (measured: 85 s of CPU in 81 s for python/tests). The package's suite
+# is shown when it ends; either failing fails the command.
+phase "pytest python/tests (on the installed package, from a folder outside the repository) beside pytest scripts/tests"
+python_log="$(mktemp)"
 (cd "$outside" && RUBBER_ATLAS_BIN="$root/target/release/rubber-atlas" \
-  "$root/.venv/bin/python" -m pytest -q -p no:cacheprovider --rootdir "$outside" "$root/python/tests")
+  "$root/.venv/bin/python" -m pytest -q -p no:cacheprovider --rootdir "$outside" "$root/python/tests") \
+  > "$python_log" 2>&1 &
+python_pid=$!
+trap 'kill "$package_pid" "$python_pid" 2>/dev/null || true; rm -rf "$outside" "$package_log" "$python_log"' EXIT
+scripts_status=0
+RUBBER_ATLAS_BIN="$root/target/release/rubber-atlas" .venv/bin/python -m pytest -q --durations=10 scripts/tests \
+  || scripts_status=$?
+phase "scripts/tests ended; waiting for python/tests"
+python_status=0
+wait "$python_pid" || python_status=$?
+echo "test: pytest python/tests:"
+cat "$python_log"
+if [ "$scripts_status" -ne 0 ] || [ "$python_status" -ne 0 ]; then
+  echo "test: a Python suite failed (scripts/tests exit $scripts_status, python/tests exit $python_status)" >&2
+  exit 1
+fi
 echo "test: all suites passed in $(( (SECONDS - start) / 60 )) min $(( (SECONDS - start) % 60 )) s"
