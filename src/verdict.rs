@@ -1340,6 +1340,15 @@ pub fn boundaries(alpha: f64, nu: f64, eta: f64, options: &BoundaryOptions) -> R
     boundaries_until(alpha, nu, eta, options, &|| false)
 }
 
+/// How far a boundary search ([`boundaries_with`]) has come, for a progress display.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BoundarySearch {
+    /// `done` of the `of` verdicts of the β scan are in.
+    Scanned { done: usize, of: usize },
+    /// Locating the `index`-th (from 1) of the `of` changes the scan found.
+    Locating { index: usize, of: usize },
+}
+
 /// [`boundaries`], given up when `stop` says so: then [`AtlasError::Stopped`].
 pub fn boundaries_until(
     alpha: f64,
@@ -1347,6 +1356,18 @@ pub fn boundaries_until(
     eta: f64,
     options: &BoundaryOptions,
     stop: &(dyn Fn() -> bool + Sync),
+) -> Result<Boundaries> {
+    boundaries_with(alpha, nu, eta, options, stop, &|_| {})
+}
+
+/// [`boundaries_until`], telling `progress` how far it has come.
+pub fn boundaries_with(
+    alpha: f64,
+    nu: f64,
+    eta: f64,
+    options: &BoundaryOptions,
+    stop: &(dyn Fn() -> bool + Sync),
+    progress: &(dyn Fn(BoundarySearch) + Sync),
 ) -> Result<Boundaries> {
     let (b0, b1) = (options.beta_min, options.beta_max);
     if !(b0.is_finite() && b0 > 0.0) {
@@ -1408,13 +1429,33 @@ pub fn boundaries_until(
         betas.push(case_line * (1.0 + 1e-9));
     }
     betas.sort_by(f64::total_cmp);
-    let verdicts: Vec<Verdict> = betas.par_iter().map(|&b| run(b)).collect::<Result<_>>()?;
+    let scanned = std::sync::atomic::AtomicUsize::new(0);
+    let verdicts: Vec<Verdict> = betas
+        .par_iter()
+        .map(|&b| {
+            let v = run(b);
+            let done = scanned.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            progress(BoundarySearch::Scanned {
+                done,
+                of: betas.len(),
+            });
+            v
+        })
+        .collect::<Result<_>>()?;
+    let changes = verdicts
+        .windows(2)
+        .filter(|p| key(&p[0]) != key(&p[1]))
+        .count();
     let mut found = Vec::new();
     for pair in verdicts.windows(2) {
         let (lo, hi) = (&pair[0], &pair[1]);
         if key(lo) == key(hi) {
             continue;
         }
+        progress(BoundarySearch::Locating {
+            index: found.len() + 1,
+            of: changes,
+        });
         let boundary = |beta: f64, error: f64, quantity: String| Boundary {
             beta,
             error,

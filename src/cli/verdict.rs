@@ -6,6 +6,7 @@ use clap::Args;
 use rubber_atlas::error::{show, show_digits as digits, AtlasError};
 use rubber_atlas::verdict::{self, VerdictOptions};
 use rubber_atlas::EllipsoidBody;
+use std::io::IsTerminal;
 
 #[derive(Debug, Args)]
 pub struct VerdictArgs {
@@ -70,7 +71,18 @@ pub(super) fn verdict(args: VerdictArgs) -> Result<()> {
     }
     if args.boundaries {
         let defaults = verdict::BoundaryOptions::default();
-        let found = verdict::boundaries(
+        // A bar on a terminal (the search takes a minute or two): the scan's verdicts, then
+        // the changes being located.
+        let bar = if std::io::stderr().is_terminal() {
+            indicatif::ProgressBar::new(0)
+        } else {
+            indicatif::ProgressBar::hidden()
+        };
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} ({elapsed})")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        let found = verdict::boundaries_with(
             args.alpha,
             args.nu,
             args.eta,
@@ -80,7 +92,23 @@ pub(super) fn verdict(args: VerdictArgs) -> Result<()> {
                 scan: args.scan.unwrap_or(defaults.scan),
                 verdict: options,
             },
-        )?;
+            &|| false,
+            &|at| {
+                let (message, done, of) = match at {
+                    verdict::BoundarySearch::Scanned { done, of } => {
+                        ("verdicts along beta", done, of)
+                    }
+                    verdict::BoundarySearch::Locating { index, of } => {
+                        ("locating the changes", index - 1, of)
+                    }
+                };
+                bar.set_message(message);
+                bar.set_length(of as u64);
+                bar.set_position(done as u64);
+            },
+        );
+        bar.finish_and_clear();
+        let found = found?;
         if args.json {
             println!("{}", serde_json::to_string_pretty(&found)?);
         } else {
@@ -89,7 +117,14 @@ pub(super) fn verdict(args: VerdictArgs) -> Result<()> {
                 found.alpha, found.nu, found.eta, found.beta_range[0], found.beta_range[1]
             );
             let side = |c: verdict::Case, h: Option<bool>| match h {
-                None => "not covered".to_string(),
+                None if c == verdict::Case::NotCovered => "not covered".to_string(),
+                None => format!(
+                    "case {} undecided",
+                    serde_json::to_value(c)
+                        .unwrap_or_default()
+                        .as_str()
+                        .unwrap_or("?")
+                ),
                 Some(h) => format!(
                     "case {} {}",
                     serde_json::to_value(c)
