@@ -65,10 +65,21 @@ pub fn run_dop853<const N: usize, F: System<f64, SVector<f64, N>>>(
                 n_step, ..
             }) if max_steps != u32::MAX => n_step as usize,
             Err(e) => {
-                return Err(AtlasError::Integration {
-                    time: t0,
-                    reason: e.to_string(),
-                })
+                use ode_solvers::dop_shared::IntegrationError as Stop;
+                let (time, reason) = match e {
+                    Stop::StepSizeUnderflow { x } => (
+                        x,
+                        "the step fell below the rounding of t: the motion is too fast there for \
+                         this tolerance (near a pole at high energy; the full model may still \
+                         resolve it)"
+                            .to_string(),
+                    ),
+                    Stop::StiffnessDetected { x } => (x, "the equations became stiff".to_string()),
+                    Stop::MaxNumStepReached { x, n_step } => {
+                        (x, format!("more than {n_step} steps were needed"))
+                    }
+                };
+                return Err(AtlasError::Integration { time, reason });
             }
         };
     let (ts, ys) = (solver.x_out(), solver.y_out());

@@ -92,6 +92,12 @@ impl<S: Shape> System<f64, State> for PeriodSystem<'_, '_, S> {
     }
 }
 
+/// Accepted steps one run over a period may take: the hardest cells of the declared domain
+/// take a few hundred thousand (small κ at tol 1e-13); beyond this the run gives up, and
+/// the component is `tolerance_not_reached` (at κ = 0.8, ε = 1e20 … 1e50 the steps shrink
+/// at the pole until the run would take hours, and Ctrl-C in Python waits for the cell).
+const STEPS_PER_PERIOD: u32 = 1_000_000;
+
 /// Integrates from (t0, y0) to at most t1 at tolerance `tol`; returns the last state and
 /// the number of accepted steps.
 fn run<S: Shape>(
@@ -101,7 +107,13 @@ fn run<S: Shape>(
     t1: f64,
     tol: f64,
 ) -> Result<(State, usize)> {
-    let (_, y, steps) = run_dop853(system, t0, t1, y0, tol, 0.0, u32::MAX)?;
+    let (t, y, steps) = run_dop853(system, t0, t1, y0, tol, 0.0, STEPS_PER_PERIOD)?;
+    if steps >= STEPS_PER_PERIOD as usize {
+        return Err(AtlasError::Integration {
+            time: t,
+            reason: format!("gave up after {STEPS_PER_PERIOD} steps"),
+        });
+    }
     Ok((y, steps))
 }
 

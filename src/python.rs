@@ -9,7 +9,7 @@ use crate::cell::{CellOptions, Method};
 use crate::critical::CriticalSet;
 use crate::error::AtlasError;
 use crate::family::{ComponentAxis, Layout};
-use crate::resonance::{trace_curves, ResonanceOptions};
+use crate::resonance::{trace_curves_until, ResonanceOptions};
 use crate::scene::Field;
 use crate::table::{Table, Values};
 use crate::trajectory::{Duration, Model, Request, StartAt};
@@ -510,8 +510,8 @@ fn resonance(
         grid,
         tol,
     );
-    let curves = py
-        .detach(|| trace_curves(&body, &options))
+    // Ctrl-C is heard between seed rows and continuation steps.
+    let curves = interruptible(py, &None, |stop| trace_curves_until(&body, &options, stop))?
         .map_err(value_error)?;
     Ok((
         table_dict(py, crate::table::resonance(&curves))?,

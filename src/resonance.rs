@@ -312,6 +312,8 @@ struct Tracer<'a, S: Shape> {
     options: &'a ResonanceOptions,
     /// Scales of κ and ε: continuation runs in the window scaled to the unit square.
     scale: (f64, f64),
+    /// Asked between seed rows and continuation steps: true gives up (Ctrl-C in Python).
+    stop: &'a (dyn Fn() -> bool + Sync),
 }
 
 impl<S: Shape> Tracer<'_, S> {
@@ -426,7 +428,7 @@ impl<S: Shape> Tracer<'_, S> {
             let mut p = seed;
             let mut t = tangent(gradient, sign);
             let mut s = 0.25 * s_max;
-            while half.len() < self.options.max_points && s >= s_min {
+            while half.len() < self.options.max_points && s >= s_min && !(self.stop)() {
                 let k = p.kappa + s * t.0 * self.scale.0;
                 let e = p.energy + s * t.1 * self.scale.1;
                 // Solve along ε unless the curve runs nearly along ε: along ε the corrector
@@ -539,6 +541,9 @@ impl<S: Shape> Tracer<'_, S> {
         (self.seed_rows())
             .into_par_iter()
             .flat_map_iter(|kappa| {
+                if (self.stop)() {
+                    return Vec::new();
+                }
                 let potential = EffectivePotential::new(self.body, kappa);
                 let levels = potential.separatrix_levels();
                 let wells: Vec<f64> = potential
@@ -645,16 +650,34 @@ fn check_window(options: &ResonanceOptions) -> Result<()> {
     if !options.target.is_finite() {
         return bad("rotation_number", options.target, "must be finite");
     }
-    if options.grid < 4 {
-        return bad("grid", options.grid as f64, "must be at least 4");
+    if !(4..=MAX_GRID).contains(&options.grid) {
+        return bad(
+            "grid",
+            options.grid as f64,
+            "must be between 4 and 4096 (the seed scan solves about grid² cells)",
+        );
     }
     options.cell.validate()
 }
+
+/// The largest seed grid: 4096² ≈ 1.7e7 cells, a few minutes on two cores (a grid of 1e10
+/// asked for 80 GB and aborted).
+pub const MAX_GRID: usize = 4096;
 
 /// Every curve of the window on which a component's N equals `options.target`, found from a
 /// seed scan on a grid of `options.grid` κ-rows and traced by continuation. A curve that
 /// crosses no row of the seed grid (a loop smaller than the grid) is not found.
 pub fn trace_curves<S: Shape>(body: &Body<S>, options: &ResonanceOptions) -> Result<Vec<Curve>> {
+    trace_curves_until(body, options, &|| false)
+}
+
+/// [`trace_curves`], given up when `stop` says so (asked between seed rows and continuation
+/// steps): then [`AtlasError::Stopped`].
+pub fn trace_curves_until<S: Shape>(
+    body: &Body<S>,
+    options: &ResonanceOptions,
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Result<Vec<Curve>> {
     check_window(options)?;
     let tracer = Tracer {
         body,
@@ -663,10 +686,21 @@ pub fn trace_curves<S: Shape>(body: &Body<S>, options: &ResonanceOptions) -> Res
             options.kappa.1 - options.kappa.0,
             options.energy.1 - options.energy.0,
         ),
+        stop,
+    };
+    let stopped = || {
+        if stop() {
+            Err(AtlasError::Stopped)
+        } else {
+            Ok(())
+        }
     };
     let mut curves: Vec<Curve> = Vec::new();
     let near = 1.5 / options.grid as f64;
-    for seed in tracer.seeds() {
+    let seeds = tracer.seeds();
+    stopped()?;
+    for seed in seeds {
+        stopped()?;
         let known = curves.iter().any(|c| {
             c.points
                 .iter()
@@ -679,6 +713,7 @@ pub fn trace_curves<S: Shape>(body: &Body<S>, options: &ResonanceOptions) -> Res
             }
         }
     }
+    stopped()?;
     // A curve traced from a seed that an earlier curve did not reach may run on over that
     // curve: keep the longer of two curves that mostly coincide.
     curves.sort_by_key(|c| std::cmp::Reverse(c.points.len()));
@@ -724,6 +759,7 @@ pub fn fold<S: Shape>(body: &Body<S>, options: &ResonanceOptions) -> Result<Opti
         body,
         options,
         scale: (window, options.energy.1 - options.energy.0),
+        stop: &|| false,
     };
     let tol = options.cell.tol.max(1e-13);
     // κ(ε) on the curve near the top: the root of N − p/q in κ nearest the last one (the

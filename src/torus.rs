@@ -791,7 +791,11 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 let (sd, cd) = libm::sincos(diff);
                 if cd > -0.4 {
                     let d = divided_difference(self, t, c_angle, sd, cd).0;
-                    return (sd * d - (energy - c.value), slope);
+                    // Right next to a pole D ∝ κ²/(sin²θ sin θ_c) overflows before V does
+                    // (below 7e-155·κ^0.75): there V − ε is taken as it is.
+                    if d.is_finite() {
+                        return (sd * d - (energy - c.value), slope);
+                    }
                 }
             }
             (self.value(t) - energy, slope)

@@ -404,6 +404,8 @@ def _derived(full: np.ndarray, dims: tuple, coords: dict, sources: Iterable[str]
     dimensions its `sources` vary along."""
     spanned = set().union(*(_dims_of(coords[s]) for s in sources))
     keep = tuple(d for d in dims if d in spanned)
+    if full.size == 0:  # an empty input: no cell to take the value from
+        return keep, np.empty(tuple(n for n, d in zip(full.shape, dims) if d in keep), dtype=full.dtype)
     index = tuple(slice(None) if d in keep else 0 for d in dims)
     return keep, np.array(full[index])
 
@@ -435,7 +437,8 @@ def _to_kappa_energy(plane: tuple[str, str], flat: list[np.ndarray]) -> list[np.
         _first_bad("s", b, b == 0, "s = 0 is the high-energy limit energy = infinity, which cells does "
                    "not compute; give s > 0 (energy = 1/s^2)")
         _first_bad("s", b, ~(b > 0) | ~np.isfinite(b), "s = 1 / sqrt(energy) must be a finite number > 0")
-        with np.errstate(over="ignore"):
+        # Overflows and s² underflowing to 0 give inf, refused below with the inputs named.
+        with np.errstate(over="ignore", divide="ignore", under="ignore"):
             return flat[:4] + [a / b, 1.0 / (b * b)]
     return flat[:4] + [a, _excess_to_energy(*flat[:4], a, b)]
 
@@ -765,7 +768,8 @@ def cells(
         with excess_energy, or lambda_ with s; `allow_large` or `progress` not True or
         False; `threads` not a whole number.
     KeyboardInterrupt
-        Ctrl-C stops a call within one cell's time (0.2 s measured on 4 million cells).
+        Ctrl-C stops a call within one cell's time (0.2 s measured on 4 million cells; an ODE
+        cell that gives up takes up to about 3 s).
 
     See Also
     --------
@@ -1295,7 +1299,7 @@ def diagram(alpha: float, beta: float, nu: float = 0.5, eta: float = 0.5, *, sam
 
 
 def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, energy: float | None = None, *,
-               component: int = 0, theta0: float | None = None, theta_dot0: float = 0.0,
+               component: int | None = None, theta0: float | None = None, theta_dot0: float | None = None,
                periods: float | None = None, t_end: float | None = None, samples: int = 2000,
                model: str = "reduced", tol: float = 1e-12, allow_large: bool = False) -> xr.Dataset:
     """A trajectory of the body over time, as ``rubber-atlas trajectory`` writes it.
@@ -1309,12 +1313,13 @@ def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, e
     energy : float, optional
         ε (m g b3): start at the lower turning point θ_min of `component` (θ̇ = 0).
         Exactly one of `energy` and `theta0`.
-    component : int, default 0
-        Which component of {V ≤ ε} to start on, ≥ 0, in increasing theta_min.
+    component : int, optional
+        With `energy`: which component of {V ≤ ε} to start on, ≥ 0, in increasing
+        theta_min (default 0).
     theta0 : float, optional
         Start at θ = theta0 (rad, 0 < θ0 < π) instead of a turning point.
-    theta_dot0 : float, default 0.0
-        θ̇ at the start when `theta0` is given (rad per unit of time sqrt(b3/g)).
+    theta_dot0 : float, optional
+        With `theta0`: θ̇ at the start (rad per unit of time sqrt(b3/g), default 0).
     periods : float, optional
         Duration in θ-periods (> 0). Exactly one of `periods` and `t_end`.
     t_end : float, optional
@@ -1325,7 +1330,7 @@ def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, e
         The reduced one-degree-of-freedom system, or the full equations of motion (ω, γ)
         with the positions.
     tol : float, default 1e-12
-        Tolerance of the integrator.
+        Tolerance of the integrator, 1e-15 … 0.1.
     allow_large : bool, default False
         Allow `samples` beyond 80 % of the available memory.
 
@@ -1361,6 +1366,13 @@ def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, e
     """
     body = _reals(alpha=alpha, beta=beta, nu=nu, eta=eta)
     tol = _real("tol", tol)
+    # As the command: each start option goes with its start (it used to be ignored silently).
+    if energy is not None and theta_dot0 is not None:
+        raise ValueError("theta_dot0 goes with theta0 (a start at energy= has theta_dot = 0 at its turning point)")
+    if theta0 is not None and component is not None:
+        raise ValueError("component goes with energy= (theta0= picks the component that holds it)")
+    component = 0 if component is None else component
+    theta_dot0 = 0.0 if theta_dot0 is None else theta_dot0
     table, (k, e, t0, td0, drift) = _core.trajectory(
         *body.values(), _real("kappa", kappa), _optional_real("energy", energy), _count("component", component),
         _optional_real("theta0", theta0), _real("theta_dot0", theta_dot0), _optional_real("periods", periods),

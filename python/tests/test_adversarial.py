@@ -4,6 +4,7 @@ error, never a silently wrong result."""
 from __future__ import annotations
 
 import shutil
+import warnings
 import subprocess
 import sys
 
@@ -318,3 +319,25 @@ def test_dataarray_coordinates_that_would_be_misread_are_refused():
 def test_a_long_text_is_shown_short():
     message = refused(ValueError, lambda: ra.resonance(*BODY, "1" + "0" * 400 + "/3"), "rotation_number")
     assert len(message) < 200, message
+
+
+def test_third_round_findings_are_refused_in_one_line():
+    """Issue 22, third adversary pass."""
+    # An empty lambda_ gave numpy's IndexError.
+    empty = ra.cells(*BODY, lambda_=np.array([]), s=0.5, progress=False)
+    assert empty.sizes["cell"] == 0
+    # Start options that do not go with the start were ignored silently.
+    refused(ValueError, lambda: ra.trajectory(*BODY, kappa=0.8, energy=2.5, periods=1, theta_dot0=1.0),
+            "theta_dot0", "theta0")
+    refused(ValueError, lambda: ra.trajectory(*BODY, kappa=0.8, theta0=2.4, component=5, periods=1),
+            "component", "energy")
+    # A tolerance the integrator cannot meet, and a seed grid of 1e10 (it aborted the interpreter).
+    refused(ValueError, lambda: ra.trajectory(*BODY, kappa=0.8, energy=2.5, periods=1, tol=5e-324), "tol")
+    refused(ValueError, lambda: ra.resonance(*BODY, "-1/7", grid=10**10), "grid", "4096")
+    # s² underflowing to 0 warned from numpy before the one-line refusal.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        refused(ValueError, lambda: ra.cells(*BODY, lambda_=1e-300, s=1e-300, progress=False), "energy")
+    # The trajectory says how well it kept the energy.
+    t = ra.trajectory(*BODY, kappa=0.8, energy=2.5, periods=1, samples=10)
+    assert 0 <= t.attrs["energy_drift"] < 1e-10

@@ -218,6 +218,9 @@ LONG_CALLS = {
     # A verdict at resolution 1024 takes tens of seconds per body.
     "verdict": "ra.verdict([0.5, 0.5], [3.0, 0.5], 0.5, 0.5, resolution=1024)",
     "boundaries": "ra.boundaries(0.5, 0.5, 0.5, beta_min=0.05, beta_max=50, scan=200)",
+    # About 15 s each on one core; they ran to the end under Ctrl-C.
+    "trajectory": "ra.trajectory(0.5, 3.0, 0.5, 0.5, kappa=0.8, energy=2.5, t_end=1e6, model='full')",
+    "resonance": "ra.resonance(0.5, 3.0, 0.5, 0.5, '-1/7', grid=400)",
 }
 
 

@@ -13,13 +13,13 @@ pub struct CellArgs {
     #[command(flatten)]
     pub start: StartArgs,
     /// Accuracy: relative for T, ω, drift; absolute for N. 1e-15 <= TOL <= 0.1.
-    #[arg(long, default_value_t = 1e-10, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, default_value_t = 1e-10, allow_hyphen_values = true)]
     pub tol: f64,
     /// How to compute the period integrals.
     #[arg(long, value_enum, default_value_t = MethodArg::Quadrature)]
     pub method: MethodArg,
     /// |N − round(N)| at or below this (or N's error estimate) counts as a resonance.
-    #[arg(long, default_value_t = 1e-9, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, default_value_t = 1e-9, allow_hyphen_values = true)]
     pub resonance_tol: f64,
     /// Print one JSON object (keys of docs/files.md).
     #[arg(long)]

@@ -15,10 +15,10 @@ pub struct DiagramArgs {
     #[command(flatten)]
     pub shape: ShapeArgs,
     /// ν = i3/i1 (does not change the critical set; recorded in the output).
-    #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, default_value_t = 0.5, allow_hyphen_values = true)]
     pub nu: f64,
     /// η = m b3²/i1 (does not change the critical set; recorded in the output).
-    #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, default_value_t = 0.5, allow_hyphen_values = true)]
     pub eta: f64,
     /// Print the critical set as one JSON object.
     #[arg(long, conflicts_with = "out")]
@@ -35,7 +35,7 @@ pub struct DiagramArgs {
     #[command(flatten)]
     pub limits: Limits,
     /// Truncate the sampled curves at this κ.
-    #[arg(long, default_value_t = 3.0, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, default_value_t = 3.0, allow_hyphen_values = true)]
     pub kappa_max: f64,
 }
 

@@ -148,13 +148,13 @@ pub enum MethodArg {
 pub struct StartArgs {
     /// Energy ε (`cell`: every component; `trajectory`: start at the lower turning point of
     /// component --component with θ̇ = 0).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, allow_hyphen_values = true)]
     pub energy: Option<f64>,
     /// Initial inclination θ(0) (`cell`: only the component that holds it).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, allow_hyphen_values = true)]
     pub theta0: Option<f64>,
     /// Initial θ̇(0) (with --theta0) [default: 0].
-    #[arg(long, requires = "theta0", allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, requires = "theta0", allow_hyphen_values = true)]
     pub theta_dot0: Option<f64>,
 }
 
@@ -176,10 +176,10 @@ impl StartArgs {
 pub struct ShapeArgs {
     /// α = a/b3: displacement of the centre of mass along the axis, -1 < α < 1 (α < 0 is the
     /// mirror image θ -> π - θ).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, allow_hyphen_values = true)]
     pub alpha: f64,
     /// β = b1/b3: < 1 prolate, > 1 oblate, 1 sphere.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, allow_hyphen_values = true)]
     pub beta: f64,
 }
 
@@ -189,13 +189,13 @@ pub struct LevelArgs {
     #[command(flatten)]
     pub shape: ShapeArgs,
     /// ν = i3/i1, 0 < ν <= 2.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, allow_hyphen_values = true)]
     pub nu: f64,
     /// η = m b3²/i1 > 0.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, allow_hyphen_values = true)]
     pub eta: f64,
     /// κ, the value of the integral F2 = J ω3.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, allow_hyphen_values = true)]
     pub kappa: f64,
 }
 
@@ -317,6 +317,24 @@ pub(crate) fn table_attributes(own: &[(&str, AttrValue)]) -> Vec<(String, AttrVa
 
 /// Refuses options that the chosen start would silently ignore (clap's `requires` cannot see
 /// this through the flattened start group).
+/// A number on the command line, as Rust reads it, except that one whose digits are not all
+/// zero must not read as 0 (`1e-400` underflows to 0.0: κ = 1e-400 would be the planar
+/// κ = 0, η = 1e-400 "invalid eta = 0"). Subnormal values are kept: they are exact.
+pub(crate) fn number(text: &str) -> std::result::Result<f64, String> {
+    let value: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("{text:?} is not a number"))?;
+    let mantissa = text.trim().split(['e', 'E']).next().unwrap_or_default();
+    let nonzero = mantissa.chars().any(|c| c.is_ascii_digit() && c != '0');
+    if value == 0.0 && nonzero {
+        return Err(format!(
+            "{text} underflows: its size is below the smallest double (4.9e-324); give 0 or a number of larger size"
+        ));
+    }
+    Ok(value)
+}
+
 pub(crate) fn check_start(start: &StartArgs, component: Option<usize>) -> Result<()> {
     let refuse = |reason: &str| -> Result<()> {
         Err(AtlasError::Atlas {

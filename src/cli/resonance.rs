@@ -15,32 +15,32 @@ pub struct ResonanceArgs {
     #[command(flatten)]
     pub shape: ShapeArgs,
     /// ν = i3/i1, 0 < ν <= 2.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, allow_hyphen_values = true)]
     pub nu: f64,
     /// η = m b3²/i1 > 0.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, allow_hyphen_values = true)]
     pub eta: f64,
     /// The rotation number of the curves: P/Q (e.g. 0, 1, -1/7) or a decimal.
     #[arg(long, value_name = "P/Q", allow_hyphen_values = true)]
     pub rotation_number: String,
     /// The window: smallest κ (> 0; N = 0 at κ = 0).
-    #[arg(long, default_value_t = 0.01, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, default_value_t = 0.01, allow_hyphen_values = true)]
     pub kappa_min: f64,
     /// The window: largest κ.
-    #[arg(long, default_value_t = 2.0, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, default_value_t = 2.0, allow_hyphen_values = true)]
     pub kappa_max: f64,
     /// The window: smallest ε [default: the lowest minimum of V over the window].
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, allow_hyphen_values = true)]
     pub energy_min: Option<f64>,
     /// The window: largest ε.
-    #[arg(long, default_value_t = 5.0, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, default_value_t = 5.0, allow_hyphen_values = true)]
     pub energy_max: f64,
     /// Rows of κ (and energies per row) of the seed scan; curves are also followed between
     /// rows, but a closed curve that crosses no row is missed.
     #[arg(long, default_value_t = 48, allow_hyphen_values = true)]
     pub grid: usize,
     /// Tolerance of the cell solver (N on the curve equals P/Q to this).
-    #[arg(long, default_value_t = 1e-10, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, default_value_t = 1e-10, allow_hyphen_values = true)]
     pub tol: f64,
     /// Print the fold of the curve of largest κ as JSON {"kappa_max": …, "energy": …}.
     #[arg(long)]

@@ -22,18 +22,18 @@ pub struct TrajectoryArgs {
     #[arg(long, requires = "energy", allow_hyphen_values = true)]
     pub component: Option<usize>,
     /// Length in θ-periods of the starting component.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, allow_hyphen_values = true)]
     pub periods: Option<f64>,
     /// Length in time units √(b3/g).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, allow_hyphen_values = true)]
     pub t_end: Option<f64>,
     /// Number of output intervals (the file has SAMPLES + 1 rows).
     #[arg(long, default_value_t = 2000, allow_hyphen_values = true)]
     pub samples: usize,
     #[command(flatten)]
     pub limits: Limits,
-    /// Relative and absolute tolerance of the DOP853 integrator.
-    #[arg(long, default_value_t = 1e-12, allow_hyphen_values = true)]
+    /// Relative and absolute tolerance of the DOP853 integrator, 1e-15 ... 0.1.
+    #[arg(value_parser = number, long, default_value_t = 1e-12, allow_hyphen_values = true)]
     pub tol: f64,
     /// Which equations to integrate.
     #[arg(long, value_enum, default_value_t = ModelArg::Reduced)]

@@ -1,6 +1,7 @@
 //! `rubber-atlas verdict`: the boundedness hypothesis for one body, or the β where its verdict
 //! changes along β.
 
+use crate::cli::number;
 use anyhow::Result;
 use clap::Args;
 use rubber_atlas::error::{show, show_digits as digits, AtlasError};
@@ -12,37 +13,38 @@ use std::io::IsTerminal;
 pub struct VerdictArgs {
     /// α = a/b3: displacement of the centre of mass along the axis, 0 <= α < 1 (α < 0 is the
     /// mirror image θ -> π - θ of -α).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, allow_hyphen_values = true)]
     pub alpha: f64,
     /// β = b1/b3 (not with --boundaries).
     #[arg(
         long,
+        value_parser = number,
         allow_hyphen_values = true,
         required_unless_present = "boundaries",
         conflicts_with = "boundaries"
     )]
     pub beta: Option<f64>,
     /// ν = i3/i1, 0 < ν <= 2.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, allow_hyphen_values = true)]
     pub nu: f64,
     /// η = m b3²/i1 > 0.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, allow_hyphen_values = true)]
     pub eta: f64,
     /// The β at which the verdict changes along β at this α, each by root-finding.
     #[arg(long)]
     pub boundaries: bool,
     /// Smallest β searched by --boundaries [default: 0.05].
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, allow_hyphen_values = true)]
     pub beta_min: Option<f64>,
     /// Largest β searched by --boundaries [default: 50].
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, allow_hyphen_values = true)]
     pub beta_max: Option<f64>,
     /// Log-spaced β of the scan behind --boundaries (the line β² = 1 + α is added)
     /// [default: 48].
     #[arg(long, allow_hyphen_values = true)]
     pub scan: Option<usize>,
     /// Tolerance of the cell solver (N at a counterexample equals the integer to this).
-    #[arg(long, default_value_t = 1e-10, allow_hyphen_values = true)]
+    #[arg(value_parser = number, long, default_value_t = 1e-10, allow_hyphen_values = true)]
     pub tol: f64,
     /// κ-lines of each kind and energies per line of the sampling (doubling it halves the
     /// spacing).

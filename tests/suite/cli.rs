@@ -202,6 +202,11 @@ fn bad_input_is_refused_with_one_clear_line() {
         (traj(&["--tol", "0"]), "tol = 0"),
         (traj(&["--model", "exact"]), "exact"),
         (traj(&["--alpha", "abc"]), "abc"),
+        // Underflow to 0 would silently be another input (κ = 0 is the planar case).
+        (traj(&["--kappa", "1e-400"]), "underflows"),
+        (traj(&["--eta", "-1e-999"]), "underflows"),
+        // A tolerance DOP853 cannot meet (its steps fell under the rounding of t).
+        (traj(&["--tol", "5e-324"]), "tol"),
     ];
     for (args, needle) in &cases {
         let a: Vec<&str> = args.iter().map(String::as_str).collect();

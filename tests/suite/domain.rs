@@ -258,6 +258,19 @@ fn nearly_symmetric_bodies_do_not_fail_on_values_near_an_integer() {
     assert!(!v.counterexamples.is_empty());
 }
 
+/// Resonance curves asked to stop give up between seed rows and continuation steps (Ctrl-C
+/// in Python; a grid of 200 ran on for minutes).
+#[test]
+fn resonance_curves_stop_when_asked() {
+    use rubber_atlas::resonance::{trace_curves_until, ResonanceOptions};
+    let body = EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 0.5).unwrap();
+    let options = ResonanceOptions::window(&body, -1.0 / 7.0, (0.01, 2.0), None, 5.0, 48, 1e-10);
+    let polls = AtomicUsize::new(0);
+    let stop = || polls.fetch_add(1, Ordering::Relaxed) >= 20;
+    let stopped = trace_curves_until(&body, &options, &stop);
+    assert_eq!(stopped.unwrap_err(), AtlasError::Stopped);
+}
+
 /// A verdict asked to stop gives up between components (Ctrl-C in Python).
 #[test]
 fn a_verdict_stops_when_asked() {
