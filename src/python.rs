@@ -27,6 +27,16 @@ fn value_error(e: AtlasError) -> PyErr {
     PyValueError::new_err(e.to_string())
 }
 
+/// A trajectory error in the words of `ra.trajectory`'s keywords, not the command's flags.
+fn trajectory_error(e: AtlasError) -> PyErr {
+    let text = e
+        .to_string()
+        .replace("give --t-end", "give t_end=")
+        .replace("t-end", "t_end")
+        .replace("theta-dot0", "theta_dot0");
+    PyValueError::new_err(text)
+}
+
 fn bad(message: String) -> PyErr {
     PyValueError::new_err(message)
 }
@@ -468,8 +478,8 @@ fn trajectory<'py>(
         tol,
     };
     // Ctrl-C is heard between integrator runs (at most 100,000 steps each).
-    let (start, traj) =
-        interruptible(py, &None, |stop| request.run_until(&body, stop))?.map_err(value_error)?;
+    let (start, traj) = interruptible(py, &None, |stop| request.run_until(&body, stop))?
+        .map_err(trajectory_error)?;
     let start = [
         start.kappa,
         start.energy(&body),

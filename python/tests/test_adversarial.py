@@ -338,6 +338,10 @@ def test_third_round_findings_are_refused_in_one_line():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         refused(ValueError, lambda: ra.cells(*BODY, lambda_=1e-300, s=1e-300, progress=False), "energy")
+    # In the keywords' words, not the command's flags.
+    refused(ValueError, lambda: ra.trajectory(*BODY, kappa=0.8, energy=2.5, t_end=float("nan")), "t_end")
+    refused(ValueError, lambda: ra.trajectory(*BODY, kappa=0.8, theta0=2.4, theta_dot0=float("nan"), periods=1),
+            "theta_dot0")
     # The trajectory says how well it kept the energy.
     t = ra.trajectory(*BODY, kappa=0.8, energy=2.5, periods=1, samples=10)
     assert 0 <= t.attrs["energy_drift"] < 1e-10
