@@ -196,7 +196,10 @@ def _reals(**parameters) -> dict[str, float]:
 
 def _count(name: str, value) -> int:
     """A whole number (threads, samples, …) as the core takes it, a 64-bit integer; refused
-    naming `name` otherwise (its range is the core's to check)."""
+    naming `name` otherwise (its range is the core's to check). A 0-d array counts as the
+    number it holds, as it does for the other parameters."""
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value[()]
     whole = isinstance(value, numbers.Integral) or (
         isinstance(value, (float, np.floating)) and float(value).is_integer())
     if isinstance(value, (bool, np.bool_)) or not whole:
@@ -204,6 +207,13 @@ def _count(name: str, value) -> int:
     if abs(int(value)) >= 2**63:
         raise ValueError(f"invalid {name} = {_shown(int(value))}: beyond a 64-bit integer")
     return int(value)
+
+
+def _text(name: str, value, choices: str) -> str:
+    """A word option (method, model): text only, so that None is not taken for "None"."""
+    if not isinstance(value, str):
+        raise TypeError(f"{name} must be {choices}, not {value!r}")
+    return value
 
 
 def _optional_count(name: str, value) -> int | None:
@@ -812,7 +822,8 @@ def cells(
         field_list = None if fields is None else [str(f) for f in ([fields] if isinstance(fields, str) else fields)]
     except TypeError:
         raise TypeError(f"fields must be names of fields (a str or a list of them), not {fields!r}") from None
-    options = (_real("tol", tol), str(method), _real("resonance_tol", resonance_tol), field_list,
+    options = (_real("tol", tol), _text("method", method, '"quadrature" or "ode"'),
+               _real("resonance_tol", resonance_tol), field_list,
                _optional_count("threads", threads), _switch("allow_large", allow_large))
     progress = None if progress is None else _switch("progress", progress)
     outputs = [m["name"] for m in _core.variables(None)] + ["component"]
@@ -1376,7 +1387,7 @@ def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, e
     table, (k, e, t0, td0, drift) = _core.trajectory(
         *body.values(), _real("kappa", kappa), _optional_real("energy", energy), _count("component", component),
         _optional_real("theta0", theta0), _real("theta_dot0", theta_dot0), _optional_real("periods", periods),
-        _optional_real("t_end", t_end), _count("samples", samples), str(model), tol,
+        _optional_real("t_end", t_end), _count("samples", samples), _text("model", model, '"reduced" or "full"'), tol,
         _switch("allow_large", allow_large))
     arguments = dict(alpha=alpha, beta=beta, nu=nu, eta=eta, kappa=kappa, energy=energy, component=component,
                      theta0=theta0, theta_dot0=theta_dot0, periods=periods, t_end=t_end, samples=samples,

@@ -342,6 +342,10 @@ def test_third_round_findings_are_refused_in_one_line():
     refused(ValueError, lambda: ra.trajectory(*BODY, kappa=0.8, energy=2.5, t_end=float("nan")), "t_end")
     refused(ValueError, lambda: ra.trajectory(*BODY, kappa=0.8, theta0=2.4, theta_dot0=float("nan"), periods=1),
             "theta_dot0")
+    # A 0-d array is the number it holds for counts too; a word option is text.
+    assert ra.trajectory(*BODY, kappa=0.8, energy=2.5, periods=1, samples=np.array(4)).sizes["t"] == 5
+    refused(TypeError, lambda: ra.trajectory(*BODY, kappa=0.8, energy=2.5, periods=1, model=None), "model")
+    refused(TypeError, lambda: ra.cells(*BODY, 0.8, 2.5, method=None), "method")
     # The trajectory says how well it kept the energy.
     t = ra.trajectory(*BODY, kappa=0.8, energy=2.5, periods=1, samples=10)
     assert 0 <= t.attrs["energy_drift"] < 1e-10
