@@ -3,8 +3,6 @@
 //! dense per-cell and per-component arrays of the atlas file (docs/files.md).
 
 use crate::body::Ellipsoid;
-#[cfg(test)]
-use crate::cell::CellOptions;
 use crate::cell::{
     high_energy_families, solve_high_energy_limit, solve_level, CellResult, ComponentResult, Status,
 };
@@ -966,7 +964,7 @@ pub fn compute_cells(
 /// is marked `failed` (keeping what fits) where a component has no slot, or where two
 /// components of one family meet away from κ = 0; at κ = 0 the mirror images of one family
 /// (the body leaning either way) share its slot, the one at larger θ kept.
-fn fill_cell(
+pub fn fill_cell(
     block: &mut Block,
     variables: &[Variable],
     axis: &ComponentAxis,
@@ -1019,104 +1017,5 @@ fn fill_cell(
             }
             _ => unreachable!("a column matches its variable's kind"),
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_cell_the_solver_refuses_is_marked_failed_and_the_block_goes_on() {
-        let body = crate::EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 0.5).unwrap();
-        let potential = EffectivePotential::new(&body, 0.8);
-        let variables = variables(&Field::ALL);
-        let axis = ComponentAxis::full(crate::family::Layout::ThetaMin, COMPONENT_SLOTS);
-        let mut block = Block::empty(&variables, 3, axis.len());
-        let options = CellOptions::default();
-        // A NaN energy makes the solver return an error; the cells around it are solved.
-        for (cell, energy) in [2.5, f64::NAN, 0.1].into_iter().enumerate() {
-            fill_cell(&mut block, &variables, &axis, cell, (0.8, energy), || {
-                solve_level(&potential, energy, &options)
-            });
-        }
-        let status = block.flags(&variables, "cell_status").unwrap();
-        assert_eq!(
-            status,
-            &[cell_status::OK, cell_status::FAILED, cell_status::NO_MOTION]
-        );
-        let count = block.flags(&variables, "n_components").unwrap();
-        assert_eq!(count, &[1, 0, 0]);
-        let Column::F64(n) = &block.columns[variables
-            .iter()
-            .position(|v| v.name == "rotation_number")
-            .unwrap()]
-        else {
-            panic!("rotation_number is f64")
-        };
-        assert!(n[0].is_finite() && n[3..].iter().all(|x| x.is_nan()));
-    }
-
-    #[test]
-    fn units_cover_the_grid_once_and_shards_partition_them() {
-        let shape = [2, 3, 50, 100];
-        let all: Vec<Unit> = units(shape).collect();
-        let cells: usize = all.iter().map(|u| u.rows.len() * shape[3]).sum();
-        assert_eq!(cells, 2 * 3 * 50 * 100);
-        for shape in [shape, [7, 2, 50, 100], [1, 1, 6000, 3], [3, 9, 10, 4000]] {
-            let all: Vec<Unit> = units(shape).collect();
-            assert_eq!(all.len(), unit_count(shape));
-            assert!(all.iter().enumerate().all(|(i, u)| u.index == i));
-            let units_total = all.len();
-            let mut tiled = 0;
-            for count in 1..=units_total.min(24) {
-                if (Shard { index: 1, count }).check_against(shape).is_err() {
-                    continue;
-                }
-                tiled += 1;
-                let mut seen = vec![0; all.len()];
-                let mut cells = 0;
-                for index in 1..=count {
-                    let shard = Shard { index, count };
-                    shard.check_against(shape).unwrap();
-                    let region = shard.region(shape);
-                    let mine: Vec<Unit> = shard.units(shape).collect();
-                    assert!(!mine.is_empty());
-                    assert!(mine.iter().all(|u| region.holds(u)));
-                    assert_eq!(mine.len(), all.iter().filter(|u| region.holds(u)).count());
-                    for u in mine {
-                        seen[u.index] += 1;
-                        // A unit lies in its shard's region whole.
-                        assert!(u.rows.end <= region.rows.end, "{shape:?} {shard}");
-                    }
-                    cells += region.shape().iter().product::<usize>();
-                }
-                assert!(seen.iter().all(|&s| s == 1), "{shape:?} {count}");
-                assert_eq!(cells, shape.iter().product::<usize>());
-            }
-            assert!(tiled >= 4, "{shape:?}");
-            assert!((Shard {
-                index: 1,
-                count: units_total + 1
-            })
-            .check_against(shape)
-            .is_err());
-        }
-        // A count that does not factor over the axes is refused: 3 of 2 x 2 x 1.
-        let small = [2, 2, 24, 40];
-        assert!((Shard { index: 1, count: 3 }).check_against(small).is_err());
-        assert_eq!(
-            (Shard { index: 1, count: 4 }).layout(small),
-            Some([2, 2, 1])
-        );
-        // The fewest units in the largest shard: 6 shards of 7 x 2 x 1 split beta too.
-        assert_eq!(
-            (Shard { index: 1, count: 6 }).layout([7, 2, 1, 4000]),
-            Some([3, 2, 1])
-        );
-        assert!(Shard::parse("0/3").is_err());
-        assert!(Shard::parse("4/3").is_err());
-        assert!(Shard::parse("x").is_err());
-        assert_eq!(Shard::parse("2/3").unwrap(), Shard { index: 2, count: 3 });
     }
 }

@@ -91,17 +91,3 @@ pub fn utc_now() -> String {
 pub fn history(command: &str) -> String {
     format!("{}: {}", utc_now(), command)
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn utc_now_is_iso_8601_to_the_second() {
-        let now = utc_now();
-        assert_eq!(now.len(), 20, "{now}");
-        assert!(now.ends_with('Z') && now.as_bytes()[10] == b'T', "{now}");
-        let parsed: jiff::Timestamp = now.parse().unwrap();
-        assert!((parsed.as_second() - jiff::Timestamp::now().as_second()).abs() < 5);
-    }
-}

@@ -427,30 +427,3 @@ pub fn golden_max(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64, xtol: f64) -> 
         (d, fd)
     }
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::EllipsoidBody;
-
-    #[test]
-    fn symmetric_body_has_no_high_energy_rotation() {
-        let body = EllipsoidBody::ellipsoid(0.0, 0.5, 0.5, 0.5).unwrap();
-        let lim = HighEnergyLimit::of(&body, 1e-12).unwrap();
-        assert_eq!((lim.n_min, lim.n_max, lim.slope), (0.0, 0.0, 0.0));
-        assert_eq!(lim.lambda_at_min, 0.0);
-    }
-
-    #[test]
-    fn lambda_out_of_range_is_refused() {
-        let body = EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 0.5).unwrap();
-        assert!(high_energy_rotation_number(&body, 1.5, 1e-10).is_err());
-        assert!(high_energy_rotation_number(&body, f64::NAN, 1e-10).is_err());
-        assert_eq!(
-            high_energy_rotation_number(&body, SQRT_2, 1e-10)
-                .unwrap()
-                .value,
-            0.0
-        );
-    }
-}

@@ -11,4 +11,5 @@ mod model;
 mod plane;
 mod resonance;
 mod run;
+mod units;
 mod verdict;

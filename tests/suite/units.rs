@@ -1,0 +1,369 @@
+//! Unit tests of single functions of the library (moved here from `#[cfg(test)]` modules:
+//! the library is then compiled once for the tests, not twice).
+
+mod atlas {
+    use rubber_atlas::atlas::*;
+    use rubber_atlas::cell::{solve_level, CellOptions};
+    use rubber_atlas::family::ComponentAxis;
+    use rubber_atlas::scene::Field;
+    use rubber_atlas::torus::EffectivePotential;
+
+    #[test]
+    fn a_cell_the_solver_refuses_is_marked_failed_and_the_block_goes_on() {
+        let body = rubber_atlas::EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 0.5).unwrap();
+        let potential = EffectivePotential::new(&body, 0.8);
+        let variables = variables(&Field::ALL);
+        let axis = ComponentAxis::full(rubber_atlas::family::Layout::ThetaMin, COMPONENT_SLOTS);
+        let mut block = Block::empty(&variables, 3, axis.len());
+        let options = CellOptions::default();
+        // A NaN energy makes the solver return an error; the cells around it are solved.
+        for (cell, energy) in [2.5, f64::NAN, 0.1].into_iter().enumerate() {
+            fill_cell(&mut block, &variables, &axis, cell, (0.8, energy), || {
+                solve_level(&potential, energy, &options)
+            });
+        }
+        let status = block.flags(&variables, "cell_status").unwrap();
+        assert_eq!(
+            status,
+            &[cell_status::OK, cell_status::FAILED, cell_status::NO_MOTION]
+        );
+        let count = block.flags(&variables, "n_components").unwrap();
+        assert_eq!(count, &[1, 0, 0]);
+        let Column::F64(n) = &block.columns[variables
+            .iter()
+            .position(|v| v.name == "rotation_number")
+            .unwrap()]
+        else {
+            panic!("rotation_number is f64")
+        };
+        assert!(n[0].is_finite() && n[3..].iter().all(|x| x.is_nan()));
+    }
+
+    #[test]
+    fn units_cover_the_grid_once_and_shards_partition_them() {
+        let shape = [2, 3, 50, 100];
+        let all: Vec<Unit> = units(shape).collect();
+        let cells: usize = all.iter().map(|u| u.rows.len() * shape[3]).sum();
+        assert_eq!(cells, 2 * 3 * 50 * 100);
+        for shape in [shape, [7, 2, 50, 100], [1, 1, 6000, 3], [3, 9, 10, 4000]] {
+            let all: Vec<Unit> = units(shape).collect();
+            assert_eq!(all.len(), unit_count(shape));
+            assert!(all.iter().enumerate().all(|(i, u)| u.index == i));
+            let units_total = all.len();
+            let mut tiled = 0;
+            for count in 1..=units_total.min(24) {
+                if (Shard { index: 1, count }).check_against(shape).is_err() {
+                    continue;
+                }
+                tiled += 1;
+                let mut seen = vec![0; all.len()];
+                let mut cells = 0;
+                for index in 1..=count {
+                    let shard = Shard { index, count };
+                    shard.check_against(shape).unwrap();
+                    let region = shard.region(shape);
+                    let mine: Vec<Unit> = shard.units(shape).collect();
+                    assert!(!mine.is_empty());
+                    assert!(mine.iter().all(|u| region.holds(u)));
+                    assert_eq!(mine.len(), all.iter().filter(|u| region.holds(u)).count());
+                    for u in mine {
+                        seen[u.index] += 1;
+                        // A unit lies in its shard's region whole.
+                        assert!(u.rows.end <= region.rows.end, "{shape:?} {shard}");
+                    }
+                    cells += region.shape().iter().product::<usize>();
+                }
+                assert!(seen.iter().all(|&s| s == 1), "{shape:?} {count}");
+                assert_eq!(cells, shape.iter().product::<usize>());
+            }
+            assert!(tiled >= 4, "{shape:?}");
+            assert!((Shard {
+                index: 1,
+                count: units_total + 1
+            })
+            .check_against(shape)
+            .is_err());
+        }
+        // A count that does not factor over the axes is refused: 3 of 2 x 2 x 1.
+        let small = [2, 2, 24, 40];
+        assert!((Shard { index: 1, count: 3 }).check_against(small).is_err());
+        assert_eq!(
+            (Shard { index: 1, count: 4 }).layout(small),
+            Some([2, 2, 1])
+        );
+        // The fewest units in the largest shard: 6 shards of 7 x 2 x 1 split beta too.
+        assert_eq!(
+            (Shard { index: 1, count: 6 }).layout([7, 2, 1, 4000]),
+            Some([3, 2, 1])
+        );
+        assert!(Shard::parse("0/3").is_err());
+        assert!(Shard::parse("4/3").is_err());
+        assert!(Shard::parse("x").is_err());
+        assert_eq!(Shard::parse("2/3").unwrap(), Shard { index: 2, count: 3 });
+    }
+}
+
+mod body {
+    use rubber_atlas::body::*;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn ellipsoid_rejects_out_of_range_parameters() {
+        assert!(Ellipsoid::new(1.0, 2.0).is_err());
+        assert!(Ellipsoid::new(0.2, 0.0).is_err());
+        assert!(Ellipsoid::new(f64::NAN, 1.0).is_err());
+        assert!(Ellipsoid::new(0.2, f64::INFINITY).is_err());
+        assert!(Body::new(Ellipsoid::new(0.5, 3.0).unwrap(), 2.5, 1.0).is_err());
+        assert!(Body::new(Ellipsoid::new(0.5, 3.0).unwrap(), 0.5, -1.0).is_err());
+        assert!(EllipsoidBody::ellipsoid(0.5, 3.0, 2.0, 0.5).is_ok());
+    }
+
+    /// The divided difference (U(x) − U(y)) / sin(x − y) where Z and α cosθ cancel, against
+    /// the difference of U's own values (full relative precision, tested above) over pairs
+    /// far enough apart that their difference loses little: within a few ulps of
+    /// (|U(x)| + |U(y)|) / |sin(x − y)|. The plain form was 1e-12 off here.
+    #[test]
+    fn divided_differences_of_u_keep_full_precision_where_z_and_alpha_cos_cancel() {
+        for alpha in [0.999999, -0.999999, 0.9] {
+            for beta in [0.0068, 0.05, 0.6] {
+                let shape = Ellipsoid::new(alpha, beta).unwrap();
+                // Points on the cancelling side: θ beyond π/2 for α > 0, before it for α < 0.
+                let side = |t: f64| if alpha > 0.0 { t } else { PI - t };
+                for (x, y) in [(1.655, 2.506), (1.6, 1.7), (2.0, 3.0), (1.58, 3.1)] {
+                    let (ax, ay) = (Angle::new(side(x)), Angle::new(side(y)));
+                    let (s, c) = (side(x) - side(y)).sin_cos();
+                    let (dd, _) = shape.potential_divided_difference(ax, ay, s, c);
+                    let (ux, uy) = (shape.potential_at(ax), shape.potential_at(ay));
+                    let want = (ux - uy) / s;
+                    let allowed = 8.0 * f64::EPSILON * (ux.abs() + uy.abs()) / s.abs();
+                    assert!(
+                        (dd - want).abs() <= allowed,
+                        "α = {alpha}, β = {beta}, ({x}, {y}): {dd} vs {want} ± {allowed:e}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// U′ and U″ where Z and α cosθ cancel, against their Taylor series about the bottom of
+    /// U (θ = π for α > 0, U = (1 − α) + (β² − 1 + α) x²/2 + … in x = θ − π): U′ = U″ x and
+    /// U″ = β² − 1 + α to O(x²).
+    #[test]
+    fn slope_and_curvature_of_u_keep_full_precision_where_z_and_alpha_cos_cancel() {
+        for alpha in [0.999999f64, -0.999999] {
+            for beta in [0.0068f64, 0.3] {
+                let shape = Ellipsoid::new(alpha, beta).unwrap();
+                let x = 1e-9;
+                let angle = if alpha > 0.0 {
+                    Angle::from_pi(x)
+                } else {
+                    Angle::new(x)
+                };
+                // β² − (1 − |α|): 1 − |α| is exact, β² − 1 + |α| would cancel.
+                let curvature = beta * beta - (1.0 - alpha.abs());
+                let second = shape.potential_second_at(angle);
+                assert!(
+                    (second - curvature).abs() <= 8.0 * f64::EPSILON * curvature.abs(),
+                    "U″ at α = {alpha}, β = {beta}: {second} vs {curvature}"
+                );
+                // U′ = U″ x, signed: U grows away from the bottom.
+                let slope = shape.potential_prime_at(angle) * if alpha > 0.0 { -1.0 } else { 1.0 };
+                assert!(
+                    (slope - curvature * x).abs() <= 8.0 * f64::EPSILON * curvature.abs() * x,
+                    "U′ at α = {alpha}, β = {beta}: {slope} vs {}",
+                    curvature * x
+                );
+            }
+        }
+    }
+
+    /// U = Z + α cosθ and w = cosθ + αZ where they cancel (|α| → 1 at the pole where α cosθ
+    /// < 0: θ = π for α > 0, θ = 0 for α < 0), against their Taylor series in the distance x
+    /// to that pole (truncated at x⁸, far below 1e-15 of U for x ≤ 1e-3).
+    #[test]
+    fn height_keeps_full_precision_where_z_and_alpha_cos_cancel() {
+        for alpha in [0.999999, -0.999999, 0.75, -0.6] {
+            for beta in [0.44, 1.0, 1.4142132] {
+                let shape = Ellipsoid::new(alpha, beta).unwrap();
+                let a = f64::abs(alpha);
+                for x in [1e-3, 1e-5, 1e-8, 0.0] {
+                    let angle = if alpha > 0.0 {
+                        Angle::from_pi(x)
+                    } else {
+                        Angle::new(x)
+                    };
+                    let q = (beta * beta - 1.0) * x.sin().powi(2);
+                    let z_minus_1 = q / 2.0 - q * q / 8.0 + q * q * q / 16.0;
+                    let one_minus_cos = x * x / 2.0 - x.powi(4) / 24.0 + x.powi(6) / 720.0;
+                    // U = (1 − |α|) + (Z − 1) + |α| (1 − cos x).
+                    let u = (1.0 - a) + z_minus_1 + a * one_minus_cos;
+                    // w = sgn α (|α| Z − cos x) = sgn α (−(1 − |α|) + |α| (Z − 1) + (1 − cos x)).
+                    let w = alpha.signum() * (-(1.0 - a) + a * z_minus_1 + one_minus_cos);
+                    // Full precision: a few ulps of the L1 size of the series' terms.
+                    let size = (1.0 - a) + z_minus_1.abs() + one_minus_cos;
+                    let z = shape.centre_height_at(angle);
+                    let (u_got, w_got) = shape.height_and_offset_at(angle, z);
+                    for (got, want, name) in [(u_got, u, "U"), (w_got, w, "w")] {
+                        assert!(
+                            (got - want).abs() <= 4.0 * f64::EPSILON * size,
+                            "{name} at α = {alpha}, β = {beta}, x = {x}: {got} vs {want}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
+mod cf {
+    use rubber_atlas::cf::*;
+
+    #[test]
+    fn utc_now_is_iso_8601_to_the_second() {
+        let now = utc_now();
+        assert_eq!(now.len(), 20, "{now}");
+        assert!(now.ends_with('Z') && now.as_bytes()[10] == b'T', "{now}");
+        let parsed: jiff::Timestamp = now.parse().unwrap();
+        assert!((parsed.as_second() - jiff::Timestamp::now().as_second()).abs() < 5);
+    }
+}
+
+mod family {
+    use rubber_atlas::family::*;
+
+    #[test]
+    fn names_codes_and_flags_agree() {
+        let names: Vec<&str> = Family::ALL.iter().map(|f| f.name()).collect();
+        assert_eq!(names.join(" "), Family::MEANINGS);
+        for f in Family::ALL {
+            assert_eq!(Family::from_code(f.code()), Some(f));
+            assert_eq!(Family::from_name(f.name()), Some(f));
+            assert_eq!(Family::VALUES[usize::from(f.code())], f.code());
+            assert_eq!(
+                serde_json::to_string(&f).unwrap(),
+                format!("\"{}\"", f.name())
+            );
+        }
+        assert_eq!(Family::from_code(5), None);
+    }
+
+    #[test]
+    fn sides_name_the_wells() {
+        use Side::*;
+        let outer = Family::WellPi;
+        assert_eq!(of_sides([Upper], outer), Some(Family::Well0));
+        assert_eq!(of_sides([Lower, Lower], outer), Some(Family::WellPi));
+        assert_eq!(of_sides([Equator], outer), Some(Family::WellEquator));
+        assert_eq!(of_sides([Upper, Lower], outer), Some(outer));
+        assert_eq!(of_sides([Upper, Lower], Family::Well0), Some(Family::Well0));
+        assert_eq!(of_sides([], outer), None);
+    }
+
+    #[test]
+    fn the_axis_has_no_slot_empty_everywhere() {
+        let mut census = Census::default();
+        census.add(&[Family::Well0, Family::WellPi]);
+        census.add(&[Family::OverTheTop]);
+        let by_family = ComponentAxis::of(Layout::Family, &census);
+        assert_eq!(by_family.labels, vec![0, 1, 3]);
+        assert_eq!(by_family.slot(0, Family::OverTheTop), Some(2));
+        assert_eq!(by_family.slot(0, Family::WellEquator), None);
+        let (values, meanings) = by_family.flag_attributes().unwrap();
+        assert_eq!(
+            (values, meanings.as_str()),
+            (vec![0, 1, 3], "well_0 well_pi over_the_top")
+        );
+        let by_theta = ComponentAxis::of(Layout::ThetaMin, &census);
+        assert_eq!(by_theta.labels, vec![0, 1]);
+        assert_eq!(by_theta.slot(1, Family::Well0), Some(1));
+        assert_eq!(by_theta.slot(2, Family::Well0), None);
+        assert!(by_theta.flag_attributes().is_none());
+        let none = ComponentAxis::of(Layout::Family, &Census::default());
+        assert_eq!(none.len(), 1);
+    }
+}
+
+mod limits {
+    use rubber_atlas::limits::*;
+    use rubber_atlas::EllipsoidBody;
+    use std::f64::consts::SQRT_2;
+
+    #[test]
+    fn symmetric_body_has_no_high_energy_rotation() {
+        let body = EllipsoidBody::ellipsoid(0.0, 0.5, 0.5, 0.5).unwrap();
+        let lim = HighEnergyLimit::of(&body, 1e-12).unwrap();
+        assert_eq!((lim.n_min, lim.n_max, lim.slope), (0.0, 0.0, 0.0));
+        assert_eq!(lim.lambda_at_min, 0.0);
+    }
+
+    #[test]
+    fn lambda_out_of_range_is_refused() {
+        let body = EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 0.5).unwrap();
+        assert!(high_energy_rotation_number(&body, 1.5, 1e-10).is_err());
+        assert!(high_energy_rotation_number(&body, f64::NAN, 1e-10).is_err());
+        assert_eq!(
+            high_energy_rotation_number(&body, SQRT_2, 1e-10)
+                .unwrap()
+                .value,
+            0.0
+        );
+    }
+}
+
+mod quadrature {
+    use rubber_atlas::quadrature::*;
+
+    #[test]
+    fn tanh_sinh_integrates_end_singularities() {
+        // ∫_0^2 dx / √(x (2 − x)) = π, with both ends singular.
+        let level = TanhSinhLevel::new(5);
+        let sum: f64 = (0..level.count)
+            .map(|j| {
+                let node = IntervalNode::tanh_sinh(level.tau(j), 2.0);
+                node.jacobian / (node.from_left * node.from_right).sqrt()
+            })
+            .sum::<f64>()
+            * level.step;
+        assert!((sum - std::f64::consts::PI).abs() < 1e-14, "{sum}");
+    }
+
+    #[test]
+    fn cosine_substitution_converges_geometrically() {
+        // ∫_0^1 eˣ / √(x (1 − x)) dx = π e^{1/2} I₀(1/2) (a high-precision value): the
+        // trapezoid rule in φ on [0, π], ends weighted ½ and taken as their limits.
+        let exact = 5.508_429_773_886_107;
+        let rule = |n: usize| {
+            let f = |j: usize| {
+                let node = IntervalNode::cosine_tabulated(n, j, 1.0);
+                if j == 0 || j == n {
+                    0.5 * node.from_left.exp()
+                } else {
+                    node.from_left.exp() * node.jacobian / (node.from_left * node.from_right).sqrt()
+                }
+            };
+            std::f64::consts::PI / n as f64 * (0..=n).map(f).sum::<f64>()
+        };
+        // Geometric convergence: 2 → 4 → 8 steps take the error 2e-3 → 4e-9 → rounding.
+        assert!((rule(2) - exact).abs() > 1e-3);
+        assert!((rule(4) - exact).abs() < 1e-8);
+        assert!((rule(8) - exact).abs() < 4e-15, "{}", rule(8) - exact);
+    }
+
+    #[test]
+    fn spectral_antiderivative_matches_a_closed_form() {
+        // g = sech² τ on the tanh-sinh grid of ∫_0^1 2x dx: G(x) = x², compared at each node.
+        let level = TanhSinhLevel::new(5);
+        let nodes: Vec<_> = (0..level.count)
+            .map(|j| IntervalNode::tanh_sinh(level.tau(j), 1.0))
+            .collect();
+        let g: Vec<f64> = nodes
+            .iter()
+            .map(|n| 2.0 * n.from_left * n.jacobian)
+            .collect();
+        let cumulative = spectral_antiderivative(&g, level.step);
+        for (node, value) in nodes.iter().zip(&cumulative) {
+            let exact = node.from_left * node.from_left;
+            assert!((value - exact).abs() < 1e-13, "{value} vs {exact}");
+        }
+    }
+}
