@@ -540,14 +540,17 @@ impl Shard {
         let (i, n) = text
             .split_once('/')
             .ok_or_else(|| bad("expected I/N, e.g. 2/8"))?;
-        let index: usize = i
-            .trim()
-            .parse()
-            .map_err(|_| bad("I is not a whole number"))?;
-        let count: usize = n
-            .trim()
-            .parse()
-            .map_err(|_| bad("N is not a whole number"))?;
+        let whole = |part: &str, name: &str| -> Result<usize> {
+            part.trim().parse().map_err(|e: std::num::ParseIntError| {
+                use std::num::IntErrorKind::PosOverflow;
+                bad(&if *e.kind() == PosOverflow {
+                    format!("{name} is beyond {}", usize::MAX)
+                } else {
+                    format!("{name} is not a whole number >= 1")
+                })
+            })
+        };
+        let (index, count) = (whole(i, "I")?, whole(n, "N")?);
         if count == 0 || index == 0 || index > count {
             return Err(bad("needs 1 <= I <= N"));
         }
@@ -765,11 +768,9 @@ fn visit_row(
             // κ = λ/s, ε = 1/s²: every cell has its own κ; s = 0 is ε = ∞.
             for (j, &s) in columns.iter().enumerate() {
                 if s == 0.0 {
-                    visit(
-                        j,
-                        (f64::INFINITY, f64::INFINITY),
-                        CellLevel::HighEnergy(row_value),
-                    );
+                    // λ = 0 keeps κ = 0 at ε = ∞ (rolling over the top), as at every s > 0.
+                    let kappa = if row_value == 0.0 { 0.0 } else { f64::INFINITY };
+                    visit(j, (kappa, f64::INFINITY), CellLevel::HighEnergy(row_value));
                 } else {
                     let (kappa, energy) = (row_value / s, 1.0 / (s * s));
                     let potential = EffectivePotential::new(body, kappa);

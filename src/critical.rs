@@ -227,6 +227,24 @@ impl CriticalSet {
     /// The critical set of an ellipsoid body with α ≥ 0, its curves sampled with `samples`
     /// points per half (θ0 < π/2, θ0 > π/2) and truncated at κ ≤ `kappa_max`.
     pub fn of(body: &EllipsoidBody, samples: usize, kappa_max: f64) -> Result<Self> {
+        Self::of_until(body, samples, kappa_max, &|| false)
+    }
+
+    /// [`CriticalSet::of`], given up with [`AtlasError::Stopped`] when `stop` says so (asked
+    /// every 65,536 samples; Ctrl-C in Python).
+    pub fn of_until(
+        body: &EllipsoidBody,
+        samples: usize,
+        kappa_max: f64,
+        stop: &dyn Fn() -> bool,
+    ) -> Result<Self> {
+        let stopped = |i: usize| {
+            if i.is_multiple_of(65_536) && stop() {
+                Err(AtlasError::Stopped)
+            } else {
+                Ok(())
+            }
+        };
         let (alpha, beta) = (body.shape.alpha, body.shape.beta);
         if alpha < 0.0 {
             return Err(AtlasError::InvalidParameter {
@@ -285,6 +303,7 @@ impl CriticalSet {
             // Interior samples; a pole is added only where a branch ends at it (U″ > 0 there,
             // i.e. κ² ≥ 0 on its neighbourhood), never as a lone point.
             for i in 1..samples {
+                stopped(i)?;
                 let t = lo + (hi - lo) * i as f64 / samples as f64;
                 if fixed_point_kappa_sq(body, t) < 0.0 {
                     continue;
@@ -354,6 +373,7 @@ impl CriticalSet {
                 });
             };
             for i in 0..=samples {
+                stopped(i)?;
                 let kappa = kappa_max * i as f64 / samples as f64;
                 let stable = kappa * kappa - (beta * beta - 1.0) / beta > 0.0;
                 let last_stable = run.last().map(|p| p.stable);

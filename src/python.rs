@@ -42,21 +42,35 @@ fn bad(message: String) -> PyErr {
 }
 
 /// The fields named by `names` (all of them for None).
+/// As a scene's `[outputs] fields`: known names, none twice, not empty, and `status`
+/// always (without it a failed or unconverged value would not be flagged).
 fn parse_fields(names: Option<Vec<String>>) -> PyResult<Vec<Field>> {
-    match names {
-        None => Ok(Field::ALL.to_vec()),
-        Some(names) => names
-            .iter()
-            .map(|n| {
-                Field::from_name(n).ok_or_else(|| {
-                    bad(format!(
-                        "unknown field {n:?}; known: {}",
-                        Field::ALL.map(|f| f.name()).join(", ")
-                    ))
-                })
-            })
-            .collect(),
+    let Some(names) = names else {
+        return Ok(Field::ALL.to_vec());
+    };
+    if names.is_empty() {
+        return Err(bad(
+            "fields is empty: name at least one field, or leave it out for all".into(),
+        ));
     }
+    let mut fields = Vec::with_capacity(names.len() + 1);
+    for n in &names {
+        let field = Field::from_name(n).ok_or_else(|| {
+            bad(format!(
+                "unknown field {n:?}; known: {}",
+                Field::ALL.map(|f| f.name()).join(", ")
+            ))
+        })?;
+        if fields.contains(&field) {
+            return Err(bad(format!("field {n:?} is listed twice")));
+        }
+        fields.push(field);
+    }
+    if !fields.contains(&Field::Status) {
+        fields.push(Field::Status);
+    }
+    fields.sort();
+    Ok(fields)
 }
 
 /// A count given from Python (`samples`, `component`, …), refused below `min` naming it.
@@ -415,9 +429,12 @@ fn diagram(
         "use fewer samples, or allow_large=True",
     )?;
     let body = body(alpha, beta, nu, eta)?;
-    let set = py
-        .detach(|| CriticalSet::of(&body, samples, kappa_max))
-        .map_err(value_error)?;
+    // Ctrl-C is heard every 65,536 samples (it used to wait for the whole set, and a
+    // KeyboardInterrupt pending at the first NumPy call became a panic).
+    let set = interruptible(py, &None, |stop| {
+        CriticalSet::of_until(&body, samples, kappa_max, stop)
+    })?
+    .map_err(value_error)?;
     let summary = serde_json::to_string(&set).map_err(|e| bad(e.to_string()))?;
     Ok((table_dict(py, crate::table::diagram(&set))?, summary))
 }

@@ -712,7 +712,8 @@ def cells(
         Quadrature of the period integrals, or integration of the reduced equations of
         motion over one period.
     fields : iterable of str, optional
-        The fields to compute, from `FIELDS` (default: all of them). A field left out costs
+        The fields to compute, from `FIELDS` (default: all of them), each once; ``status``
+        is always added, as a scene's ``[outputs] fields`` adds it. A field left out costs
         no time (the drift integrals only run for ``drift``, ``drift_radius`` or
         ``bounded``).
     resonance_tol : float, default 1e-9

@@ -103,9 +103,10 @@ class RubberAccessor:
         Returns
         -------
         list of dict
-            One dict per component, sorted by theta_min, keys as in ``rubber-atlas cell
-            --json``; ``status``, ``motion`` and ``family`` as names, ``bounded`` as
-            True/False/None.
+            One dict per component, sorted by theta_min, one key per per-component
+            variable of the dataset (named as in ``rubber-atlas cell --json``; the errors as
+            flat ``*_error`` keys); ``status``, ``motion`` and ``family`` as names,
+            ``bounded`` as True/False/None.
 
         Raises
         ------

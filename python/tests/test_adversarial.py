@@ -346,6 +346,10 @@ def test_third_round_findings_are_refused_in_one_line():
     assert ra.trajectory(*BODY, kappa=0.8, energy=2.5, periods=1, samples=np.array(4)).sizes["t"] == 5
     refused(TypeError, lambda: ra.trajectory(*BODY, kappa=0.8, energy=2.5, periods=1, model=None), "model")
     refused(TypeError, lambda: ra.cells(*BODY, 0.8, 2.5, method=None), "method")
+    # fields as a scene takes them: status always, no empty list, no field twice.
+    assert "status" in ra.cells(*BODY, 1.0, 3.0, fields=["rotation_number"]).data_vars
+    refused(ValueError, lambda: ra.cells(*BODY, 1.0, 3.0, fields=[]), "empty")
+    refused(ValueError, lambda: ra.cells(*BODY, 1.0, 3.0, fields=["status", "status"]), "twice")
     # The trajectory says how well it kept the energy.
     t = ra.trajectory(*BODY, kappa=0.8, energy=2.5, periods=1, samples=10)
     assert 0 <= t.attrs["energy_drift"] < 1e-10

@@ -106,11 +106,12 @@ def test_cells_on_named_dimensions_equal_an_atlas_file(slice_atlas):
         for key in ("long_name", "units", "comment"):
             assert ds[name].attrs.get(key) == atlas[name].attrs.get(key), (name, key)
     assert ds.attrs["tolerance"] == atlas.attrs["tolerance"] and ds.attrs["Conventions"] == atlas.attrs["Conventions"]
-    # Fewer fields: only theirs (and the cell's counts). Without the drift the quadrature
+    # Fewer fields: only theirs (and the cell's counts and status). Without the drift the quadrature
     # stops when N alone has converged: the same N within its error estimate (as an atlas
     # with these fields gives it), not bit for bit.
     few = ra.cells(0.5, 3.0, 0.5, 0.5, kappa, energy, fields=["rotation_number", "error_estimate"], layout=layout)
-    assert set(few.data_vars) - {"family"} == {"n_components", "cell_status", "rotation_number", "error_estimate"}
+    assert set(few.data_vars) - {"family"} == {"n_components", "cell_status", "status", "rotation_number",
+                                                "error_estimate"}
     np.testing.assert_array_equal(np.isnan(few.rotation_number), np.isnan(ds.rotation_number))
     gap = np.abs(few.rotation_number - ds.rotation_number).fillna(0)
     assert (gap <= few.error_estimate.fillna(0) + ds.error_estimate.fillna(0)).all()
@@ -221,6 +222,8 @@ LONG_CALLS = {
     # About 15 s each on one core; they ran to the end under Ctrl-C.
     "trajectory": "ra.trajectory(0.5, 3.0, 0.5, 0.5, kappa=0.8, energy=2.5, t_end=1e6, model='full')",
     "resonance": "ra.resonance(0.5, 3.0, 0.5, 0.5, '-1/7', grid=400)",
+    # 48 s; a SIGINT in the first call became a Rust panic.
+    "diagram": "ra.diagram(0.5, 3.0, samples=50_000_000)",
 }
 
 

@@ -51,7 +51,7 @@ pub struct RunArgs {
     #[arg(long, value_name = "N", allow_hyphen_values = true)]
     pub threads: Option<usize>,
     /// Continue an interrupted run of the same scene and output (finished units are kept).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "force")]
     pub resume: bool,
     /// Overwrite an existing output and discard an interrupted run.
     #[arg(long)]
@@ -68,7 +68,7 @@ pub struct RunArgs {
     #[command(flatten)]
     pub limits: Limits,
     /// Compute part I of N of the grid (1 <= I <= N) into its own file.
-    #[arg(long, value_name = "I/N")]
+    #[arg(long, value_name = "I/N", allow_hyphen_values = true)]
     pub shard: Option<String>,
     /// No progress and no summary.
     #[arg(long)]

@@ -429,6 +429,22 @@ fn edge_inputs_get_one_line_and_never_a_panic() {
         "do not tile",
         Some(&out),
     );
+    // --resume --force threw the journal away; a negative I was "unexpected argument".
+    assert_refused(
+        &["run", scene_s, "--out", out_s, "--resume", "--force"],
+        "cannot be used with",
+        Some(&out),
+    );
+    assert_refused(
+        &["run", scene_s, "--out", out_s, "--shard", "-1/2"],
+        "--shard -1/2",
+        Some(&out),
+    );
+    assert_refused(
+        &["run", scene_s, "--out", out_s, "--shard", "1/99999999999999999999"],
+        "beyond",
+        Some(&out),
+    );
     // A grid whose step overflows (inf · 0 = NaN passed the monotonic check).
     let nan = dir.path().join("nan.toml");
     std::fs::write(&nan, grid("{ start = -1.7e308, stop = 1.7e308, num = 2 }")).unwrap();

@@ -181,6 +181,18 @@ fn excess_energy_plane_starts_at_the_bottom_of_every_row() {
     }
 }
 
+/// λ = 0 is κ = 0 along the whole s-axis, ε = ∞ included (its κ coordinate was inf there).
+#[test]
+fn compact_plane_keeps_kappa_zero_at_lambda_zero() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = run_scene(dir.path(), "lambda = [0.0, 0.5]\ns = [0.0, 0.5]");
+    let kappa = read4(&f, "kappa");
+    assert_eq!(kappa[[0, 0, 0, 0]], 0.0);
+    assert_eq!(kappa[[0, 0, 0, 1]], 0.0);
+    assert!(kappa[[0, 0, 1, 0]].is_infinite());
+    assert_eq!(kappa[[0, 0, 1, 1]], 1.0);
+}
+
 #[test]
 fn compact_plane_reaches_infinite_energy_exactly() {
     let dir = tempfile::tempdir().unwrap();
