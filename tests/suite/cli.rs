@@ -441,7 +441,14 @@ fn edge_inputs_get_one_line_and_never_a_panic() {
         Some(&out),
     );
     assert_refused(
-        &["run", scene_s, "--out", out_s, "--shard", "1/99999999999999999999"],
+        &[
+            "run",
+            scene_s,
+            "--out",
+            out_s,
+            "--shard",
+            "1/99999999999999999999",
+        ],
         "beyond",
         Some(&out),
     );
