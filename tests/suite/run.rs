@@ -279,7 +279,7 @@ fn slow_scene(dir: &Path) -> PathBuf {
             "slow",
             "ode",
             "alpha = [0.3, 0.5]\nbeta = [0.8, 2.0, 3.0]\n\
-             kappa = { start = 0.05, stop = 1.5, num = 16 }\n\
+             kappa = { start = 0.05, stop = 1.5, num = 24 }\n\
              energy = { start = 1.0, stop = 4.0, num = 64 }",
         ),
     )
