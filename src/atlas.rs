@@ -13,6 +13,7 @@ use crate::scene::{Field, Plane, Scene};
 use crate::torus::{EffectivePotential, MotionKind};
 use crate::EllipsoidBody;
 use rayon::prelude::*;
+use std::f64::consts::{PI, TAU};
 use std::ops::Range;
 
 /// Component slots per cell in the θ_min layout before the census trims them. {V ≤ ε} has
@@ -960,11 +961,24 @@ pub fn compute_cells(
     Block::concat(variables, axis.len(), blocks)
 }
 
+/// The middle of a component's θ-range on the circle, in (−π, π]: at κ = 0 the angles are
+/// lifted (θ up to 3π), so a mirror image at θ < 0 may be held as one beyond π.
+fn leaning_angle(c: &ComponentResult) -> f64 {
+    let mid = 0.5 * (c.theta_min + c.theta_max);
+    let wrapped = mid - TAU * (mid / TAU).round();
+    if wrapped <= -PI {
+        wrapped + TAU
+    } else {
+        wrapped
+    }
+}
+
 /// One cell of `block`: `solve` gives its components, laid out in the slots of `axis`;
 /// `(kappa, energy)` are its κ and ε, written where they are auxiliary coordinates. The cell
 /// is marked `failed` (keeping what fits) where a component has no slot, or where two
 /// components of one family meet away from κ = 0; at κ = 0 the mirror images of one family
-/// (the body leaning either way) share its slot, the one at larger θ kept.
+/// (the body leaning either way) share its slot, and the one leaning to θ > 0 is kept
+/// ([`leaning_angle`]), the one continuous with κ > 0.
 pub fn fill_cell(
     block: &mut Block,
     variables: &[Variable],
@@ -985,7 +999,11 @@ pub fn fill_cell(
     for (index, c) in components.iter().enumerate() {
         match axis.slot(index, c.family) {
             Some(slot) => match placed.iter_mut().find(|(s, _)| *s == slot) {
-                Some(twin) if kappa == 0.0 => twin.1 = c,
+                Some(twin) if kappa == 0.0 => {
+                    if leaning_angle(c) > leaning_angle(twin.1) {
+                        twin.1 = c;
+                    }
+                }
                 Some(_) => status = cell_status::FAILED,
                 None => placed.push((slot, c)),
             },

@@ -257,3 +257,36 @@ fn compact_plane_reaches_infinite_energy_exactly() {
         }
     }
 }
+
+/// At κ = 0 the family layout keeps the mirror image leaning to θ > 0, the one continuous
+/// with κ > 0 (for `well_pi` of α = 0.3, β = 0.6 it kept the one held at θ = 4.12 … 4.64,
+/// i.e. leaning to θ < 0, and θ_min jumped to 1.649 at the next κ).
+#[test]
+fn the_family_layout_keeps_the_mirror_image_continuous_with_positive_kappa() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("twins.toml");
+    std::fs::write(
+        &path,
+        "name = \"twins\"\n[body]\nnu = 0.5\neta = 0.5\n[axes]\nalpha = [0.3]\nbeta = [0.6]\n\
+         kappa = { start = 0.0, stop = 0.04, num = 3 }\nenergy = [0.58]\n\
+         [outputs]\nfields = [\"theta_min\", \"status\"]\n",
+    )
+    .unwrap();
+    let out = dir.path().join("twins.h5");
+    let o = Command::new(BIN)
+        .args([
+            "run",
+            path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--quiet",
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let f = hdf5::File::open(out).unwrap();
+    let theta_min = read5(&f, "theta_min");
+    let row: Vec<f64> = (0..3).map(|k| theta_min[[0, 0, k, 0, 0]]).collect();
+    assert!((row[0] - 1.6481).abs() < 1e-3, "{row:?}");
+    assert!((row[1] - row[0]).abs() < 0.01, "{row:?}");
+}
