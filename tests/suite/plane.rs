@@ -23,8 +23,13 @@ fn scene(axes: &str) -> String {
 }
 
 fn run_scene(dir: &Path, axes: &str) -> hdf5::File {
+    run_scene_text(dir, &scene(axes))
+}
+
+/// Runs a scene given whole, and opens its atlas.
+fn run_scene_text(dir: &Path, text: &str) -> hdf5::File {
     let path = dir.join("plane.toml");
-    std::fs::write(&path, scene(axes)).unwrap();
+    std::fs::write(&path, text).unwrap();
     let out = dir.join("plane.h5");
     let o = Command::new(BIN)
         .args([
@@ -264,27 +269,12 @@ fn compact_plane_reaches_infinite_energy_exactly() {
 #[test]
 fn the_family_layout_keeps_the_mirror_image_continuous_with_positive_kappa() {
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("twins.toml");
-    std::fs::write(
-        &path,
+    let f = run_scene_text(
+        dir.path(),
         "name = \"twins\"\n[body]\nnu = 0.5\neta = 0.5\n[axes]\nalpha = [0.3]\nbeta = [0.6]\n\
          kappa = { start = 0.0, stop = 0.04, num = 3 }\nenergy = [0.58]\n\
          [outputs]\nfields = [\"theta_min\", \"status\"]\n",
-    )
-    .unwrap();
-    let out = dir.path().join("twins.h5");
-    let o = Command::new(BIN)
-        .args([
-            "run",
-            path.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--quiet",
-        ])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let f = hdf5::File::open(out).unwrap();
+    );
     let theta_min = read5(&f, "theta_min");
     let row: Vec<f64> = (0..3).map(|k| theta_min[[0, 0, k, 0, 0]]).collect();
     assert!((row[0] - 1.6481).abs() < 1e-3, "{row:?}");
