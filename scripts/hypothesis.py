@@ -37,16 +37,17 @@ ROOT = Path(__file__).resolve().parents[1]
 CATEGORIES = {"holds": 0, "fails": 1, "not covered": 2, "undecided": 3}
 
 
-def boundaries(alpha: float, nu: float, eta: float, scan: int, beta_min: float, beta_max: float) -> dict:
+def boundaries(alpha: float, nu: float, eta: float, scan: int, beta_min: float, beta_max: float,
+               resolution: int) -> dict:
     """`verdict --boundaries` at one α (the package's, on rayon's pool, which the callers in
     several threads share): {alpha, boundaries: [...], scan: [...]}."""
-    found = ra.boundaries(alpha, nu, eta, scan=scan, beta_min=beta_min, beta_max=beta_max)
+    found = ra.boundaries(alpha, nu, eta, scan=scan, beta_min=beta_min, beta_max=beta_max, resolution=resolution)
     return json.loads(found.attrs["boundaries_json"])
 
 
-def verdict(alpha: float, beta: float, nu: float, eta: float) -> dict:
+def verdict(alpha: float, beta: float, nu: float, eta: float, resolution: int) -> dict:
     """The verdict of one body, as `rubber-atlas verdict --json` prints it."""
-    return json.loads(ra.verdict(alpha, beta, nu, eta).verdict_json.item())
+    return json.loads(ra.verdict(alpha, beta, nu, eta, resolution=resolution).verdict_json.item())
 
 
 def label(holds, case="1") -> str:
@@ -57,10 +58,10 @@ def label(holds, case="1") -> str:
     return "holds" if holds else "fails"
 
 
-def sweep(alphas, nu, eta, scan, beta_min, beta_max, jobs):
+def sweep(alphas, nu, eta, scan, beta_min, beta_max, resolution, jobs):
     """`verdict --boundaries` at every α, `jobs` at a time, in α order."""
     with ThreadPoolExecutor(max_workers=jobs) as pool:
-        return list(pool.map(lambda a: boundaries(a, nu, eta, scan, beta_min, beta_max), alphas))
+        return list(pool.map(lambda a: boundaries(a, nu, eta, scan, beta_min, beta_max, resolution), alphas))
 
 
 def map_rows(results) -> list[dict]:
@@ -136,10 +137,10 @@ def regions(rows: list[dict]) -> list[list[dict]]:
     return out
 
 
-def confirm(alpha: float, beta: float, nu: float, eta: float, periods=(10, 20)) -> dict:
+def confirm(alpha: float, beta: float, nu: float, eta: float, resolution: int, periods=(10, 20)) -> dict:
     """The first counterexample of one body, followed with the full model: the centre of mass
     is n·|Δζ| from its start after n periods on an integer resonance."""
-    v = verdict(alpha, beta, nu, eta)
+    v = verdict(alpha, beta, nu, eta, resolution)
     if not v["counterexamples"]:
         return dict(alpha=alpha, beta=beta, confirmed=False, reason=v["evidence"].get("limit_failure") or "none")
     c = min(v["counterexamples"], key=lambda c: abs(np.log(c["kappa"])))
@@ -271,6 +272,9 @@ def main() -> None:
                              "(default '0.1,1;1,0.1;1.5,5'; '' for none)")
     parser.add_argument("--other-alphas", type=int, default=10, help="alpha values for the other pairs (default 10)")
     parser.add_argument("--other-betas", type=int, default=24, help="beta scan for the other pairs (default 24)")
+    parser.add_argument("--resolution", type=int, default=64,
+                        help="sampling of each body's (kappa, energy) plane, as verdict --resolution (default 64; "
+                             "a coarser one is faster and may miss a narrow failure)")
     parser.add_argument("--jobs", type=int, default=2, help="verdict processes at a time (default 2)")
     parser.add_argument("--no-confirm", action="store_true", help="skip the trajectory evidence")
     parser.add_argument("--replot", action="store_true",
@@ -284,14 +288,16 @@ def main() -> None:
 
     start = time.time()
     alphas = [float(a) for a in np.linspace(0.0, 0.975, args.alphas)] if args.alphas > 1 else [0.5]
-    results = sweep(alphas, args.nu, args.eta, args.betas, args.beta_min, args.beta_max, args.jobs)
+    results = sweep(alphas, args.nu, args.eta, args.betas, args.beta_min, args.beta_max, args.resolution,
+                    args.jobs)
     rows = map_rows(results)
     brows = boundary_rows(results, args.nu, args.eta)
     main_seconds = time.time() - start
     for pair in filter(None, args.others.split(";")):
         o_nu, o_eta = (float(x) for x in pair.split(","))
         o_alphas = [float(a) for a in np.linspace(0.0, 0.975, args.other_alphas)]
-        o_results = sweep(o_alphas, o_nu, o_eta, args.other_betas, args.beta_min, args.beta_max, args.jobs)
+        o_results = sweep(o_alphas, o_nu, o_eta, args.other_betas, args.beta_min, args.beta_max,
+                          args.resolution, args.jobs)
         brows += boundary_rows(o_results, o_nu, o_eta)
     evidence = []
     if not args.no_confirm:
@@ -300,14 +306,14 @@ def main() -> None:
             mid_a = np.median([r["alpha"] for r in region])
             mid_b = np.exp(np.median([np.log(r["beta"]) for r in region]))
             body = min(region, key=lambda r: (abs(r["alpha"] - mid_a), abs(np.log(r["beta"] / mid_b))))
-            e = confirm(body["alpha"], body["beta"], args.nu, args.eta)
+            e = confirm(body["alpha"], body["beta"], args.nu, args.eta, args.resolution)
             e["region_bodies"] = len(region)
             evidence.append(e)
     out.parent.mkdir(parents=True, exist_ok=True)
     write_csv(out.with_suffix(".csv"), rows)
     write_csv(out.parent / f"{out.name}-boundaries.csv", brows)
     write_csv(out.parent / f"{out.name}-evidence.csv", evidence)
-    attrs = dict(nu=args.nu, eta=args.eta, program=f"rubber-atlas {ra.__version__} ({ra.git_commit})",
+    attrs = dict(nu=args.nu, eta=args.eta, resolution=args.resolution, program=f"rubber-atlas {ra.__version__} ({ra.git_commit})",
                  command_line=" ".join(sys.argv), seconds_map=main_seconds)
     write_h5(out.with_suffix(".h5"), dict(map=rows, boundaries=brows, evidence=evidence), attrs)
     plot(rows, brows, evidence, out.with_suffix(".png"), args.nu, args.eta)

@@ -224,8 +224,9 @@ pub fn energy_min(alpha: f64, beta: f64) -> f64 {
 }
 
 impl CriticalSet {
-    /// The critical set of an ellipsoid body with α ≥ 0, its curves sampled with `samples`
-    /// points per half (θ0 < π/2, θ0 > π/2) and truncated at κ ≤ `kappa_max`.
+    /// The critical set of an ellipsoid body, its curves sampled with `samples` points per
+    /// half (θ0 < π/2, θ0 > π/2) and truncated at κ ≤ `kappa_max`. For α < 0 it is the mirror
+    /// image of the body with −α (θ → π − θ; [`DiagramType`] is that of |α|).
     pub fn of(body: &EllipsoidBody, samples: usize, kappa_max: f64) -> Result<Self> {
         Self::of_until(body, samples, kappa_max, &|| false)
     }
@@ -247,11 +248,8 @@ impl CriticalSet {
         };
         let (alpha, beta) = (body.shape.alpha, body.shape.beta);
         if alpha < 0.0 {
-            return Err(AtlasError::InvalidParameter {
-                name: "alpha",
-                value: alpha,
-                reason: "the diagram is tabulated for alpha >= 0; alpha < 0 is its mirror image theta -> pi - theta",
-            });
+            let image = EllipsoidBody::ellipsoid(-alpha, beta, body.nu, body.eta)?;
+            return Ok(Self::of_until(&image, samples, kappa_max, stop)?.mirrored());
         }
         if !(kappa_max.is_finite() && kappa_max > 0.0) {
             return Err(AtlasError::InvalidParameter {
@@ -403,6 +401,83 @@ impl CriticalSet {
             branches,
             kappa_max,
         })
+    }
+}
+
+/// The name of a branch or an equilibrium seen in the mirror θ → π − θ.
+fn mirror_name(name: &'static str) -> &'static str {
+    match name {
+        "sigma_s0" => "sigma_spi",
+        "sigma_spi" => "sigma_s0",
+        "sigma_0" => "sigma_pi",
+        "sigma_pi" => "sigma_0",
+        other => other,
+    }
+}
+
+impl FixedPoint {
+    /// The same permanent rotation of the mirror body (−α): θ0 → π − θ0; the circles and
+    /// the precession turn the other way, so ρ_c, ρ_p and N change sign.
+    fn mirrored(self) -> Self {
+        FixedPoint {
+            theta0: PI - self.theta0,
+            rho_c: -self.rho_c,
+            rho_p: -self.rho_p,
+            rotation_number: self.rotation_number.map(|n| -n),
+            ..self
+        }
+    }
+}
+
+impl CriticalSet {
+    /// The critical set of the mirror body (α → −α), whose V at θ is this body's at π − θ
+    /// (docs/model.md): every angle θ → π − θ, the names of the two halves exchanged, and
+    /// ρ_c, ρ_p and N of the opposite sign. Branches and equilibria keep their order by θ.
+    fn mirrored(self) -> Self {
+        let flip = |[lo, hi]: [f64; 2]| [PI - hi, PI - lo];
+        let mut branches: Vec<Branch> = self
+            .branches
+            .into_iter()
+            .rev()
+            .map(|b| Branch {
+                name: mirror_name(b.name),
+                theta0_range: flip(b.theta0_range),
+                rotation_number_range: b.rotation_number_range.map(|[lo, hi]| [-hi, -lo]),
+                points: b
+                    .points
+                    .into_iter()
+                    .rev()
+                    .map(FixedPoint::mirrored)
+                    .collect(),
+                ..b
+            })
+            .collect();
+        branches.sort_by(|a, b| a.theta0_range[0].total_cmp(&b.theta0_range[0]));
+        let mut equilibria: Vec<Equilibrium> = self
+            .equilibria
+            .into_iter()
+            .map(|e| Equilibrium {
+                name: mirror_name(e.name),
+                theta: PI - e.theta,
+                ..e
+            })
+            .collect();
+        equilibria.sort_by_key(|e| match e.name {
+            "sigma_0" => 0,
+            "sigma_pi" => 1,
+            _ => 2,
+        });
+        CriticalSet {
+            alpha: -self.alpha,
+            theta_star: self.theta_star.map(|t| PI - t),
+            cusp: self.cusp.map(|c| Cusp {
+                theta: PI - c.theta,
+                ..c
+            }),
+            equilibria,
+            branches,
+            ..self
+        }
     }
 }
 

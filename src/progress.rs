@@ -132,6 +132,8 @@ impl Progress for Reporter {
                     let (_, eta) = rate_and_eta(s.pos(), resumed, s.len().unwrap_or(0), s.elapsed());
                     let _ = write!(w, "{}", format_duration(eta));
                 });
+                bar.disable_steady_tick();
+                bar.set_message("");
                 bar.set_style(style);
                 bar.set_prefix(format!("run {}", self.name));
                 bar.set_length(total);
@@ -166,6 +168,25 @@ impl Progress for Reporter {
                     self.line();
                 }
             }
+            Mode::Quiet => {}
+        }
+    }
+
+    fn laying_out(&self) {
+        match &self.mode {
+            Mode::Bar(bar) => {
+                bar.set_style(
+                    ProgressStyle::with_template("{prefix} [{elapsed_precise}] {spinner} {msg}")
+                        .expect("the template is valid"),
+                );
+                bar.set_prefix(format!("run {}", self.name));
+                bar.set_message("laying out the component axis (the grid's critical points)");
+                bar.enable_steady_tick(Duration::from_millis(200));
+            }
+            Mode::Lines { .. } => eprintln!(
+                "run {}: laying out the component axis (the grid's critical points)",
+                self.name
+            ),
             Mode::Quiet => {}
         }
     }

@@ -23,6 +23,9 @@ pub trait Progress: Sync {
     fn begin(&self, _total: u64, _done: u64) {}
     /// `cells` more cells are done.
     fn advance(&self, _cells: u64) {}
+    /// The component axis is being laid out from the grid's critical points (the census,
+    /// before [`Progress::begin`]; long only for grids of very many bodies and κ-rows).
+    fn laying_out(&self) {}
     /// Every unit is computed; the HDF5 file is being written.
     fn writing(&self) {}
     /// Whether the run should stop (the caller got SIGINT or SIGTERM): units in flight are
@@ -275,6 +278,7 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
     }
     // The component axis, from the whole grid's critical points: the same for every shard.
     // (A census cut short by a signal lays out nothing: the run stops before any work.)
+    progress.laying_out();
     let axis = atlas::component_axis(scene, &|| progress.interrupted());
     if progress.interrupted() {
         return Err(AtlasError::Interrupted {
@@ -297,6 +301,13 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
         .as_bytes(),
     );
     let journal_dir = Journal::dir_for(out);
+    if journal_dir.exists() && !journal_dir.is_dir() {
+        return Err(AtlasError::atlas(
+            &journal_dir,
+            "is not a directory, and a run keeps its resume journal at this path; \
+             move it away (the program never removes it)",
+        ));
+    }
     let journal = if journal_dir.exists() {
         let matching = || Journal::open(&journal_dir, fingerprint);
         if request.force || (request.update && matching().is_err()) {
@@ -458,6 +469,16 @@ pub fn merge(
             "does not exist"
         };
         return Err(AtlasError::atlas(path, why));
+    }
+    // The same file named twice (under one name or two): one line that says so.
+    let canonical: Vec<Option<PathBuf>> = shards.iter().map(|p| p.canonicalize().ok()).collect();
+    for (i, path) in shards.iter().enumerate() {
+        if canonical[..i]
+            .iter()
+            .any(|c| c.is_some() && *c == canonical[i])
+        {
+            return Err(AtlasError::atlas(path, "is named twice among the shards"));
+        }
     }
     // The scene, from the first shard; every shard must carry the same one.
     let first = shards[0].as_path();

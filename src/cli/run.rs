@@ -176,10 +176,17 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
         Err(AtlasError::Interrupted { done, total, .. }) => {
             reporter.finish();
             let (signal, status) = crate::stop::received();
-            eprintln!(
-                "rubber-atlas: stopped by {signal} with {done} of {total} cells computed and kept in {}; continue with: {resume}",
-                rubber_atlas::store::journal::Journal::dir_for(&out).display(),
-            );
+            let journal = rubber_atlas::store::journal::Journal::dir_for(&out);
+            if journal.is_dir() {
+                eprintln!(
+                    "rubber-atlas: stopped by {signal} with {done} of {total} cells computed and kept in {}; continue with: {resume}",
+                    journal.display(),
+                );
+            } else {
+                eprintln!(
+                    "rubber-atlas: stopped by {signal} before any cell was computed (nothing kept, nothing to resume)",
+                );
+            }
             std::process::exit(i32::from(status));
         }
         result => result?,

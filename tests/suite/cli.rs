@@ -238,8 +238,8 @@ fn bad_input_is_refused_with_one_clear_line() {
     let d_out = dir.path().join("d.h5");
     let d = d_out.to_str().unwrap();
     assert_refused(
-        &["diagram", "--alpha", "-0.5", "--beta", "3", "--out", d],
-        "alpha = -0.5",
+        &["diagram", "--alpha", "-1", "--beta", "3", "--out", d],
+        "alpha = -1",
         Some(&d_out),
     );
     assert_refused(

@@ -268,3 +268,69 @@ fn paper_type_c_values_and_misprints() {
     assert_eq!(DiagramType::of(0.0, 0.5), DiagramType::D);
     assert_eq!(DiagramType::of(0.0, 1.5), DiagramType::E);
 }
+
+/// α < 0 is the mirror image of −α: every point of the mirrored diagram is, evaluated directly
+/// on the body with α < 0 (the formulas of `s1` and `s0` hold for either sign), a permanent
+/// rotation or an equilibrium of that body, with its stability, circles and N; the cusp is a
+/// double zero of V′ there.
+#[test]
+fn a_negative_alpha_diagram_is_the_mirror_image_and_holds_on_its_own_body() {
+    for (alpha, beta) in [(-0.4, 3.0), (-0.5, 0.5), (-0.2, 1.05), (-0.9, 20.0)] {
+        let body = EllipsoidBody::ellipsoid(alpha, beta, 0.5, 0.5).unwrap();
+        let image = EllipsoidBody::ellipsoid(-alpha, beta, 0.5, 0.5).unwrap();
+        let set = CriticalSet::of(&body, 400, 3.0).unwrap();
+        let image_set = CriticalSet::of(&image, 400, 3.0).unwrap();
+        assert_eq!(set.alpha, alpha);
+        assert_eq!(set.diagram_type, image_set.diagram_type);
+        assert_eq!(set.branches.len(), image_set.branches.len());
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * (1.0 + a.abs().max(b.abs()));
+        for branch in &set.branches {
+            let half_ok = match branch.name {
+                "sigma_s0" => branch.theta0_range[1] <= FRAC_PI_2,
+                "sigma_spi" => branch.theta0_range[0] >= FRAC_PI_2,
+                _ => true,
+            };
+            assert!(half_ok, "α = {alpha}, β = {beta}: {branch:?}");
+            for p in &branch.points {
+                let direct = fixed_point(&body, p.theta0);
+                assert!(
+                    close(p.kappa, direct.kappa)
+                        && close(p.energy, direct.energy)
+                        && close(p.rho_c, direct.rho_c)
+                        && close(p.rho_p, direct.rho_p)
+                        && p.stable == branch.stable,
+                    "α = {alpha}, β = {beta}: {p:?} vs {direct:?}"
+                );
+                if let (Some(n), Some(m)) = (p.rotation_number, direct.rotation_number) {
+                    assert!(close(n, m), "α = {alpha}, β = {beta}: N {n} vs {m}");
+                }
+                // Stability from the linearised equations, as for α > 0.
+                if p.kappa > 1e-3 && (p.theta0 - FRAC_PI_2).abs() > 1e-3 {
+                    let v2 =
+                        ReducedSystem::new(&body, p.kappa).effective_potential_second(p.theta0);
+                    if v2.abs() > 1e-6 {
+                        assert_eq!(p.stable, v2 > 0.0, "α = {alpha}, β = {beta}: {p:?}");
+                    }
+                }
+            }
+        }
+        for e in &set.equilibria {
+            assert!(close(e.energy, body.shape.potential(e.theta)), "{e:?}");
+            let expected_theta = match e.name {
+                "sigma_0" => 0.0,
+                "sigma_pi" => PI,
+                _ => e.theta,
+            };
+            assert_eq!(e.theta, expected_theta, "{e:?}");
+            assert!(body.shape.potential_prime(e.theta).abs() < 1e-12, "{e:?}");
+        }
+        if let Some(c) = set.cusp {
+            let sys = ReducedSystem::new(&body, c.kappa);
+            assert!(sys.effective_potential_prime(c.theta).abs() < 1e-9, "{c:?}");
+            assert!(
+                sys.effective_potential_second(c.theta).abs() < 1e-6,
+                "{c:?}"
+            );
+        }
+    }
+}

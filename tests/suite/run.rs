@@ -448,6 +448,40 @@ fn four_shards_merged_equal_a_single_run() {
         r,
     ]);
     assert_eq!(twice.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&twice.stderr).contains("is named twice among the shards"));
+    // The same file under another spelling of its path.
+    let respelled = dir.path().join(".").join("shard-1.h5");
+    let twice = run(&[
+        "merge",
+        shards[0].to_str().unwrap(),
+        respelled.to_str().unwrap(),
+        "--out",
+        r,
+    ]);
+    assert_eq!(twice.status.code(), Some(2));
+    let text = String::from_utf8_lossy(&twice.stderr);
+    assert!(
+        text.contains("is named twice among the shards") && text.lines().count() == 1,
+        "{text}"
+    );
+    // A regular file where the run keeps its resume journal: named as such, and kept, with
+    // --force too.
+    let blocked = dir.path().join("blocked.h5");
+    let journal = dir.path().join("blocked.h5.partial.d");
+    std::fs::write(&journal, "not a journal").unwrap();
+    for extra in [None, Some("--force"), Some("--resume")] {
+        let mut args = vec!["run", s, "--out", blocked.to_str().unwrap(), "--quiet"];
+        args.extend(extra);
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}");
+        let text = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            text.contains("is not a directory") && text.lines().count() == 1,
+            "{text}"
+        );
+        assert_eq!(std::fs::read_to_string(&journal).unwrap(), "not a journal");
+        assert!(!blocked.exists());
+    }
     let other_scene = dir.path().join("other.toml");
     std::fs::write(
         &other_scene,
@@ -622,6 +656,49 @@ fn two_runs_on_one_output_never_leave_a_wrong_file() {
             assert!(!path.exists(), "round {round}: {path:?} left behind");
         }
     }
+}
+
+/// A run stopped while it lays out its component axis (a long census: 9 million κ-rows in
+/// the θ_min layout, which counts them all) says that nothing was kept, and names no journal.
+#[test]
+fn a_run_stopped_before_its_first_cell_says_that_nothing_was_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("census.toml");
+    std::fs::write(
+        &scene,
+        "name = \"census\"\n[body]\nnu = 0.5\neta = 0.5\n[axes]\n\
+         alpha = { start = 0.0, stop = 0.9, num = 300 }\n\
+         beta = { start = 0.3, stop = 3.0, num = 300 }\n\
+         kappa = { start = 0.0, stop = 2.0, num = 100 }\nenergy = [2.5]\n\
+         [outputs]\nfields = [\"rotation_number\"]\nlayout = \"theta_min\"\n",
+    )
+    .unwrap();
+    let out = dir.path().join("census.h5");
+    let child = Command::new(BIN)
+        .args([
+            "run",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(500));
+    // SAFETY: a signal to our own child process.
+    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    let output = child.wait_with_output().unwrap();
+    let text = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(130), "{text}");
+    assert!(text.contains("laying out the component axis"), "{text}");
+    assert!(
+        text.contains(
+            "stopped by SIGINT before any cell was computed (nothing kept, nothing to resume)"
+        ),
+        "{text}"
+    );
+    assert!(!text.contains("partial.d") && !out.exists());
+    assert!(!dir.path().join("census.h5.partial.d").exists());
 }
 
 #[test]

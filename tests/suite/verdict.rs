@@ -154,7 +154,7 @@ fn boundaries_stay_put_when_the_resolution_doubles() {
         assert_eq!(b.boundaries.len(), 1, "{b:#?}");
         b.boundaries[0].clone()
     };
-    let (coarse, fine) = (at(64), at(128));
+    let (coarse, fine) = (at(32), at(64));
     assert!(
         (coarse.beta - fine.beta).abs() <= 1e-5 + coarse.error + fine.error,
         "{coarse:?} vs {fine:?}"
