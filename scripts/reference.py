@@ -87,6 +87,10 @@ class Cell:
         z = self._z(s, c)
         return mpmath.sqrt((c * c + self.nu * s * s) / self.eta + (z + self.alpha * c) ** 2)
 
+    def kinks(self) -> list[Point]:
+        """Where U″ jumps (none on the ellipsoid): the integrals are cut there."""
+        return []
+
     # Critical points.
     def _scan(self):
         """Scan points in (0, π) as chart points: log-spaced towards both poles, uniform between."""
@@ -250,7 +254,8 @@ class Cell:
     def _integrate(self, e, lo: Point, hi: Point, interior, ends: bool = True):
         """(T, Δψ, error T, error Δψ) of a libration between turning points lo < hi: twice the
         integrals over [θ_min, θ_max], split at interior critical points and π/2."""
-        cuts = [lo] + list(interior) + [hi]
+        kinks = [k for k in self.kinks() if lo.theta < k.theta < hi.theta]
+        cuts = sorted([lo] + list(interior) + kinks + [hi], key=lambda p: p.theta)
         half = Point(mpmath.pi / 2, 0)
         if lo.theta < mpmath.pi / 2 < hi.theta and all(abs(c.theta - mpmath.pi / 2) > 1e-20 for c in cuts):
             cuts = sorted(cuts + [half], key=lambda p: p.theta)
@@ -295,6 +300,69 @@ class Cell:
             et += t_err
             ea += a_err
         return 2 * period, 2 * advance, 2 * et, 2 * ea
+
+
+class EdgedCell(Cell):
+    """V of one (body, κ) of the disk, the truncated ball or the wheel (docs/bodies.md): on each
+    part of the surface U = p|sinθ| + q cosθ + r (an edge: r = 0; the sphere: p = 0, r = 1),
+    |r|² = U² + U′², J = √((cos²θ + ν sin²θ)/η + U²). κ ≠ 0 only (no faces)."""
+
+    def __init__(self, kind, alpha, cut, nu, eta, kappa, digits: int = DIGITS):
+        if kappa == 0:
+            raise ValueError("EdgedCell: kappa = 0 (a motion may reach a face) is not covered")
+        super().__init__(alpha, 1, nu, eta, kappa, digits)
+        self.kind = kind
+        with mpmath.workdps(digits):
+            self.cut = mpmath.mpf(0 if kind == "disk" else cut)
+            self.rho = mpmath.sqrt(1 - self.cut**2) if kind != "disk" else mpmath.mpf(1)
+
+    def _part(self, c):
+        h, rho, a = self.cut, self.rho, self.alpha
+        if self.kind == "disk":
+            return rho, a, 0
+        if c > h:
+            return rho, h + a, 0
+        if self.kind == "wheel" and c < -h:
+            return rho, a - h, 0
+        return 0, a, 1
+
+    def _u(self, s, c):
+        p, q, r = self._part(c)
+        return p * s + q * c + r
+
+    def _u_prime(self, s, c):
+        p, q, _ = self._part(c)
+        return p * c - q * s
+
+    def potential(self, p: Point):
+        s, c = p.sin_cos()
+        return self.kappa**2 / (2 * s * s) + self._u(s, c)
+
+    def g(self, p: Point):
+        s, c = p.sin_cos()
+        return -self.kappa**2 * c + s**3 * self._u_prime(s, c)
+
+    def inertia(self, s, c):
+        return 1 / self.eta + self._u(s, c) ** 2 + self._u_prime(s, c) ** 2
+
+    def integral_factor(self, s, c):
+        return mpmath.sqrt((c * c + self.nu * s * s) / self.eta + self._u(s, c) ** 2)
+
+    def kinks(self) -> list[Point]:
+        if self.kind == "disk":
+            return []
+        with mpmath.workdps(self.digits):
+            theta_c = mpmath.acos(self.cut)
+            # θ_c from its own pole's chart, π − θ_c from the other.
+            kinks = [at(theta_c)]
+            if self.kind == "wheel":
+                kinks.append(at(mpmath.pi - theta_c))
+            return kinks
+
+
+def edged_reference(kind, alpha, cut, nu, eta, kappa, energy, digits: int = DIGITS) -> list[Component]:
+    """The components of a cell of an edged body with T and N at `digits` digits."""
+    return EdgedCell(kind, alpha, cut, nu, eta, kappa, digits).components(energy)
 
 
 def _splits(distance):

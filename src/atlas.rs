@@ -44,14 +44,17 @@ pub mod status_flag {
     pub const FIXED_POINT: u8 = 2;
     pub const SEPARATRIX: u8 = 3;
     pub const HIGH_ENERGY_LIMIT: u8 = 4;
-    pub const VALUES: [u8; 5] = [
+    pub const REACHES_FACE: u8 = 5;
+    pub const VALUES: [u8; 6] = [
         OK,
         TOLERANCE_NOT_REACHED,
         FIXED_POINT,
         SEPARATRIX,
         HIGH_ENERGY_LIMIT,
+        REACHES_FACE,
     ];
-    pub const MEANINGS: &str = "ok tolerance_not_reached fixed_point separatrix high_energy_limit";
+    pub const MEANINGS: &str =
+        "ok tolerance_not_reached fixed_point separatrix high_energy_limit reaches_face";
 }
 
 /// A component's motion flag (`motion`).
@@ -333,6 +336,7 @@ pub fn variables(fields: &[Field]) -> Vec<Variable> {
                             Status::FixedPoint => status_flag::FIXED_POINT,
                             Status::Separatrix => status_flag::SEPARATRIX,
                             Status::HighEnergyLimit => status_flag::HIGH_ENERGY_LIMIT,
+                            Status::ReachesFace => status_flag::REACHES_FACE,
                         })
                     },
                 ),

@@ -10,6 +10,9 @@
 use crate::error::{check_range, AtlasError, Result};
 use nalgebra::Vector3;
 
+mod edged;
+pub use edged::{EdgedKind, EdgedShape};
+
 /// An angle θ given by its sine and cosine, both to full relative precision. Near θ = π a
 /// double holds θ only to an absolute 4e-16, so callers build the pair from π − θ there
 /// (docs/accuracy.md); on the κ = 0 circle θ may be any real number.
@@ -160,6 +163,20 @@ pub trait Shape: Send + Sync {
     /// then V has a critical point at θ = π/2 for every κ.
     fn symmetric_about_equator(&self) -> bool {
         false
+    }
+
+    /// The angles in (0, π), in order, where U″ jumps (the contact passes between a smooth
+    /// part of the surface and a sharp edge): integrals over θ are split there, since the
+    /// rules' fast convergence needs an integrand analytic on each piece. None for a smooth
+    /// body.
+    fn kinks(&self) -> &[f64] {
+        &[]
+    }
+
+    /// Whether the body has a flat face that lies on the plane at θ = 0 and at θ = π: a
+    /// motion that reaches it ends there (U has a corner at that pole).
+    fn faces(&self) -> [bool; 2] {
+        [false, false]
     }
 
     /// The smallest angular scale (in radians) on which U, B and J vary: numerical rules
@@ -519,4 +536,64 @@ impl<S: Shape> Body<S> {
         let u = self.shape.potential(theta);
         ((c * c + self.nu * s * s) / self.eta + u * u).sqrt()
     }
+}
+
+/// A body of any supported shape: what the command line passes around (the solvers are
+/// generic over [`Shape`]; [`with_body!`](crate::with_body) calls one with the shape inside).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum AnyBody {
+    /// The paper's ellipsoid of revolution (α, β).
+    Ellipsoid(EllipsoidBody),
+    /// A disk, a truncated ball or a wheel (α and the cut h).
+    Edged(Body<EdgedShape>),
+}
+
+impl AnyBody {
+    /// The shape's name: `ellipsoid`, `disk`, `truncated_ball` or `wheel`.
+    pub fn shape_name(&self) -> &'static str {
+        match self {
+            AnyBody::Ellipsoid(_) => "ellipsoid",
+            AnyBody::Edged(b) => b.shape.kind.name(),
+        }
+    }
+
+    /// The shape's parameters by name, as the command line, the JSON and the files name
+    /// them: (α, β) of the ellipsoid, α of the disk, (α, cut) of the cut balls.
+    pub fn shape_parameters(&self) -> Vec<(&'static str, f64)> {
+        match self {
+            AnyBody::Ellipsoid(b) => vec![("alpha", b.shape.alpha), ("beta", b.shape.beta)],
+            AnyBody::Edged(b) if b.shape.kind == EdgedKind::Disk => {
+                vec![("alpha", b.shape.alpha)]
+            }
+            AnyBody::Edged(b) => vec![("alpha", b.shape.alpha), ("cut", b.shape.cut)],
+        }
+    }
+
+    /// ν.
+    pub fn nu(&self) -> f64 {
+        match self {
+            AnyBody::Ellipsoid(b) => b.nu,
+            AnyBody::Edged(b) => b.nu,
+        }
+    }
+
+    /// η.
+    pub fn eta(&self) -> f64 {
+        match self {
+            AnyBody::Ellipsoid(b) => b.eta,
+            AnyBody::Edged(b) => b.eta,
+        }
+    }
+}
+
+/// `with_body!(any, b => expression)`: the expression with `b` bound to the `&Body<S>` inside
+/// an [`AnyBody`] reference, whatever its shape.
+#[macro_export]
+macro_rules! with_body {
+    ($body:expr, $b:ident => $e:expr) => {
+        match $body {
+            $crate::body::AnyBody::Ellipsoid($b) => $e,
+            $crate::body::AnyBody::Edged($b) => $e,
+        }
+    };
 }

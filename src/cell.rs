@@ -68,6 +68,21 @@ impl CellOptions {
         )
         .map(|_| ())
     }
+
+    /// Checks the options against the body: the ODE method's error estimate (the difference
+    /// of two runs) assumes a smooth right-hand side, which a kink of U (an edged body) breaks
+    /// (measured: 8× below the true error at tol 1e-6 on a truncated ball), so it is refused
+    /// there.
+    pub fn check_for<S: Shape>(&self, body: &Body<S>) -> Result<()> {
+        if self.method == Method::Ode && !body.shape.kinks().is_empty() {
+            return Err(AtlasError::Unsupported {
+                what: "method ode",
+                reason: "its error estimate needs a smooth body, and this one has edges \
+                         where the contact changes part; use the quadrature",
+            });
+        }
+        Ok(())
+    }
 }
 
 /// How a computed value is to be read.
@@ -90,6 +105,10 @@ pub enum Status {
     /// (N∞(λ), [`crate::limits`]); T = 0 and ω_θ = ∞ there, ω_ψ = −N ω_θ; the drift is not
     /// computed.
     HighEnergyLimit,
+    /// κ = 0 and the component reaches a pole where the body has a flat face
+    /// ([`crate::body::Shape::faces`]): the body lands on the face and the motion ends there;
+    /// no periodic values (NaN).
+    ReachesFace,
 }
 
 /// Estimated absolute errors of the values of one component.
@@ -247,6 +266,7 @@ pub fn solve_cell<S: Shape>(
     crate::error::check_range("kappa", kappa, None, None, "must be finite")?;
     crate::error::check_range("energy", energy, None, None, "must be finite")?;
     options.validate()?;
+    options.check_for(body)?;
     solve_level(&EffectivePotential::new(body, kappa), energy, options)
 }
 
@@ -287,6 +307,15 @@ pub fn solve_component<S: Shape>(
     component: &Component,
     options: &CellOptions,
 ) -> Result<ComponentResult> {
+    // (Before the fixed points: a body at rest on its face is on the face, not at the
+    // bottom of a smooth well.)
+    if reaches_face(potential, component) {
+        return Ok(ComponentResult {
+            status: Status::ReachesFace,
+            error_estimate: f64::NAN,
+            ..unresolved(component)
+        });
+    }
     if component.kind == MotionKind::FixedPoint {
         let result = fixed_point(potential, component, options);
         // Linearised limits that overflowed or lost every digit (extreme η, β, κ) are no
@@ -336,6 +365,19 @@ pub fn solve_component<S: Shape>(
     Ok(finish(component, raw, limit, options))
 }
 
+/// Whether a κ = 0 component reaches a pole at which the body has a flat face: a pole
+/// θ = 2πm (face 0) or π + 2πm (face π) of the lifted circle within [θ_min, θ_max].
+fn reaches_face<S: Shape>(potential: &EffectivePotential<'_, S>, component: &Component) -> bool {
+    let faces = potential.body.shape.faces();
+    if potential.kappa != 0.0 || faces == [false, false] {
+        return false;
+    }
+    let (lo, hi) = (component.theta_min(), component.theta_max());
+    let first = (lo / PI).ceil() as i64;
+    let last = (hi / PI).floor() as i64;
+    (first..=last).any(|k| faces[k.rem_euclid(2) as usize])
+}
+
 /// ε above this many times Ū² (Ū the scale of U) is "far out": N(κ, ε) is the high-energy
 /// limit N∞(κ/√ε) up to O(Ū/ε), far below double precision, while the quadrature's ψ
 /// advance, built from two near-π jumps at turning points within λ/√2 of the poles, loses
@@ -358,7 +400,9 @@ fn far_out<S: Shape>(
 ) -> Option<Estimate> {
     let kappa = potential.kappa;
     // Ū ≥ 1: ordinary cells leave here before U is evaluated (this runs for every libration).
+    // The limit is derived for bodies smooth up to the poles: not for edged ones.
     if kappa == 0.0
+        || !crate::limits::has_high_energy_limit(&potential.body.shape)
         || component.kind != MotionKind::Libration
         || energy.is_nan()
         || energy < FAR_OUT

@@ -54,6 +54,12 @@ pub enum AtlasError {
     /// journal and a resumed run continues from them.
     #[error("{path}: interrupted with {done} of {total} cells computed and kept")]
     Interrupted { path: String, done: u64, total: u64 },
+    /// A request this body or method does not support (yet): what, and why.
+    #[error("{what}: {reason}")]
+    Unsupported {
+        what: &'static str,
+        reason: &'static str,
+    },
     /// A computation given up because its caller asked it to stop (Ctrl-C in Python).
     #[error("stopped on request")]
     Stopped,

@@ -66,5 +66,5 @@ pub mod verdict;
 #[cfg(feature = "python")]
 mod python;
 
-pub use body::{Angle, Body, Ellipsoid, EllipsoidBody, Shape};
+pub use body::{Angle, AnyBody, Body, EdgedKind, EdgedShape, Ellipsoid, EllipsoidBody, Shape};
 pub use error::{AtlasError, Result};

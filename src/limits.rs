@@ -30,6 +30,12 @@ pub struct Estimate {
     pub error: f64,
 }
 
+/// Whether the high-energy limit below holds for `shape`: its derivation needs H smooth on
+/// [−1, 1], which a body with a kink or a face (U′/sinθ unbounded at a pole) does not give.
+pub fn has_high_energy_limit<S: Shape>(shape: &S) -> bool {
+    shape.kinks().is_empty() && shape.faces() == [false, false]
+}
+
 /// The rotation number tends to these at κ → 0 (docs/hypothesis.md): a libration that passes near the
 /// pole θ = 0 only winds ψ by −π per passage (N → +1/2), one near θ = π only by +π
 /// (N → −1/2), and one that passes near both (a κ = 0 rotation over the top, ε > ε_min) has
@@ -219,6 +225,12 @@ pub fn high_energy_rotation_number<S: Shape>(
     tol: f64,
 ) -> Result<Estimate> {
     check_lambda(lambda)?;
+    if !has_high_energy_limit(&body.shape) {
+        return Err(crate::error::AtlasError::NotPeriodic {
+            reason: "the high-energy limit is derived for bodies smooth up to the poles, \
+                     not for a body with edges or faces",
+        });
+    }
     let x0 = turning_cosine(lambda);
     let factor = lambda * x0 / (SQRT_2 * PI);
     if factor == 0.0 {

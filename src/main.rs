@@ -67,6 +67,7 @@ fn main() -> ExitCode {
                             | rubber_atlas::AtlasError::Output { .. }
                             | rubber_atlas::AtlasError::Scene { .. }
                             | rubber_atlas::AtlasError::Atlas { .. }
+                            | rubber_atlas::AtlasError::Unsupported { .. }
                     )
                 )
             });

@@ -113,6 +113,7 @@ impl Summary {
         }
         if let Some(status) = block.flags(variables, "status") {
             for &s in status {
+                // (reaches_face: no scene body has a face yet.)
                 if s <= status_flag::HIGH_ENERGY_LIMIT {
                     self.components_by_status[usize::from(s)] += 1;
                 }

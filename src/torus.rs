@@ -858,7 +858,13 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         }
         // A libration is tried whole with the cosine substitution first: unless a saddle or
         // a pole comes close to the level, that is several times cheaper.
-        if component.kind == MotionKind::Libration {
+        // (Not across a kink of U: its rule converges geometrically only on an analytic
+        // integrand.)
+        if component.kind == MotionKind::Libration
+            && self
+                .kinks_inside(component.lower.theta, component.upper.theta)
+                .is_empty()
+        {
             let whole = &self.pieces(energy, component, false)[0];
             if let Some(result) =
                 cosine::integrate(self, whole, energy, component, tol, with_drift)?
@@ -1002,8 +1008,31 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         (saddle_t, saddle_psi)
     }
 
+    /// The kinks of U ([`Shape::kinks`]) strictly between `lower` and `upper`, in order. On
+    /// the κ = 0 circle θ is lifted and U(−θ) = U(θ), so a kink θ_k recurs at ±θ_k + 2πm.
+    pub fn kinks_inside(&self, lower: f64, upper: f64) -> Vec<Site> {
+        let kinks = self.body.shape.kinks();
+        if kinks.is_empty() {
+            return Vec::new();
+        }
+        let (first, last) = (
+            ((lower - PI) / TAU).floor() as i64,
+            ((upper + PI) / TAU).ceil() as i64,
+        );
+        let mut inside: Vec<f64> = (first..=last)
+            .flat_map(|m| {
+                let turn = TAU * m as f64;
+                kinks.iter().flat_map(move |&k| [turn + k, turn - k])
+            })
+            .filter(|&t| t > lower && t < upper)
+            .collect();
+        inside.sort_by(f64::total_cmp);
+        inside.dedup();
+        inside.into_iter().map(Site::at).collect()
+    }
+
     /// The pieces of a component: cut at the ends and, if `cut`, at every interior maximum or
-    /// tangency.
+    /// tangency and at every kink of U.
     fn pieces(&self, energy: f64, component: &Component, cut: bool) -> Vec<Piece> {
         let end = |site: Site, turning: bool| {
             let angle = site.angle();
@@ -1035,6 +1064,16 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 .filter(|p| cut && (p.kind != CriticalKind::Minimum || sharp))
                 .map(|p| end(p.site, false)),
         );
+        if cut {
+            // U″ jumps at a kink: each piece must be analytic for the rule's fast convergence.
+            ends.extend(
+                self.kinks_inside(component.lower.theta, component.upper.theta)
+                    .into_iter()
+                    .map(|site| end(site, false)),
+            );
+            ends[1..].sort_by(|a, b| a.site.theta.total_cmp(&b.site.theta));
+            ends.dedup_by(|a, b| a.site.theta == b.site.theta);
+        }
         ends.push(end(component.upper, turning));
         ends.windows(2)
             .map(|w| {

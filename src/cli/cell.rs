@@ -5,6 +5,7 @@ use anyhow::Result;
 use clap::Args;
 use rubber_atlas::cell::{solve_cell, solve_component, CellOptions, CellResult, Method, Status};
 use rubber_atlas::torus::EffectivePotential;
+use rubber_atlas::{Body, Shape};
 
 #[derive(Debug, Args)]
 pub struct CellArgs {
@@ -26,6 +27,29 @@ pub struct CellArgs {
     pub json: bool,
 }
 
+/// The cell (or the component of the start) of `body`.
+fn solve<S: Shape>(body: &Body<S>, args: &CellArgs, options: &CellOptions) -> Result<CellResult> {
+    Ok(match (args.start.energy, args.start.theta0) {
+        (Some(e), _) => solve_cell(body, args.level.kappa, e, options)?,
+        (None, Some(t)) => {
+            // Only the component that holds θ(0).
+            let start = args.start.at_theta0(args.level.kappa, t)?;
+            options.validate()?;
+            options.check_for(body)?;
+            let potential = EffectivePotential::new(body, start.kappa);
+            let energy = start.checked_energy(body)?;
+            let component = start.component_in(&potential)?;
+            CellResult {
+                kappa: start.kappa,
+                energy,
+                status: Status::Ok,
+                components: vec![solve_component(&potential, energy, &component, options)?],
+            }
+        }
+        (None, None) => unreachable!("clap requires --energy or --theta0"),
+    })
+}
+
 pub(super) fn cell(args: CellArgs) -> Result<()> {
     check_start(&args.start, None)?;
     let body = args.level.body()?;
@@ -38,29 +62,18 @@ pub(super) fn cell(args: CellArgs) -> Result<()> {
         drift: true,
         resonance_tol: args.resonance_tol,
     };
-    let result = match (args.start.energy, args.start.theta0) {
-        (Some(e), _) => solve_cell(&body, args.level.kappa, e, &options)?,
-        (None, Some(t)) => {
-            // Only the component that holds θ(0).
-            let start = args.start.at_theta0(args.level.kappa, t)?;
-            options.validate()?;
-            let potential = EffectivePotential::new(&body, start.kappa);
-            let energy = start.checked_energy(&body)?;
-            let component = start.component_in(&potential)?;
-            CellResult {
-                kappa: start.kappa,
-                energy,
-                status: Status::Ok,
-                components: vec![solve_component(&potential, energy, &component, &options)?],
-            }
-        }
-        (None, None) => unreachable!("clap requires --energy or --theta0"),
-    };
+    let result = rubber_atlas::with_body!(&body, b => solve(b, &args, &options))?;
     let energy = result.energy;
     if args.json {
-        let value = serde_json::json!({
-            "alpha": args.level.shape.alpha,
-            "beta": args.level.shape.beta,
+        // The ellipsoid's object as it always was; another shape adds its name.
+        let mut value = serde_json::Map::new();
+        if !matches!(body, AnyBody::Ellipsoid(_)) {
+            value.insert("shape".into(), body.shape_name().into());
+        }
+        for (name, x) in body.shape_parameters() {
+            value.insert(name.into(), x.into());
+        }
+        let rest = serde_json::json!({
             "nu": args.level.nu,
             "eta": args.level.eta,
             "kappa": args.level.kappa,
@@ -70,13 +83,24 @@ pub(super) fn cell(args: CellArgs) -> Result<()> {
             "status": result.status,
             "components": result.components,
         });
+        if let serde_json::Value::Object(rest) = rest {
+            value.extend(rest);
+        }
         println!("{}", serde_json::to_string_pretty(&value)?);
         return Ok(());
     }
+    let shape: Vec<String> = body
+        .shape_parameters()
+        .iter()
+        .map(|(name, x)| format!("{name}={}", show(*x)))
+        .collect();
+    let shape_name = match body {
+        AnyBody::Ellipsoid(_) => String::new(),
+        _ => format!("{} ", body.shape_name()),
+    };
     println!(
-        "cell alpha={} beta={} nu={} eta={} kappa={} energy={} ({}, tol {:e}): {}",
-        show(args.level.shape.alpha),
-        show(args.level.shape.beta),
+        "cell {shape_name}{} nu={} eta={} kappa={} energy={} ({}, tol {:e}): {}",
+        shape.join(" "),
         show(args.level.nu),
         show(args.level.eta),
         show(args.level.kappa),

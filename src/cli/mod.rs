@@ -16,7 +16,7 @@ use rubber_atlas::cf::AttrValue;
 use rubber_atlas::error::{show, show_digits as digits, AtlasError};
 use rubber_atlas::machine::{disk_short, memory_short};
 use rubber_atlas::trajectory::Start;
-use rubber_atlas::EllipsoidBody;
+use rubber_atlas::{AnyBody, Body, EdgedShape, EllipsoidBody};
 
 use cell::CellArgs;
 use diagram::DiagramArgs;
@@ -183,11 +183,92 @@ pub struct ShapeArgs {
     pub beta: f64,
 }
 
-/// The body (α, β, ν, η) and κ: what a level set of the reduced system needs besides ε.
+/// The body's shape by name (docs/bodies.md).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ShapeKindArg {
+    /// The ellipsoid of revolution (α, β): the paper's body.
+    Ellipsoid,
+    /// A thin disk rolling on its rim (α).
+    Disk,
+    /// A ball cut by the plane z = −h, rolling on its sphere or on the cut's edge (α, cut).
+    #[value(name = "truncated_ball")]
+    TruncatedBall,
+    /// A ball cut by z = ±h, rolling on its sphere or on either edge (α, cut).
+    Wheel,
+}
+
+/// The shape of the body of `cell` and `trajectory`: the ellipsoid (the default) or an edged
+/// body, with its parameters.
+#[derive(Debug, Args)]
+pub struct BodyShapeArgs {
+    /// The body: ellipsoid (--alpha, --beta), disk (--alpha), truncated_ball or wheel
+    /// (--alpha, --cut); docs/bodies.md.
+    #[arg(long, value_enum, default_value_t = ShapeKindArg::Ellipsoid)]
+    pub shape: ShapeKindArg,
+    /// α: the centre of mass at α e3 from the body's centre (the ellipsoid's, in units of
+    /// b3; the ball's or the disk's, in units of its radius); -1 < α < 1 but for the disk.
+    #[arg(value_parser = number, long, allow_hyphen_values = true)]
+    pub alpha: f64,
+    /// β = b1/b3 of the ellipsoid (required for it): < 1 prolate, > 1 oblate, 1 sphere.
+    #[arg(value_parser = number, long, allow_hyphen_values = true)]
+    pub beta: Option<f64>,
+    /// h of the cut balls, in units of the ball's radius: the plane z = -h (truncated_ball,
+    /// -1 < h < 1) or the planes z = ±h (wheel, 0 < h < 1).
+    #[arg(value_parser = number, long, allow_hyphen_values = true)]
+    pub cut: Option<f64>,
+}
+
+impl BodyShapeArgs {
+    /// The validated body with mass parameters ν, η; a parameter the shape does not take,
+    /// or one it needs and was not given, is refused in one line.
+    pub fn body(&self, nu: f64, eta: f64) -> Result<AnyBody> {
+        let name = |kind: ShapeKindArg| {
+            kind.to_possible_value()
+                .map(|v| v.get_name().to_string())
+                .unwrap_or_default()
+        };
+        let shape = name(self.shape);
+        let refuse = |what: &str| -> Result<AnyBody> {
+            Err(AtlasError::Atlas {
+                path: "options".into(),
+                reason: format!("--shape {shape}: {what}"),
+            }
+            .into())
+        };
+        match (self.shape, self.beta, self.cut) {
+            (ShapeKindArg::Ellipsoid, None, _) => refuse("--beta is required"),
+            (ShapeKindArg::Ellipsoid, Some(_), Some(_)) | (ShapeKindArg::Disk, _, Some(_)) => {
+                refuse("takes no --cut (only truncated_ball and wheel do)")
+            }
+            (ShapeKindArg::Ellipsoid, Some(beta), None) => Ok(AnyBody::Ellipsoid(
+                EllipsoidBody::ellipsoid(self.alpha, beta, nu, eta)?,
+            )),
+            (_, Some(_), _) => refuse("takes no --beta (only the ellipsoid does)"),
+            (ShapeKindArg::Disk, None, None) => Ok(AnyBody::Edged(Body::new(
+                EdgedShape::disk(self.alpha)?,
+                nu,
+                eta,
+            )?)),
+            (_, None, None) => refuse("--cut is required"),
+            (ShapeKindArg::TruncatedBall, None, Some(cut)) => Ok(AnyBody::Edged(Body::new(
+                EdgedShape::truncated_ball(self.alpha, cut)?,
+                nu,
+                eta,
+            )?)),
+            (ShapeKindArg::Wheel, None, Some(cut)) => Ok(AnyBody::Edged(Body::new(
+                EdgedShape::wheel(self.alpha, cut)?,
+                nu,
+                eta,
+            )?)),
+        }
+    }
+}
+
+/// The body (shape, ν, η) and κ: what a level set of the reduced system needs besides ε.
 #[derive(Debug, Args)]
 pub struct LevelArgs {
     #[command(flatten)]
-    pub shape: ShapeArgs,
+    pub shape: BodyShapeArgs,
     /// ν = i3/i1, 0 < ν <= 2.
     #[arg(value_parser = number, long, allow_hyphen_values = true)]
     pub nu: f64,
@@ -201,13 +282,8 @@ pub struct LevelArgs {
 
 impl LevelArgs {
     /// The validated body.
-    fn body(&self) -> Result<EllipsoidBody> {
-        Ok(EllipsoidBody::ellipsoid(
-            self.shape.alpha,
-            self.shape.beta,
-            self.nu,
-            self.eta,
-        )?)
+    fn body(&self) -> Result<AnyBody> {
+        self.shape.body(self.nu, self.eta)
     }
 }
 

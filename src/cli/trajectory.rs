@@ -91,22 +91,33 @@ pub(super) fn trajectory(args: TrajectoryArgs) -> Result<()> {
         model,
         tol: args.tol,
     };
-    let (start, traj) = request.run(&body)?;
+    let (start, traj, energy) = rubber_atlas::with_body!(&body, b => request
+        .run(b)
+        .map(|(start, traj)| (start, traj, start.energy(b))))?;
     let (tol, t_end) = (args.tol, traj.t.last().copied().unwrap_or(0.0));
     let mut table = rubber_atlas::table::trajectory(&traj);
-    table.attributes.extend(table_attributes(&[
-        ("model", AttrValue::Text(json_name(&model))),
-        ("alpha", AttrValue::Number(args.level.shape.alpha)),
-        ("beta", AttrValue::Number(args.level.shape.beta)),
+    // The ellipsoid's attributes as they always were; another shape adds its name.
+    let mut attributes: Vec<(&str, AttrValue)> =
+        vec![("model", AttrValue::Text(json_name(&model)))];
+    if !matches!(body, AnyBody::Ellipsoid(_)) {
+        attributes.push(("shape", AttrValue::Text(body.shape_name().to_string())));
+    }
+    attributes.extend(
+        body.shape_parameters()
+            .into_iter()
+            .map(|(name, x)| (name, AttrValue::Number(x))),
+    );
+    attributes.extend([
         ("nu", AttrValue::Number(args.level.nu)),
         ("eta", AttrValue::Number(args.level.eta)),
         ("kappa", AttrValue::Number(start.kappa)),
-        ("energy", AttrValue::Number(start.energy(&body))),
+        ("energy", AttrValue::Number(energy)),
         ("theta0", AttrValue::Number(start.theta0)),
         ("theta_dot0", AttrValue::Number(start.theta_dot0)),
         ("tolerance", AttrValue::Number(tol)),
         ("energy_drift", AttrValue::Number(traj.energy_drift)),
-    ]));
+    ]);
+    table.attributes.extend(table_attributes(&attributes));
     write_table(&args.out, &table)?;
     eprintln!(
         "wrote {} samples over t in [0, {}] ({} model, energy kept to {:.1e}) to {}",

@@ -1,6 +1,7 @@
 //! The integration tests of rubber-atlas, one binary (one link instead of ten): each module
 //! tests one part of the pipeline through the public library or the built program.
 
+mod bodies;
 mod cell;
 mod cli;
 mod critical;

@@ -1,0 +1,95 @@
+"""`rubber-atlas cell --shape …` for the edged bodies (docs/bodies.md) against the independent
+50-digit reference of scripts/reference.py (mpmath; it shares no code with the solver, only the
+formulas of docs/bodies.md): T and N of every component within the solver's estimates, on
+tori that cross a kink of U and on tori that do not."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import mpmath
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "scripts"))
+
+from reference import EdgedCell, at  # noqa: E402
+
+BIN = os.environ.get("RUBBER_ATLAS_BIN", str(ROOT / "target" / "release" / "rubber-atlas"))
+
+# (shape, α, cut, ν, η, κ, θ at which the level is taken, whether its torus crosses a kink):
+# the level ε = V(θ).
+CASES = [
+    ("truncated_ball", 0.2, 0.4, 0.7, 1.3, 0.6, 0.45, True),
+    ("truncated_ball", -0.3, -0.5, 0.7, 1.3, 0.9, 2.3, True),
+    ("truncated_ball", 0.5, 0.9, 1.0, 2.5, 0.3, 0.3, True),
+    ("truncated_ball", 0.5, 0.9, 1.0, 2.5, 0.3, 2.0, False),
+    ("wheel", 0.25, 0.7, 0.7, 1.3, 0.5, 0.4, True),
+    ("wheel", 0.0, 0.3, 0.5, 3.0, 1.2, 0.9, True),
+    ("disk", 0.3, None, 2.0, 4.0, 0.7, 0.5, False),
+    ("disk", -0.6, None, 1.5, 2.0, 0.05, 0.2, False),
+]
+
+
+def level(shape, alpha, cut, nu, eta, kappa, theta):
+    cell = EdgedCell(shape, alpha, cut or 0, nu, eta, kappa)
+    with mpmath.workdps(50):
+        return cell, float(cell.potential(at(theta)))
+
+
+def run_cell(shape, alpha, cut, nu, eta, kappa, energy, tol):
+    args = [BIN, "cell", "--shape", shape, "--alpha", repr(alpha), "--nu", repr(nu), "--eta", repr(eta),
+            "--kappa", repr(kappa), "--energy", repr(energy), "--tol", repr(tol), "--json"]
+    if cut is not None:
+        args += ["--cut", repr(cut)]
+    out = subprocess.run(args, check=True, capture_output=True, text=True).stdout
+    return json.loads(out)
+
+
+@pytest.mark.parametrize("case", CASES, ids=[f"{c[0]}-{c[1]}-{c[5]}" for c in CASES])
+def test_cells_of_edged_bodies_against_50_digit_values(case):
+    shape, alpha, cut, nu, eta, kappa, theta, crosses = case
+    cell, energy = level(shape, alpha, cut, nu, eta, kappa, theta)
+    reference = cell.components(energy)
+    assert reference
+    kinks = [float(k.theta) for k in cell.kinks()]
+    crossed = 0
+    for tol in (1e-8, 1e-12):
+        out = run_cell(shape, alpha, cut, nu, eta, kappa, energy, tol)
+        assert out["shape"] == shape and out["alpha"] == alpha
+        comps = out["components"]
+        assert len(comps) == len(reference), (out, reference)
+        for got, ref in zip(comps, reference):
+            where = f"{case} tol {tol}: {got} vs {ref}"
+            assert abs(got["theta_min"] - ref.theta_min) < 1e-12 and abs(got["theta_max"] - ref.theta_max) < 1e-12, where
+            assert ref.period_error < 1e-25 and ref.rotation_error < 1e-25, ref
+            assert got["status"] == "ok", where
+            assert abs(got["period"] - ref.period) <= got["errors"]["period"], where
+            assert abs(got["rotation_number"] - ref.rotation_number) <= got["errors"]["rotation_number"], where
+            # The estimates are within the tolerance (relative for T, absolute for N).
+            assert got["errors"]["rotation_number"] <= tol and got["errors"]["period"] <= tol * ref.period, where
+            crossed += any(ref.theta_min < k < ref.theta_max for k in kinks)
+    assert bool(crossed) == crosses, f"{case}: kinks {kinks}"
+
+
+def test_the_cut_balls_refuse_what_they_do_not_take():
+    """One line, exit 2, naming the parameter: a cut for the disk, a beta for a cut ball, a cut
+    out of range, a missing cut or beta."""
+    base = ["cell", "--nu", "0.5", "--eta", "0.5", "--kappa", "0.5", "--energy", "3"]
+    for extra, words in [
+        (["--shape", "disk", "--alpha", "0", "--cut", "0.5"], "takes no --cut"),
+        (["--shape", "wheel", "--alpha", "0", "--cut", "0.5", "--beta", "2"], "takes no --beta"),
+        (["--shape", "wheel", "--alpha", "0", "--cut", "-0.2"], "invalid cut = -0.2"),
+        (["--shape", "truncated_ball", "--alpha", "0", "--cut", "1"], "invalid cut = 1"),
+        (["--shape", "truncated_ball", "--alpha", "1", "--cut", "0.5"], "invalid alpha = 1"),
+        (["--shape", "truncated_ball", "--alpha", "0.1"], "--cut is required"),
+        (["--alpha", "0.1"], "--beta is required"),
+        (["--shape", "ellipsoid", "--alpha", "0.1", "--beta", "2", "--cut", "0.3"], "takes no --cut"),
+    ]:
+        p = subprocess.run([BIN, *base, *extra], capture_output=True, text=True)
+        assert p.returncode == 2, (extra, p.stderr)
+        assert words in p.stderr and len(p.stderr.strip().splitlines()) == 1, (extra, p.stderr)

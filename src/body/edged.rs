@@ -1,0 +1,341 @@
+//! Bodies of revolution whose meridian is made of circular arcs and sharp edges (docs/bodies.md):
+//! the thin disk, the truncated ball and the wheel (a ball cut by two parallel planes). The
+//! reduction of paper §2 (`oned`) holds for them as for the ellipsoid; only U(θ) changes. On
+//! each smooth part of the surface the contact point is either a fixed circle of the body (an
+//! edge, radius of curvature of the meridian 0) or on the sphere (radius 1), and there
+//! U = p |sinθ| + q cosθ + r, so U + U″ = r. Where the contact passes from one part to the
+//! other (θ_c = arccos h) U and U′ are continuous and U″ jumps: a kink, at which the cell
+//! solver splits its integrals.
+
+use super::{check_range, Angle, Shape};
+use crate::error::Result;
+use nalgebra::Vector3;
+use serde::Serialize;
+
+/// The kinds of edged body.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EdgedKind {
+    /// A thin disk of rim radius 1, rolling on its rim: U = sinθ + α cosθ.
+    Disk,
+    /// A ball of radius 1 cut by the plane z = −h (the face down at θ = 0): on the edge of the
+    /// cut for θ < θ_c, on the sphere beyond.
+    TruncatedBall,
+    /// A ball of radius 1 cut by z = ±h: on the lower edge for θ < θ_c, the sphere between,
+    /// the upper edge for θ > π − θ_c.
+    Wheel,
+}
+
+impl EdgedKind {
+    /// The name used on the command line, in scenes and in files.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Disk => "disk",
+            Self::TruncatedBall => "truncated_ball",
+            Self::Wheel => "wheel",
+        }
+    }
+}
+
+/// One smooth part of the surface: there U = p |sinθ| + q cosθ + r and the contact point,
+/// seen from the centre of mass, is r = −r γ − p (γ1, γ2, 0)/|sinθ| − q e3.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Part {
+    p: f64,
+    q: f64,
+    r: f64,
+}
+
+impl Part {
+    /// U.
+    #[inline]
+    fn height(&self, a: Angle) -> f64 {
+        self.p * a.sin.abs() + self.q * a.cos + self.r
+    }
+
+    /// U′/sinθ = p cosθ/|sinθ| − q.
+    #[inline]
+    fn slope_over_sin(&self, a: Angle) -> f64 {
+        self.p * a.cos / a.sin.abs() - self.q
+    }
+
+    /// U″ = −p |sinθ| − q cosθ.
+    #[inline]
+    fn curvature(&self, a: Angle) -> f64 {
+        -self.p * a.sin.abs() - self.q * a.cos
+    }
+}
+
+/// A body of revolution made of a ball's sphere and flat cuts (or a disk's rim), with its
+/// centre of mass at α e3 from the ball's (or the disk's) centre; unit of length the ball's
+/// (the rim's) radius.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EdgedShape {
+    /// Which body.
+    pub kind: EdgedKind,
+    /// α: the centre of mass at α e3 from the centre of the ball (the disk).
+    pub alpha: f64,
+    /// h: the cut plane z = −h (and z = +h for the wheel); 0 for the disk.
+    pub cut: f64,
+    /// ρ = √(1 − h²), the radius of the edge circle (1 for the disk).
+    rho: f64,
+    /// θ_c and π − θ_c, the kinks in (0, π) (`kink_count` of them are used).
+    kinks: [f64; 2],
+    kink_count: usize,
+}
+
+impl EdgedShape {
+    /// A thin disk of rim radius 1, its centre of mass at α along the axis from its centre
+    /// (α finite; a homogeneous disk has α = 0, ν = 2, η = 4).
+    pub fn disk(alpha: f64) -> Result<Self> {
+        check_range("alpha", alpha, None, None, "must be a finite number")?;
+        Ok(Self {
+            kind: EdgedKind::Disk,
+            alpha,
+            cut: 0.0,
+            rho: 1.0,
+            kinks: [0.0; 2],
+            kink_count: 0,
+        })
+    }
+
+    /// A ball of radius 1 cut by the plane z = −h, −1 < h < 1, its centre of mass at α e3
+    /// from the ball's centre, −1 < α < 1.
+    pub fn truncated_ball(alpha: f64, cut: f64) -> Result<Self> {
+        Self::cut_ball(EdgedKind::TruncatedBall, alpha, cut, -1.0)
+    }
+
+    /// A ball of radius 1 cut by the planes z = ±h, 0 < h < 1, its centre of mass at α e3
+    /// from the ball's centre, −1 < α < 1.
+    pub fn wheel(alpha: f64, cut: f64) -> Result<Self> {
+        Self::cut_ball(EdgedKind::Wheel, alpha, cut, 0.0)
+    }
+
+    fn cut_ball(kind: EdgedKind, alpha: f64, cut: f64, cut_min: f64) -> Result<Self> {
+        check_range(
+            "alpha",
+            alpha,
+            Some((-1.0, false)),
+            Some((1.0, false)),
+            "must satisfy -1 < alpha < 1 (the centre of mass inside the ball)",
+        )?;
+        let reason = if kind == EdgedKind::Wheel {
+            "must satisfy 0 < cut < 1 (the planes z = -cut and z = +cut cut the ball)"
+        } else {
+            "must satisfy -1 < cut < 1 (the plane z = -cut cuts the ball)"
+        };
+        check_range(
+            "cut",
+            cut,
+            Some((cut_min, false)),
+            Some((1.0, false)),
+            reason,
+        )?;
+        let rho = ((1.0 - cut) * (1.0 + cut)).sqrt();
+        // θ_c = arccos h, from atan2 (full precision also near h = ±1).
+        let theta_c = rho.atan2(cut);
+        let (kinks, kink_count) = match kind {
+            EdgedKind::Wheel => ([theta_c, std::f64::consts::PI - theta_c], 2),
+            _ => ([theta_c, 0.0], 1),
+        };
+        Ok(Self {
+            kind,
+            alpha,
+            cut,
+            rho,
+            kinks,
+            kink_count,
+        })
+    }
+
+    /// The part of the surface in contact at the angle `a` (decided by cosθ against ±h; at a
+    /// kink both parts give the same U and U′).
+    #[inline]
+    fn part(&self, a: Angle) -> Part {
+        let (h, rho, alpha) = (self.cut, self.rho, self.alpha);
+        let lower_edge = Part {
+            p: rho,
+            q: h + alpha,
+            r: 0.0,
+        };
+        let sphere = Part {
+            p: 0.0,
+            q: alpha,
+            r: 1.0,
+        };
+        match self.kind {
+            EdgedKind::Disk => Part {
+                p: 1.0,
+                q: alpha,
+                r: 0.0,
+            },
+            EdgedKind::TruncatedBall if a.cos > h => lower_edge,
+            EdgedKind::TruncatedBall => sphere,
+            EdgedKind::Wheel if a.cos > h => lower_edge,
+            EdgedKind::Wheel if a.cos < -h => Part {
+                p: rho,
+                q: alpha - h,
+                r: 0.0,
+            },
+            EdgedKind::Wheel => sphere,
+        }
+    }
+
+    /// The part in contact when the axis is tilted so that γ3 = cosθ = `cos`.
+    #[inline]
+    fn part_at_cos(&self, cos: f64) -> Part {
+        self.part(Angle {
+            sin: (1.0 - cos * cos).max(0.0).sqrt(),
+            cos,
+        })
+    }
+
+    /// The radius of the edge circle, ρ = √(1 − h²) (1 for the disk).
+    pub fn edge_radius(&self) -> f64 {
+        self.rho
+    }
+}
+
+impl Shape for EdgedShape {
+    /// The disk and the wheel with α = 0.
+    fn symmetric_about_equator(&self) -> bool {
+        self.alpha == 0.0 && self.kind != EdgedKind::TruncatedBall
+    }
+
+    fn kinks(&self) -> &[f64] {
+        &self.kinks[..self.kink_count]
+    }
+
+    /// The disk lies flat at both poles, the truncated ball on its face at θ = 0, the wheel
+    /// on either face.
+    fn faces(&self) -> [bool; 2] {
+        match self.kind {
+            EdgedKind::Disk | EdgedKind::Wheel => [true, true],
+            EdgedKind::TruncatedBall => [true, false],
+        }
+    }
+
+    /// χ1 = −p/|sinθ| − r, χ2 = −r cosθ − q (from U = −(χ1 sin²θ + χ2 cosθ) and
+    /// U′ = sinθ (χ2 − χ1 cosθ)).
+    fn chi(&self, theta: f64) -> (f64, f64) {
+        let a = Angle::new(theta);
+        let part = self.part(a);
+        (-part.p / a.sin.abs() - part.r, -part.r * a.cos - part.q)
+    }
+
+    /// (χ1′, χ2′) = (p sgn(sinθ) cosθ / sin²θ, r sinθ).
+    fn chi_prime(&self, theta: f64) -> (f64, f64) {
+        let a = Angle::new(theta);
+        let part = self.part(a);
+        (
+            part.p * a.sin.signum() * a.cos / (a.sin * a.sin),
+            part.r * a.sin,
+        )
+    }
+
+    /// r = −r γ − p (γ1, γ2, 0)/|γ⊥| − q e3 on the part in contact (γ⊥ = (γ1, γ2)).
+    fn contact_point(&self, gamma: &Vector3<f64>) -> Vector3<f64> {
+        let part = self.part_at_cos(gamma.z);
+        let s = gamma.x.hypot(gamma.y);
+        Vector3::new(
+            -(part.r + part.p / s) * gamma.x,
+            -(part.r + part.p / s) * gamma.y,
+            -part.r * gamma.z - part.q,
+        )
+    }
+
+    /// ṙ = −r γ̇ − p (ḣ/s − h (h, ḣ)/s³) with h = (γ1, γ2, 0), s = |h|.
+    fn contact_point_rate(&self, gamma: &Vector3<f64>, gamma_dot: &Vector3<f64>) -> Vector3<f64> {
+        let part = self.part_at_cos(gamma.z);
+        let h = Vector3::new(gamma.x, gamma.y, 0.0);
+        let h_dot = Vector3::new(gamma_dot.x, gamma_dot.y, 0.0);
+        let s2 = h.norm_squared();
+        let s = s2.sqrt();
+        -gamma_dot * part.r - (h_dot / s - h * (h.dot(&h_dot) / (s2 * s))) * part.p
+    }
+
+    #[inline]
+    fn potential(&self, theta: f64) -> f64 {
+        self.potential_at(Angle::new(theta))
+    }
+
+    #[inline]
+    fn potential_prime(&self, theta: f64) -> f64 {
+        self.potential_prime_at(Angle::new(theta))
+    }
+
+    #[inline]
+    fn potential_second(&self, theta: f64) -> f64 {
+        self.potential_second_at(Angle::new(theta))
+    }
+
+    #[inline]
+    fn contact_distance_sq(&self, theta: f64) -> f64 {
+        self.contact_distance_sq_at(Angle::new(theta))
+    }
+
+    /// d|r|²/dθ = 2U′(U + U″) = 2 r U′.
+    fn contact_distance_sq_prime(&self, theta: f64) -> f64 {
+        let a = Angle::new(theta);
+        2.0 * self.part(a).r * self.potential_prime_at(a)
+    }
+
+    #[inline]
+    fn potential_at(&self, a: Angle) -> f64 {
+        self.part(a).height(a)
+    }
+
+    #[inline]
+    fn potential_prime_at(&self, a: Angle) -> f64 {
+        let part = self.part(a);
+        part.p * a.sin.signum() * a.cos - part.q * a.sin
+    }
+
+    #[inline]
+    fn potential_second_at(&self, a: Angle) -> f64 {
+        self.part(a).curvature(a)
+    }
+
+    #[inline]
+    fn potential_prime_over_sin_at(&self, a: Angle) -> f64 {
+        self.part(a).slope_over_sin(a)
+    }
+
+    /// |r|² = U² + U′².
+    #[inline]
+    fn contact_distance_sq_at(&self, a: Angle) -> f64 {
+        let u = self.potential_at(a);
+        let up = self.potential_prime_at(a);
+        u * u + up * up
+    }
+
+    /// (U(x) − U(y)) / sin(x − y) on one part, without cancellation: with d = x − y,
+    /// (sin x − sin y)/sin d = cos y − sin y sin d/(1 + cos d) and
+    /// (cos x − cos y)/sin d = −sin y − cos y sin d/(1 + cos d). Across a kink, or where
+    /// sinθ changes sign, U is differenced directly (the default's rounding scale).
+    #[inline]
+    fn potential_divided_difference(
+        &self,
+        x: Angle,
+        y: Angle,
+        sin_diff: f64,
+        cos_diff: f64,
+    ) -> (f64, f64) {
+        let part = self.part(y);
+        if part != self.part(x) || x.sin * y.sin <= 0.0 || cos_diff <= -0.5 {
+            let (ux, uy) = (self.potential_at(x), self.potential_at(y));
+            return ((ux - uy) / sin_diff, (ux.abs() + uy.abs()) / sin_diff.abs());
+        }
+        let t = sin_diff / (1.0 + cos_diff);
+        let sin_dd = y.cos - y.sin * t;
+        let cos_dd = -y.sin - y.cos * t;
+        let p = part.p * y.sin.signum() * sin_dd;
+        let q = part.q * cos_dd;
+        (p + q, p.abs() + q.abs())
+    }
+
+    /// The edge parts are arcs of sinusoids: no scale below 1 (the kinks are split at).
+    fn angular_feature_scale(&self) -> f64 {
+        1.0
+    }
+}

@@ -1,0 +1,458 @@
+//! The edged bodies (docs/bodies.md): the disk, the truncated ball and the wheel. Their U(θ),
+//! U′, U″, |r|² and contact point against the surface itself (the lowest point found by a
+//! search over the body's boundary), the kinks, and their cells against the full equations
+//! of motion, which see the body only through its contact point.
+
+use nalgebra::Vector3;
+use rubber_atlas::body::{AnyBody, Body, EdgedShape, Shape};
+use rubber_atlas::cell::{solve_cell, CellOptions, Method, Status};
+use rubber_atlas::torus::{EffectivePotential, MotionKind};
+use rubber_atlas::trajectory::{integrate, Model, Start};
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
+
+/// The bodies: each kind, both signs of α, cuts below and above the centre.
+fn shapes() -> Vec<EdgedShape> {
+    vec![
+        EdgedShape::disk(0.0).unwrap(),
+        EdgedShape::disk(0.3).unwrap(),
+        EdgedShape::disk(-0.6).unwrap(),
+        EdgedShape::truncated_ball(0.2, 0.4).unwrap(),
+        EdgedShape::truncated_ball(-0.3, -0.5).unwrap(),
+        EdgedShape::truncated_ball(0.5, 0.9).unwrap(),
+        EdgedShape::wheel(0.0, 0.3).unwrap(),
+        EdgedShape::wheel(0.25, 0.7).unwrap(),
+    ]
+}
+
+/// The boundary of the body's meridian section in the plane of e3 and a horizontal unit
+/// vector, as (R, z) points relative to the ball's (disk's) centre, R signed: the sphere's
+/// arc where the cut keeps it, the faces' segments and their corners.
+struct Section {
+    /// The allowed z range of the sphere (the cuts), or None for the disk.
+    sphere: Option<(f64, f64)>,
+    /// The flat parts: (z, half-width).
+    faces: Vec<(f64, f64)>,
+}
+
+fn section(shape: &EdgedShape) -> Section {
+    let h = shape.cut;
+    let rho = shape.edge_radius();
+    match shape.kind {
+        rubber_atlas::body::EdgedKind::Disk => Section {
+            sphere: None,
+            faces: vec![(0.0, 1.0)],
+        },
+        rubber_atlas::body::EdgedKind::TruncatedBall => Section {
+            sphere: Some((-h, 1.0)),
+            faces: vec![(-h, rho)],
+        },
+        rubber_atlas::body::EdgedKind::Wheel => Section {
+            sphere: Some((-h, h)),
+            faces: vec![(-h, rho), (h, rho)],
+        },
+    }
+}
+
+/// The lowest point of the body when the vertical (up) is γ = (sinθ cos a, sinθ sin a, cosθ)
+/// in the body frame, found on the boundary itself: minimum of (x, γ) over a dense sampling
+/// of the section (corners included), refined by golden section on the sphere. Returns the
+/// point relative to the centre of mass (the contact point r) .
+fn lowest_point(shape: &EdgedShape, theta: f64, azimuth: f64) -> Vector3<f64> {
+    let (s, c) = theta.sin_cos();
+    let (ca, sa) = (azimuth.cos(), azimuth.sin());
+    let point = |r: f64, z: f64| Vector3::new(r * ca, r * sa, z);
+    let gamma = Vector3::new(s * ca, s * sa, c);
+    let height = |p: &Vector3<f64>| p.dot(&gamma);
+    let sec = section(shape);
+    let mut candidates: Vec<Vector3<f64>> = Vec::new();
+    for &(z, w) in &sec.faces {
+        for i in 0..=20_000 {
+            let r = -w + 2.0 * w * i as f64 / 20_000.0;
+            candidates.push(point(r, z));
+        }
+    }
+    let sphere_at = |phi: f64| point(phi.sin(), phi.cos());
+    let allowed = |phi: f64| {
+        sec.sphere
+            .is_some_and(|(lo, hi)| phi.cos() >= lo - 1e-15 && phi.cos() <= hi + 1e-15)
+    };
+    let n = 200_000;
+    let mut best_phi = None;
+    if sec.sphere.is_some() {
+        for i in 0..n {
+            let phi = TAU * i as f64 / n as f64;
+            if allowed(phi) {
+                candidates.push(sphere_at(phi));
+            }
+        }
+    }
+    let mut best = candidates[0];
+    for p in &candidates {
+        if height(p) < height(&best) {
+            best = *p;
+        }
+    }
+    // Refine on the sphere round the best sample, if it lies there.
+    if sec.sphere.is_some() && (best.norm() - 1.0).abs() < 1e-12 {
+        let phi0 = (best.x * ca + best.y * sa).atan2(best.z);
+        let step = TAU / n as f64;
+        let (mut lo, mut hi) = (phi0 - step, phi0 + step);
+        let g = (5f64.sqrt() - 1.0) / 2.0;
+        let f = |phi: f64| {
+            if allowed(phi) {
+                height(&sphere_at(phi))
+            } else {
+                f64::INFINITY
+            }
+        };
+        for _ in 0..100 {
+            let (m1, m2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+            if f(m1) < f(m2) {
+                hi = m2;
+            } else {
+                lo = m1;
+            }
+        }
+        let refined = sphere_at(0.5 * (lo + hi));
+        if height(&refined) < height(&best) {
+            best = refined;
+        }
+        best_phi = Some(0.5 * (lo + hi));
+    }
+    let _ = best_phi;
+    best - Vector3::new(0.0, 0.0, shape.alpha)
+}
+
+/// Angles over (0, π), with both sides of every kink.
+fn angles(shape: &EdgedShape) -> Vec<f64> {
+    let mut out: Vec<f64> = (1..40).map(|i| PI * i as f64 / 40.0).collect();
+    for &k in shape.kinks() {
+        out.extend([k - 1e-3, k - 1e-7, k + 1e-7, k + 1e-3]);
+    }
+    out
+}
+
+#[test]
+fn u_and_the_contact_point_are_those_of_the_surface() {
+    for shape in shapes() {
+        for theta in angles(&shape) {
+            let r = lowest_point(&shape, theta, 0.0);
+            let u = shape.potential(theta);
+            let gamma = Vector3::new(theta.sin(), 0.0, theta.cos());
+            // U is the height of the centre of mass above the plane: −(r, γ).
+            assert!(
+                (u + r.dot(&gamma)).abs() < 1e-12,
+                "{shape:?} θ = {theta}: U = {u}, surface {}",
+                -r.dot(&gamma)
+            );
+            // |r|² = U² + U′².
+            let up = shape.potential_prime(theta);
+            assert!(
+                (r.norm_squared() - (u * u + up * up)).abs() < 1e-7,
+                "{shape:?} θ = {theta}: |r|² = {} vs U² + U′² = {}",
+                r.norm_squared(),
+                u * u + up * up
+            );
+            // The full model's contact point, at two azimuths.
+            for azimuth in [0.0f64, 2.2] {
+                let g = Vector3::new(
+                    theta.sin() * azimuth.cos(),
+                    theta.sin() * azimuth.sin(),
+                    theta.cos(),
+                );
+                let direct = lowest_point(&shape, theta, azimuth);
+                let model = shape.contact_point(&g);
+                assert!(
+                    (direct - model).norm() < 1e-4 && (direct - model).dot(&g).abs() < 1e-12,
+                    "{shape:?} θ = {theta}: contact point {model:?} vs surface {direct:?}"
+                );
+            }
+            // U′ and U″ against differences of the surface's U (U″ away from the kinks).
+            let h = 1e-5;
+            let surface_u = |t: f64| {
+                let r = lowest_point(&shape, t, 0.0);
+                -r.dot(&Vector3::new(t.sin(), 0.0, t.cos()))
+            };
+            // (A difference that straddles a kink sees U″ jump: not there.)
+            let clear = shape.kinks().iter().all(|k| (k - theta).abs() > 1e-4);
+            let fd = (surface_u(theta + h) - surface_u(theta - h)) / (2.0 * h);
+            assert!(
+                !clear || (fd - up).abs() < 1e-6,
+                "{shape:?} θ = {theta}: U′ {up} vs {fd}"
+            );
+            if clear {
+                let upp = shape.potential_second(theta);
+                let fd2 = (shape.potential_prime(theta + h) - shape.potential_prime(theta - h))
+                    / (2.0 * h);
+                assert!(
+                    (fd2 - upp).abs() < 1e-6,
+                    "{shape:?} θ = {theta}: U″ {upp} vs {fd2}"
+                );
+                let b2 = shape.contact_distance_sq_prime(theta);
+                let fdb = (shape.contact_distance_sq(theta + h)
+                    - shape.contact_distance_sq(theta - h))
+                    / (2.0 * h);
+                assert!(
+                    (fdb - b2).abs() < 1e-6,
+                    "{shape:?} θ = {theta}: |r|²′ {b2} vs {fdb}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn the_contact_point_rate_is_the_derivative_of_the_contact_point() {
+    for shape in shapes() {
+        for theta in angles(&shape) {
+            let g = Vector3::new(theta.sin() * 0.6, theta.sin() * 0.8, theta.cos());
+            // A tangent direction of the unit sphere at γ.
+            let gd = g.cross(&Vector3::new(0.3, -0.2, 0.9)).normalize() * 0.7;
+            let h = 1e-6;
+            let at = |t: f64| shape.contact_point(&(g + gd * t).normalize());
+            let fd = (at(h) - at(-h)) / (2.0 * h);
+            let rate = shape.contact_point_rate(&g, &gd);
+            // (Within 1e-6 rad of a kink the difference straddles it.)
+            if shape.kinks().iter().all(|k| (k - theta).abs() > 1e-5) {
+                assert!(
+                    (fd - rate).norm() < 1e-5 * (1.0 + rate.norm()),
+                    "{shape:?} θ = {theta}: ṙ {rate:?} vs {fd:?}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn u_and_its_slope_are_continuous_at_a_kink_where_the_curvature_jumps() {
+    for shape in shapes() {
+        for &k in shape.kinks() {
+            let (below, above) = (k - 1e-9, k + 1e-9);
+            assert!((shape.potential(below) - shape.potential(above)).abs() < 1e-8);
+            assert!((shape.potential_prime(below) - shape.potential_prime(above)).abs() < 1e-8);
+            // U + U″ is the meridian's radius of curvature: 0 on an edge, 1 on the sphere.
+            let radius = |t: f64| shape.potential(t) + shape.potential_second(t);
+            let (r_below, r_above) = (radius(below), radius(above));
+            assert!(
+                ((r_below - r_above).abs() - 1.0).abs() < 1e-8,
+                "{shape:?} kink {k}: U + U″ = {r_below} | {r_above}"
+            );
+            assert!(r_below.abs() < 1e-8 || r_above.abs() < 1e-8);
+        }
+        // Convex: U + U″ ≥ 0 everywhere.
+        for theta in angles(&shape) {
+            assert!(shape.potential(theta) + shape.potential_second(theta) > -1e-12);
+        }
+    }
+}
+
+/// (shape, κ, θ0) starts of librations (θ̇0 = 0) whose θ-range crosses a kink, and of the disk.
+fn crossing_starts() -> Vec<(EdgedShape, f64, f64)> {
+    vec![
+        (EdgedShape::truncated_ball(0.2, 0.4).unwrap(), 0.6, 0.45),
+        (EdgedShape::truncated_ball(-0.3, -0.5).unwrap(), 0.9, 2.3),
+        (EdgedShape::truncated_ball(0.5, 0.9).unwrap(), 0.3, 0.3),
+        (EdgedShape::wheel(0.25, 0.7).unwrap(), 0.5, 0.4),
+        (EdgedShape::wheel(0.0, 0.3).unwrap(), 1.2, 0.9),
+        (EdgedShape::disk(0.3).unwrap(), 0.7, 0.5),
+    ]
+}
+
+/// The body (ν = 0.7, η = 1.3), the start at rest at θ0 and its energy.
+fn crossing_cell(shape: EdgedShape, kappa: f64, theta0: f64) -> (Body<EdgedShape>, Start, f64) {
+    let body = Body::new(shape, 0.7, 1.3).unwrap();
+    let start = Start {
+        kappa,
+        theta0,
+        theta_dot0: 0.0,
+    };
+    let energy = start.energy(&body);
+    (body, start, energy)
+}
+
+/// The cell's T, Δψ and |Δζ| (quadrature, split at the kinks) against one θ-period of the
+/// full equations of motion, which know the body only by its contact point r(γ).
+#[test]
+fn cells_across_a_kink_agree_with_the_full_equations() {
+    for (shape, kappa, theta0) in crossing_starts() {
+        let (body, start, energy) = crossing_cell(shape, kappa, theta0);
+        let component = start.component(&body).unwrap();
+        assert_eq!(component.kind, MotionKind::Libration);
+        let potential = EffectivePotential::new(&body, kappa);
+        if shape.kinks().is_empty() {
+            assert!(shape.kinks().is_empty());
+        } else {
+            assert!(
+                !potential
+                    .kinks_inside(component.theta_min(), component.theta_max())
+                    .is_empty(),
+                "{shape:?}: [{}, {}] crosses no kink",
+                component.theta_min(),
+                component.theta_max()
+            );
+        }
+        let q = potential
+            .integrate(energy, &component, 1e-13, true)
+            .unwrap();
+        assert!(q.converged, "{shape:?}: {q:?}");
+        let drift = q.drift.unwrap();
+        // Start at the turning point nearer θ0, so the full run ends a period later there.
+        let at_min = Start {
+            theta0: component.theta_min(),
+            ..start
+        };
+        let full = integrate(&body, &at_min, Model::Full, q.period, 4, 1e-13, &|| false).unwrap();
+        let n = full.t.len() - 1;
+        assert!(
+            (full.theta[n] - full.theta[0]).abs() < 1e-7,
+            "{shape:?}: θ after T: {} vs {}",
+            full.theta[n],
+            full.theta[0]
+        );
+        let dpsi = full.psi[n] - full.psi[0];
+        let wrapped = (dpsi - q.psi_advance + PI).rem_euclid(TAU) - PI;
+        assert!(
+            wrapped.abs() < 1e-7,
+            "{shape:?}: Δψ full {dpsi} vs cell {}",
+            q.psi_advance
+        );
+        let dz = (full.x_c[n] - full.x_c[0]).hypot(full.y_c[n] - full.y_c[0]);
+        let cell_dz = drift.value[0].hypot(drift.value[1]);
+        assert!(
+            (dz - cell_dz).abs() < 1e-6 * (1.0 + dz),
+            "{shape:?}: |Δζ| full {dz} vs cell {cell_dz}"
+        );
+    }
+}
+
+/// The quadrature's N and T with their error estimates at tol 1e-6 and 1e-10 against its own
+/// values at 1e-13 (the independent 50-digit check is scripts/tests/test_bodies.py), and the
+/// ODE method: refused across kinks (its two-run estimate assumes a smooth right-hand side:
+/// at tol 1e-6 it was 8× below its true error on a truncated ball), and within its estimate
+/// of the quadrature on the disk, which has none.
+#[test]
+fn the_estimates_across_a_kink_are_honest() {
+    for (shape, kappa, theta0) in crossing_starts() {
+        let (body, _, energy) = crossing_cell(shape, kappa, theta0);
+        let options = |tol, method| CellOptions {
+            tol,
+            method,
+            drift: true,
+            resonance_tol: 1e-9,
+        };
+        let best = solve_cell(&body, kappa, energy, &options(1e-13, Method::Quadrature)).unwrap();
+        for tol in [1e-6, 1e-10] {
+            let quad = solve_cell(&body, kappa, energy, &options(tol, Method::Quadrature)).unwrap();
+            assert_eq!(quad.components.len(), best.components.len());
+            for (a, b) in quad.components.iter().zip(&best.components) {
+                assert_eq!(a.status, Status::Ok, "{shape:?} tol {tol}: {a:?}");
+                let gap = (a.rotation_number - b.rotation_number).abs();
+                assert!(
+                    gap <= a.errors.rotation_number + b.errors.rotation_number,
+                    "{shape:?} tol {tol}: N {} ± {} vs {} ± {}",
+                    a.rotation_number,
+                    a.errors.rotation_number,
+                    b.rotation_number,
+                    b.errors.rotation_number
+                );
+                let gap = (a.period - b.period).abs();
+                assert!(
+                    gap <= a.errors.period + b.errors.period,
+                    "{shape:?} tol {tol}: T"
+                );
+            }
+            let ode = solve_cell(&body, kappa, energy, &options(tol, Method::Ode));
+            if shape.kinks().is_empty() {
+                for (a, b) in ode.unwrap().components.iter().zip(&quad.components) {
+                    let gap = (a.rotation_number - b.rotation_number).abs();
+                    assert!(gap <= a.errors.rotation_number + b.errors.rotation_number);
+                }
+            } else {
+                let text = ode.unwrap_err().to_string();
+                assert!(
+                    text.starts_with("method ode: ") && !text.contains('\n'),
+                    "{text}"
+                );
+            }
+        }
+    }
+}
+
+/// The disk with α = 0 is its own mirror image (θ → π − θ): a torus that spans both halves
+/// is symmetric and does not precess on average, N = 0 to rounding; one that does not (for
+/// κ < 1 V has two wells, at sin³θ = κ², below the saddle at π/2) has its mirror image with
+/// −N.
+#[test]
+fn the_symmetric_disk_has_n_zero_on_every_torus_that_spans_both_halves() {
+    let body = Body::new(EdgedShape::disk(0.0).unwrap(), 2.0, 4.0).unwrap();
+    let mut spanning = 0;
+    for kappa in [0.05, 0.3, 1.0, 3.0] {
+        let potential = EffectivePotential::new(&body, kappa);
+        if kappa < 1.0 {
+            let wells = potential.minimum_sites();
+            assert_eq!(wells.len(), 2, "κ = {kappa}");
+            assert!((wells[0].sin().powi(3) - kappa * kappa).abs() < 1e-12);
+        }
+        for excess in [1e-6, 0.01, 0.5, 5.0, 100.0] {
+            let energy = potential.lowest_minimum().unwrap() + excess;
+            let cell = solve_cell(&body, kappa, energy, &CellOptions::default()).unwrap();
+            let n = |c: &rubber_atlas::cell::ComponentResult| c.rotation_number;
+            match cell.components.as_slice() {
+                [c] => {
+                    assert!((c.theta_min + c.theta_max - PI).abs() < 1e-12, "{c:?}");
+                    assert!(
+                        n(c).abs() < 1e-14,
+                        "κ = {kappa}, ε − V_min = {excess}: N = {}",
+                        n(c)
+                    );
+                    spanning += 1;
+                }
+                [a, b] => {
+                    assert!(
+                        (a.theta_min + b.theta_max - PI).abs() < 1e-12,
+                        "{a:?} {b:?}"
+                    );
+                    assert!(b.theta_min > FRAC_PI_2 && a.theta_max < FRAC_PI_2);
+                    assert!((n(a) + n(b)).abs() < 1e-14, "{} vs {}", n(a), n(b));
+                }
+                other => panic!("κ = {kappa}: {other:?}"),
+            }
+        }
+    }
+    assert!(spanning >= 10, "{spanning}");
+}
+
+/// κ = 0: a motion that reaches a face ends there, and the component says so.
+#[test]
+fn a_planar_motion_that_reaches_a_face_says_so() {
+    // U(0) = h + α = 1.1 > U(π) = 1 − α = 0.8: the lowest state rests on the sphere.
+    let body = Body::new(EdgedShape::truncated_ball(0.2, 0.9).unwrap(), 0.7, 1.3).unwrap();
+    // On the sphere side (θ near π) the ball rocks without touching its face.
+    let rocking = solve_cell(
+        &body,
+        0.0,
+        body.shape.potential(PI) + 0.01,
+        &CellOptions::default(),
+    )
+    .unwrap();
+    assert!(
+        rocking.components.iter().all(|c| c.status == Status::Ok),
+        "{rocking:?}"
+    );
+    // High enough to roll over onto the face.
+    let energy = body.shape.potential(0.0).max(body.shape.potential(PI)) + 0.5;
+    let cell = solve_cell(&body, 0.0, energy, &CellOptions::default()).unwrap();
+    assert!(!cell.components.is_empty());
+    assert!(
+        cell.components
+            .iter()
+            .any(|c| c.status == Status::ReachesFace),
+        "{cell:?}"
+    );
+    for c in &cell.components {
+        if c.status == Status::ReachesFace {
+            assert!(c.rotation_number.is_nan() && c.period.is_nan() && c.bounded.is_none());
+        }
+    }
+    let _ = AnyBody::Edged(body);
+}
