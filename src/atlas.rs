@@ -2,7 +2,7 @@
 //! slice), computes them with rayon one κ-row at a time, and lays the results out as the
 //! dense per-cell and per-component arrays of the atlas file (docs/files.md).
 
-use crate::body::Ellipsoid;
+use crate::body::{Body, Ellipsoid, Shape};
 use crate::cell::{
     high_energy_families, solve_high_energy_limit, solve_level, CellResult, ComponentResult, Status,
 };
@@ -75,6 +75,7 @@ pub fn coordinate(name: &str) -> Option<(&'static str, Units)> {
     Some(match name {
         "alpha" => ("alpha, centre-of-mass offset a/b3", cf::NUMBER),
         "beta" => ("beta, semi-axis ratio b1/b3", cf::NUMBER),
+        "cut" => ("cut h of the ball (plane z = -h)", cf::NUMBER),
         "nu" => ("nu, inertia ratio i3/i1", cf::NUMBER),
         "eta" => ("eta = m b3^2/i1", cf::NUMBER),
         "kappa" => ("kappa, integral F2", cf::PAPER),
@@ -894,9 +895,19 @@ pub struct CellPoint {
 /// Cells computed in this many at a time per rayon task.
 const POINTS_PER_TASK: usize = 64;
 
-/// The bodies of `points`, each point checked: a bad one is refused, naming its index and
-/// value.
+/// The ellipsoids of `points` ([`bodies_of`] with α, β, ν, η).
 pub fn cell_bodies(points: &[CellPoint]) -> Result<Vec<crate::EllipsoidBody>> {
+    bodies_of(points, |p| {
+        crate::EllipsoidBody::ellipsoid(p.alpha, p.beta, p.nu, p.eta)
+    })
+}
+
+/// The bodies of `points`, made by `make` (an edged body takes its cut from `beta`), each
+/// point checked: a bad one is refused, naming its index and value.
+pub fn bodies_of<S: Shape>(
+    points: &[CellPoint],
+    make: impl Fn(&CellPoint) -> Result<Body<S>>,
+) -> Result<Vec<Body<S>>> {
     points
         .iter()
         .enumerate()
@@ -909,7 +920,7 @@ pub fn cell_bodies(points: &[CellPoint]) -> Result<Vec<crate::EllipsoidBody>> {
                 .map_err(at)?;
             crate::error::check_range("energy", p.energy, None, None, "must be finite")
                 .map_err(at)?;
-            crate::EllipsoidBody::ellipsoid(p.alpha, p.beta, p.nu, p.eta).map_err(at)
+            make(p).map_err(at)
         })
         .collect()
 }
@@ -918,9 +929,9 @@ pub fn cell_bodies(points: &[CellPoint]) -> Result<Vec<crate::EllipsoidBody>> {
 /// one block laid out as the atlas file lays out a row (the Python package's `cells`). Each
 /// cell is solved as `rubber-atlas cell` and `run` solve it, so the values are the same bit
 /// for bit. Given up when `stop` says so (polled between cells): then an empty block.
-pub fn compute_cells(
+pub fn compute_cells<S: Shape>(
     points: &[CellPoint],
-    bodies: &[crate::EllipsoidBody],
+    bodies: &[Body<S>],
     variables: &[Variable],
     axis: &ComponentAxis,
     options: &crate::cell::CellOptions,

@@ -229,7 +229,7 @@ fn point(slices: &[&[f64]], i: usize) -> CellPoint {
 /// fastest); `component`, the labels of the slots (the families present, or the ranks in
 /// θ_min up to the most components of a cell: no slot is empty in every cell); `layout`.
 #[pyfunction]
-#[pyo3(signature = (alpha, beta, nu, eta, kappa, energy, tol, method, resonance_tol, fields=None, threads=None, allow_large=false, layout="family"))]
+#[pyo3(signature = (alpha, beta, nu, eta, kappa, energy, tol, method, resonance_tol, fields=None, threads=None, allow_large=false, layout="family", shape="ellipsoid"))]
 #[allow(clippy::too_many_arguments)]
 fn cells<'py>(
     py: Python<'py>,
@@ -246,7 +246,9 @@ fn cells<'py>(
     threads: Option<i64>,
     allow_large: bool,
     layout: &str,
+    shape: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let kind = shape_kind(shape)?;
     let layout = Layout::from_name(layout)
         .ok_or_else(|| bad(format!("layout {layout:?}: use {}", Layout::NAMES)))?;
     let slices = equal_length(
@@ -282,11 +284,17 @@ fn cells<'py>(
         resonance_tol,
     };
     options.validate().map_err(value_error)?;
-    let bodies = atlas::cell_bodies(&points).map_err(value_error)?;
     // Ctrl-C (KeyboardInterrupt) is heard within a cell's time.
-    let block = interruptible(py, &pool, |stop| {
-        atlas::compute_cells(&points, &bodies, &vars, &room, &options, stop)
-    })?;
+    let block = match kind {
+        None => {
+            let bodies = atlas::cell_bodies(&points).map_err(value_error)?;
+            solve_cells(py, &pool, &points, &bodies, &vars, &room, &options)?
+        }
+        Some(kind) => {
+            let bodies = edged_bodies(&points, kind)?;
+            solve_cells(py, &pool, &points, &bodies, &vars, &room, &options)?
+        }
+    };
     // The slots some cell holds.
     let family = block
         .flags(&vars, "family")
@@ -329,11 +337,54 @@ fn cells<'py>(
     Ok(out)
 }
 
+/// The shape named `name`: None for the ellipsoid, else the edged kind.
+fn shape_kind(name: &str) -> PyResult<Option<crate::EdgedKind>> {
+    if name == "ellipsoid" {
+        return Ok(None);
+    }
+    crate::EdgedKind::from_name(name).map(Some).ok_or_else(|| {
+        bad(format!(
+            "shape {name:?}: use \"ellipsoid\", \"disk\", \"truncated_ball\" or \"wheel\""
+        ))
+    })
+}
+
+/// The edged bodies of `points`, each with its cut in `beta` (ignored by the disk).
+fn edged_bodies(
+    points: &[CellPoint],
+    kind: crate::EdgedKind,
+) -> PyResult<Vec<crate::Body<crate::EdgedShape>>> {
+    atlas::bodies_of(points, |p| {
+        crate::Body::new(crate::EdgedShape::of(kind, p.alpha, p.beta)?, p.nu, p.eta)
+    })
+    .map_err(value_error)
+}
+
+/// [`atlas::compute_cells`] of `bodies` with the GIL released, stopped by Ctrl-C; the options
+/// are checked against the bodies first (the ODE method needs a body without kinks).
+fn solve_cells<S: crate::Shape>(
+    py: Python<'_>,
+    pool: &Option<rayon::ThreadPool>,
+    points: &[CellPoint],
+    bodies: &[crate::Body<S>],
+    vars: &[atlas::Variable],
+    room: &ComponentAxis,
+    options: &CellOptions,
+) -> PyResult<atlas::Block> {
+    if let Some(body) = bodies.first() {
+        options.check_for(body).map_err(value_error)?;
+    }
+    interruptible(py, pool, |stop| {
+        atlas::compute_cells(points, bodies, vars, room, options, stop)
+    })
+}
+
 /// The bottom of V (its deepest minimum) at each (α, β, ν, η, κ) of five equal-length
 /// arrays, in parallel with the GIL released: the origin of the `excess_energy` axis, as an
 /// atlas's `kappa`/`excess_energy` plane measures it. A bad cell is refused, naming its index.
 #[pyfunction]
-#[pyo3(signature = (alpha, beta, nu, eta, kappa, threads=None))]
+#[pyo3(signature = (alpha, beta, nu, eta, kappa, threads=None, shape="ellipsoid"))]
+#[allow(clippy::too_many_arguments)]
 fn bottoms<'py>(
     py: Python<'py>,
     alpha: PyReadonlyArray1<'py, f64>,
@@ -342,27 +393,40 @@ fn bottoms<'py>(
     eta: PyReadonlyArray1<'py, f64>,
     kappa: PyReadonlyArray1<'py, f64>,
     threads: Option<i64>,
+    shape: &str,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let kind = shape_kind(shape)?;
     let slices = equal_length(
         &[&alpha, &beta, &nu, &eta, &kappa],
         "alpha, beta, nu, eta and kappa",
     )?;
     let points: Vec<CellPoint> = (0..slices[0].len()).map(|i| point(&slices, i)).collect();
-    let bodies = atlas::cell_bodies(&points).map_err(value_error)?;
     let pool = pool(threads)?;
-    let values = in_pool(py, &pool, || {
-        use rayon::prelude::*;
-        points
-            .par_iter()
-            .zip(&bodies)
-            .map(|(p, body)| {
-                crate::torus::EffectivePotential::new(body, p.kappa)
-                    .lowest_minimum()
-                    .unwrap_or(f64::NAN)
-            })
-            .collect::<Vec<f64>>()
-    });
+    let values = match kind {
+        None => {
+            let bodies = atlas::cell_bodies(&points).map_err(value_error)?;
+            in_pool(py, &pool, || lowest_minima(&points, &bodies))
+        }
+        Some(kind) => {
+            let bodies = edged_bodies(&points, kind)?;
+            in_pool(py, &pool, || lowest_minima(&points, &bodies))
+        }
+    };
     Ok(PyArray1::from_vec(py, values))
+}
+
+/// The lowest minimum of V at each point's κ (NaN where V has none).
+fn lowest_minima<S: crate::Shape>(points: &[CellPoint], bodies: &[crate::Body<S>]) -> Vec<f64> {
+    use rayon::prelude::*;
+    points
+        .par_iter()
+        .zip(bodies)
+        .map(|(p, body)| {
+            crate::torus::EffectivePotential::new(body, p.kappa)
+                .lowest_minimum()
+                .unwrap_or(f64::NAN)
+        })
+        .collect()
 }
 
 /// A table as a dict: `dimension`, `columns` (dicts of name, values, long_name, units,

@@ -421,12 +421,13 @@ def _derived(full: np.ndarray, dims: tuple, coords: dict, sources: Iterable[str]
 
 
 def _excess_to_energy(alpha: np.ndarray, beta: np.ndarray, nu: np.ndarray, eta: np.ndarray, kappa: np.ndarray,
-                      excess_energy: np.ndarray) -> np.ndarray:
+                      excess_energy: np.ndarray, shape: str = "ellipsoid") -> np.ndarray:
     """ε = V_min(κ) + `excess_energy` per cell (flat float64 arrays of one length), V_min the
     bottom (deepest minimum) of V(θ) = κ²/(2 sin²θ) + U(θ) at each body and κ, as the atlas's
     `kappa`/`excess_energy` plane computes it (the Rust core, in parallel)."""
     _first_bad("excess_energy", excess_energy, ~np.isfinite(excess_energy), "must be a finite number")
-    bottom = _core.bottoms(*(np.ascontiguousarray(a, dtype=np.float64) for a in (alpha, beta, nu, eta, kappa)))
+    arrays = (np.ascontiguousarray(a, dtype=np.float64) for a in (alpha, beta, nu, eta, kappa))
+    bottom = _core.bottoms(*arrays, shape=shape) if shape != "ellipsoid" else _core.bottoms(*arrays)
     return bottom + excess_energy
 
 
@@ -437,8 +438,28 @@ def _first_bad(name: str, values: np.ndarray, bad: np.ndarray, why: str) -> None
         raise ValueError(f"cell {i}: invalid {name} = {'NaN' if np.isnan(value) else repr(value)}: {why}")
 
 
-def _to_kappa_energy(plane: tuple[str, str], flat: list[np.ndarray]) -> list[np.ndarray]:
-    """The six flat inputs (α, β, ν, η and the plane's two) as α, β, ν, η, κ, ε."""
+def _shape_inputs(shape: str, beta, cut) -> dict:
+    """The inputs that give the shape beside α: β of the ellipsoid, the cut of a cut ball,
+    nothing for the disk; a parameter the shape does not take, or one it lacks, is refused."""
+    if shape == "ellipsoid":
+        if cut is not None:
+            raise ValueError("cut is a parameter of shape=\"truncated_ball\" and \"wheel\", not of the ellipsoid")
+        return {"beta": beta}
+    if shape not in ("disk", "truncated_ball", "wheel"):
+        raise ValueError(f"shape {shape!r}: use \"ellipsoid\", \"disk\", \"truncated_ball\" or \"wheel\"")
+    if beta is not None:
+        raise ValueError(f"shape {shape!r} takes no beta (only the ellipsoid does); give None")
+    if shape == "disk":
+        if cut is not None:
+            raise ValueError("shape 'disk' takes no cut (only truncated_ball and wheel do)")
+        return {}
+    if cut is None:
+        raise TypeError(f"shape {shape!r} needs cut (h: the plane z = -h cuts the ball)")
+    return {"cut": cut}
+
+
+def _to_kappa_energy(plane: tuple[str, str], flat: list[np.ndarray], shape: str = "ellipsoid") -> list[np.ndarray]:
+    """The six flat inputs (α, β or the cut, ν, η and the plane's two) as α, β, ν, η, κ, ε."""
     a, b = flat[4], flat[5]
     if plane == ("kappa", "energy"):
         return flat
@@ -450,7 +471,8 @@ def _to_kappa_energy(plane: tuple[str, str], flat: list[np.ndarray]) -> list[np.
         # Overflows and s² underflowing to 0 give inf, refused below with the inputs named.
         with np.errstate(over="ignore", divide="ignore", under="ignore"):
             return flat[:4] + [a / b, 1.0 / (b * b)]
-    return flat[:4] + [a, _excess_to_energy(*flat[:4], a, b)]
+    extra = {"shape": shape} if shape != "ellipsoid" else {}
+    return flat[:4] + [a, _excess_to_energy(*flat[:4], a, b, **extra)]
 
 
 def _show_bytes(n: float) -> str:
@@ -549,12 +571,13 @@ def _fill(dtype: np.dtype):
     return -1
 
 
-def _solve_batch(flat: list[np.ndarray], start: int, options: tuple, layout: str) -> dict:
+def _solve_batch(flat: list[np.ndarray], start: int, options: tuple, layout: str, shape: str = "ellipsoid") -> dict:
     """One call of the core: {"columns": [(name, flat array)], "component": [labels],
     "layout": …, and for the family layout possibly the component's "flag_values" and
     "flag_meanings"}."""
     try:
-        result = _core.cells(*flat, *options, layout=layout)
+        extra = {"shape": shape} if shape != "ellipsoid" else {}
+        result = _core.cells(*flat, *options, layout=layout, **extra)
     except ValueError as e:
         if start == 0:
             raise
@@ -568,21 +591,22 @@ def _solve_batch(flat: list[np.ndarray], start: int, options: tuple, layout: str
     return out
 
 
-def _solve(flat: list[np.ndarray], options: tuple, layout: str, meta: dict, progress: bool) -> dict:
+def _solve(flat: list[np.ndarray], options: tuple, layout: str, meta: dict, progress: bool,
+           shape: str = "ellipsoid") -> dict:
     """Solves the flat cells, in batches when `progress` shows how far it got; returns what
     one call of the core over all of them would (see `_solve_batch`): per-component arrays
     with the component fastest, over the union of the batches' components less those empty
     in every cell."""
     n = len(flat[0])
     if not progress:
-        return _solve_batch(flat, 0, options, layout)
+        return _solve_batch(flat, 0, options, layout, shape)
     size = max(_BATCH_CELLS, -(-n // _PROGRESS_STEPS))
     parts = []
     bar = _progress_bar(n)
     try:
         for start in range(0, max(n, 1), size):
             stop = min(n, start + size)
-            parts.append((stop - start, _solve_batch([a[start:stop] for a in flat], start, options, layout)))
+            parts.append((stop - start, _solve_batch([a[start:stop] for a in flat], start, options, layout, shape)))
             bar.update(stop - start)
     finally:
         bar.close()
@@ -671,6 +695,8 @@ def cells(
     allow_large: bool = False,
     layout: str = "family",
     progress: bool | None = None,
+    shape: str = "ellipsoid",
+    cut=None,
 ) -> xr.Dataset:
     """Solve cells (α, β, ν, η and a point of the (κ, ε) plane) in parallel.
 
@@ -736,6 +762,14 @@ def cells(
         Show a progress bar (tqdm's if it is installed: a widget in Jupyter, text in a
         terminal; else a text bar on standard error). By default shown when there are more
         than 200,000 cells and standard error is a terminal or the call runs in Jupyter.
+    shape : {"ellipsoid", "disk", "truncated_ball", "wheel"}, default "ellipsoid"
+        The body (docs/bodies.md). For any but the ellipsoid, `beta` is None; α places the
+        centre of mass at α e3 from the ball's (disk's) centre in units of its radius, and
+        the method "ode" is refused for the cut balls (their U has kinks).
+    cut : float, array_like or xarray.DataArray, optional
+        h of the cut balls, in units of the ball's radius: the plane z = -h
+        (``truncated_ball``, -1 < h < 1) or the planes z = ±h (``wheel``, 0 < h < 1); a
+        coordinate of the result as ``beta`` is for the ellipsoid.
 
     Inputs broadcast together. DataArrays broadcast by their dimension names (then every
     array input must be a DataArray; numbers mix with either). Other arrays broadcast by
@@ -813,9 +847,17 @@ def cells(
     >>> far = ra.cells(0.5, 3.0, 0.5, 0.5, lambda_=0.5, s=[0.1, 0.01], fields=["rotation_number"])
     >>> far.kappa.values.round(6).tolist(), far.energy.values.round(6).tolist()
     ([5.0, 50.0], [100.0, 10000.0])
+
+    A truncated ball (docs/bodies.md): no β, a cut instead.
+
+    >>> ball = ra.cells(0.2, None, 0.7, 1.3, kappa=0.6, energy=[1.9, 2.5], shape="truncated_ball",
+    ...                 cut=0.4, fields=["rotation_number"])
+    >>> float(ball.cut), ball.rotation_number.values.round(6).tolist()
+    (0.4, [[0.040354], [0.050904]])
     """
     plane = _plane(kappa, energy, excess_energy, lambda_, s)
-    given = {"alpha": alpha, "beta": beta, "nu": nu, "eta": eta, **plane}
+    shape = _text("shape", shape, '"ellipsoid", "disk", "truncated_ball" or "wheel"')
+    given = {"alpha": alpha, **_shape_inputs(shape, beta, cut), "nu": nu, "eta": eta, **plane}
     names = tuple(plane)
     if layout not in _LAYOUTS:
         raise ValueError(f"layout {layout!r}: use \"family\" or \"theta_min\"")
@@ -830,19 +872,25 @@ def cells(
     outputs = [m["name"] for m in _core.variables(None)] + ["component"]
     dims, arrays, coords, places = _broadcast(given, names, outputs,
                                               check=lambda n: _check_memory(n, field_list, options[-1]))
-    shape = arrays[0].shape
-    derived = _DERIVED.get(names[1], {})
+    shape_name, shape = shape, arrays[0].shape
+    # The input beside α: β, the cut, or none (the disk).
+    second = {"ellipsoid": "beta", "disk": None}.get(shape_name, "cut")
+    no_second = second is None
+    derived = {name: tuple(second if src == "beta" else src for src in sources if src != "beta" or second)
+               for name, sources in _DERIVED.get(names[1], {}).items()}
     for name in derived:
         if name in dims:
             raise ValueError(f"the dimension {name!r} is named after {name}, which is computed here from "
                              f"{' and '.join(names)}: rename the dimension")
     flat = [np.ascontiguousarray(a, dtype=np.float64).reshape(-1) for a in arrays]
+    if no_second:
+        flat.insert(1, np.zeros_like(flat[0]))
     n = flat[0].size
     show = (n > _PROGRESS_CELLS and (_stderr_is_terminal() or _in_jupyter())) if progress is None else progress
     meta = {m["name"]: m for m in _core.variables(field_list)}
     try:
-        flat = _to_kappa_energy(names, flat)
-        solved = _solve(flat, options, layout, meta, show)
+        flat = _to_kappa_energy(names, flat, shape_name)
+        solved = _solve(flat, options, layout, meta, show, shape_name)
     except ValueError as e:
         raise _located(e, shape, places, derived) from None
     for name, sources in derived.items():
@@ -867,6 +915,8 @@ def cells(
     coords["component"] = _component_coordinate(solved, meta)
     arguments = dict({_KEYWORDS.get(k, k): v for k, v in given.items()}, tol=tol, method=method, fields=field_list,
                      resonance_tol=resonance_tol, layout=layout)
+    if shape_name != "ellipsoid":
+        arguments["shape"] = shape_name
     attrs = _root_attrs(
         "cells",
         arguments,

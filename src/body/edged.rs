@@ -27,6 +27,9 @@ pub enum EdgedKind {
 }
 
 impl EdgedKind {
+    /// Every kind, in the order of [`EdgedKind::name`]'s list.
+    pub const ALL: [EdgedKind; 3] = [Self::Disk, Self::TruncatedBall, Self::Wheel];
+
     /// The name used on the command line, in scenes and in files.
     pub fn name(&self) -> &'static str {
         match self {
@@ -34,6 +37,11 @@ impl EdgedKind {
             Self::TruncatedBall => "truncated_ball",
             Self::Wheel => "wheel",
         }
+    }
+
+    /// The kind of that name.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.name() == name)
     }
 }
 
@@ -109,6 +117,15 @@ impl EdgedShape {
     /// from the ball's centre, −1 < α < 1.
     pub fn wheel(alpha: f64, cut: f64) -> Result<Self> {
         Self::cut_ball(EdgedKind::Wheel, alpha, cut, 0.0)
+    }
+
+    /// The body of `kind` with centre-of-mass offset α and cut h (ignored for the disk).
+    pub fn of(kind: EdgedKind, alpha: f64, cut: f64) -> Result<Self> {
+        match kind {
+            EdgedKind::Disk => Self::disk(alpha),
+            EdgedKind::TruncatedBall => Self::truncated_ball(alpha, cut),
+            EdgedKind::Wheel => Self::wheel(alpha, cut),
+        }
     }
 
     fn cut_ball(kind: EdgedKind, alpha: f64, cut: f64, cut_min: f64) -> Result<Self> {

@@ -1,0 +1,86 @@
+"""`cells(shape=…)` for the disk, the truncated ball and the wheel (docs/bodies.md): the values
+of `rubber-atlas cell --shape …` bit for bit, the coordinates named after the shape's
+parameters, and the parameters a shape does not take refused in one line."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import rubber_atlas as ra
+from conftest import run
+
+KEYS = ["theta_min", "theta_max", "period", "omega_theta", "omega_psi", "rotation_number", "drift",
+        "drift_radius", "error_estimate"]
+
+
+def same_double(a, b) -> bool:
+    return np.float64(a).tobytes() == np.float64(b).tobytes()
+
+
+@pytest.mark.parametrize("shape", ["disk", "truncated_ball", "wheel"])
+def test_cells_of_each_shape_equal_the_cell_command_bit_for_bit(shape):
+    rng = np.random.default_rng(20261124)
+    n = 12
+    alpha = rng.uniform(-0.8, 0.8, n)
+    cut = rng.uniform(0.05, 0.95, n) if shape != "disk" else None
+    nu = rng.uniform(0.2, 2.0, n)
+    eta = rng.uniform(0.3, 4.0, n)
+    kappa = rng.uniform(0.05, 2.0, n)
+    energy = rng.uniform(0.5, 5.0, n)
+    ds = ra.cells(alpha, None, nu, eta, kappa, energy, shape=shape, cut=cut, layout="theta_min")
+    assert "beta" not in ds.coords
+    assert ("cut" in ds.coords) == (shape != "disk")
+    with_motion = 0
+    for i in range(n):
+        args = ["cell", "--shape", shape, "--alpha", repr(float(alpha[i])), "--nu", repr(float(nu[i])),
+                "--eta", repr(float(eta[i])), "--kappa", repr(float(kappa[i])), "--energy", repr(float(energy[i])),
+                "--json"]
+        if cut is not None:
+            args += ["--cut", repr(float(cut[i]))]
+        out = json.loads(run(*args))
+        assert out["shape"] == shape
+        expected = out["components"]
+        cell = ds.isel(cell=i)
+        assert int(cell.n_components) == len(expected), i
+        with_motion += bool(expected)
+        for slot, e in enumerate(expected):
+            c = cell.isel(component=slot)
+            for key in KEYS:
+                if e[key] is None:
+                    assert not np.isfinite(float(c[key])), (i, key)
+                else:
+                    assert same_double(c[key], e[key]), (i, key, float(c[key]), e[key])
+    assert with_motion >= n // 2
+
+
+def test_the_excess_energy_plane_of_the_symmetric_disk():
+    """Its bottom found by the core for the disk's own V: the torus round the equator
+    (κ ≥ 1, one well) has N = 0 to rounding."""
+    ds = ra.cells(0.0, None, 2.0, 4.0, kappa=[1.0, 2.0, 3.0], excess_energy=[0.1, 1.0], shape="disk",
+                  fields=["rotation_number", "theta_min", "theta_max"])
+    assert set(ds.energy.dims) == {"kappa", "excess_energy"}
+    n = ds.rotation_number.values
+    assert np.nanmax(np.abs(n)) < 1e-14
+    spans = ds.theta_min + ds.theta_max
+    assert float(abs(spans - np.pi).max()) < 1e-12
+
+
+@pytest.mark.parametrize("kwargs, error, words", [
+    (dict(shape="disk", cut=0.3), ValueError, "takes no cut"),
+    (dict(shape="wheel"), TypeError, "needs cut"),
+    (dict(shape="wheel", cut=1.5), ValueError, "invalid cut = 1.5"),
+    (dict(shape="truncated_ball", cut=[0.2, -1.0]), ValueError, "cut[1]"),
+    (dict(shape="cube", cut=0.2), ValueError, "shape 'cube'"),
+    (dict(shape=None, cut=0.2), TypeError, "shape must be"),
+    (dict(shape="wheel", cut=0.5, method="ode"), ValueError, "method ode"),
+])
+def test_what_a_shape_does_not_take_is_refused(kwargs, error, words):
+    with pytest.raises(error) as caught:
+        ra.cells(0.25, None, 0.7, 1.3, kappa=0.5, energy=[2.0, 2.5], **kwargs)
+    assert words in str(caught.value) and "\n" not in str(caught.value)
+    with pytest.raises(ValueError, match="takes no beta"):
+        ra.cells(0.25, 2.0, 0.7, 1.3, kappa=0.5, energy=2.0, shape="wheel", cut=0.5)
+    with pytest.raises(ValueError, match="not of the ellipsoid"):
+        ra.cells(0.25, 2.0, 0.7, 1.3, kappa=0.5, energy=2.0, cut=0.5)
