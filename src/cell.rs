@@ -367,7 +367,10 @@ pub fn solve_component<S: Shape>(
 
 /// Whether a κ = 0 component reaches a pole at which the body has a flat face: a pole
 /// θ = 2πm (face 0) or π + 2πm (face π) of the lifted circle within [θ_min, θ_max].
-fn reaches_face<S: Shape>(potential: &EffectivePotential<'_, S>, component: &Component) -> bool {
+pub(crate) fn reaches_face<S: Shape>(
+    potential: &EffectivePotential<'_, S>,
+    component: &Component,
+) -> bool {
     let faces = potential.body.shape.faces();
     if potential.kappa != 0.0 || faces == [false, false] {
         return false;

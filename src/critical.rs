@@ -6,7 +6,7 @@
 //! Several of the paper's printed formulas carry misprints; the corrected forms used here are
 //! those of docs/model.md, and the tests check each against a direct numerical search.
 
-use crate::body::{EllipsoidBody, Shape};
+use crate::body::{Body, EdgedShape, EllipsoidBody, Shape};
 use crate::error::{AtlasError, Result};
 use crate::reduced::ReducedSystem;
 use crate::torus::bisect;
@@ -145,11 +145,29 @@ pub struct Cusp {
 /// The critical set of one body.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct CriticalSet {
+    /// The body's shape when it is not the ellipsoid (docs/bodies.md).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shape: Option<&'static str>,
     pub alpha: f64,
-    pub beta: f64,
+    /// β of the ellipsoid.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub beta: Option<f64>,
+    /// The cut h of a cut ball.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cut: Option<f64>,
     pub nu: f64,
     pub eta: f64,
-    pub diagram_type: DiagramType,
+    /// The ellipsoid's diagram type (a)–(e) (paper Fig. `ab`); None for another body.
+    pub diagram_type: Option<DiagramType>,
+    /// The kinks of U (an edged body), where U″ jumps: marked on the curves.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub kinks: Vec<f64>,
+    /// Every cusp of an edged body (whose curve may have several; `cusp` is the last).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub cusps: Vec<Cusp>,
+    /// Where a branch changes stability at a kink (V″ jumps through 0 there; no cusp).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub stability_changes_at_kinks: Vec<Cusp>,
     /// Inclination of the inclined equilibrium θ*, where it exists (α ≠ 0).
     pub theta_star: Option<f64>,
     /// ε_min: the top of U on the circle; at κ = 0 a body with ε > ε_min rolls over the top.
@@ -239,25 +257,13 @@ impl CriticalSet {
         kappa_max: f64,
         stop: &dyn Fn() -> bool,
     ) -> Result<Self> {
-        let stopped = |i: usize| {
-            if i.is_multiple_of(65_536) && stop() {
-                Err(AtlasError::Stopped)
-            } else {
-                Ok(())
-            }
-        };
+        let stopped = |i: usize| asked_to_stop(i, stop);
         let (alpha, beta) = (body.shape.alpha, body.shape.beta);
         if alpha < 0.0 {
             let image = EllipsoidBody::ellipsoid(-alpha, beta, body.nu, body.eta)?;
             return Ok(Self::of_until(&image, samples, kappa_max, stop)?.mirrored());
         }
-        if !(kappa_max.is_finite() && kappa_max > 0.0) {
-            return Err(AtlasError::InvalidParameter {
-                name: "kappa-max",
-                value: kappa_max,
-                reason: "must be a finite number > 0",
-            });
-        }
+        check_kappa_max(kappa_max)?;
         crate::error::check_samples(samples)?;
         let samples = samples.max(16);
         let diagram_type = DiagramType::of(alpha, beta);
@@ -292,107 +298,40 @@ impl CriticalSet {
             });
         }
 
-        let mut branches = Vec::new();
-        let mut cusp = None;
-        // The two halves of the θ0-range, each sampled and cut into runs of one stability.
-        let halves = [(0.0, FRAC_PI_2, "sigma_s0"), (FRAC_PI_2, PI, "sigma_spi")];
-        for (lo, hi, stable_name) in halves {
-            let mut pts: Vec<FixedPoint> = Vec::with_capacity(samples + 1);
-            // Interior samples; a pole is added only where a branch ends at it (U″ > 0 there,
-            // i.e. κ² ≥ 0 on its neighbourhood), never as a lone point.
-            for i in 1..samples {
-                stopped(i)?;
-                let t = lo + (hi - lo) * i as f64 / samples as f64;
-                if fixed_point_kappa_sq(body, t) < 0.0 {
-                    continue;
-                }
-                let p = fixed_point(body, t);
-                if p.kappa <= kappa_max {
-                    pts.push(p);
-                }
-            }
-            let pole = if lo == 0.0 { 0.0 } else { PI };
-            if body.shape.potential_second(pole) > 0.0 && !pts.is_empty() {
-                pts.push(fixed_point(body, pole));
-            }
-            if let Some(ts) = theta_star {
-                if ts > lo && ts < hi {
-                    pts.push(fixed_point(body, ts));
-                }
-            }
-            pts.sort_by(|a, b| a.theta0.total_cmp(&b.theta0));
-            pts.dedup_by(|a, b| a.theta0 == b.theta0);
-            // Runs of equal stability; a flip inside a half is the cusp (V″ = 0 on the curve).
-            let mut run: Vec<FixedPoint> = Vec::new();
-            for p in pts {
-                if let Some(last) = run.last() {
-                    let contiguous = (p.theta0 - last.theta0) <= 1.5 * (hi - lo) / samples as f64;
-                    if last.stable != p.stable || !contiguous {
-                        if last.stable != p.stable && contiguous {
-                            let c = locate_cusp(body, last.theta0, p.theta0, last.stable);
-                            cusp = Some(c);
-                            let at = fixed_point(body, c.theta);
-                            let mut at_end = at;
-                            at_end.stable = last.stable;
-                            run.push(at_end);
-                            branches.push(make_branch(std::mem::take(&mut run), stable_name));
-                            let mut at_start = at;
-                            at_start.stable = p.stable;
-                            run.push(at_start);
-                        } else {
-                            branches.push(make_branch(std::mem::take(&mut run), stable_name));
-                        }
-                    }
-                }
-                run.push(p);
-            }
-            if !run.is_empty() {
-                branches.push(make_branch(run, stable_name));
-            }
-        }
-
+        let curve = Curve {
+            kappa_sq: &|t| fixed_point_kappa_sq(body, t),
+            point: &|t| fixed_point(body, t),
+            pole_ends: &|pole| body.shape.potential_second(pole) > 0.0,
+            extra: theta_star.into_iter().collect(),
+            cusp: &|lo, hi, lo_stable| locate_cusp(body, lo, hi, lo_stable),
+        };
+        let (mut branches, cusps) = sample_branches(&curve, samples, kappa_max, &stopped)?;
+        let cusp = cusps.last().copied();
         let kappa_c_equator =
             (alpha == 0.0 && beta > 1.0).then(|| ((beta * beta - 1.0) / beta).sqrt());
         if alpha == 0.0 {
             // σ_π/2: ε = κ²/2 + β (`s2`), stable where V″(π/2) = κ² − (β² − 1)/β > 0.
-            let mut run: Vec<FixedPoint> = Vec::new();
-            let push_point = |kappa: f64, run: &mut Vec<FixedPoint>, force: Option<bool>| {
-                let v2 = kappa * kappa - (beta * beta - 1.0) / beta;
-                let stable = force.unwrap_or(v2 > 0.0);
-                run.push(FixedPoint {
-                    theta0: FRAC_PI_2,
-                    kappa,
-                    energy: 0.5 * kappa * kappa + beta,
-                    stable,
-                    rho_c: f64::INFINITY,
-                    rho_p: f64::INFINITY,
-                    // ψ̇ = 0 on the equator: the librations about it do not precess.
-                    rotation_number: stable.then_some(0.0),
-                });
-            };
-            for i in 0..=samples {
-                stopped(i)?;
-                let kappa = kappa_max * i as f64 / samples as f64;
-                let stable = kappa * kappa - (beta * beta - 1.0) / beta > 0.0;
-                let last_stable = run.last().map(|p| p.stable);
-                if let (Some(kc), Some(last_stable)) = (kappa_c_equator, last_stable) {
-                    if last_stable != stable {
-                        push_point(kc, &mut run, Some(last_stable));
-                        branches.push(make_branch(std::mem::take(&mut run), "sigma_pi2"));
-                        push_point(kc, &mut run, Some(stable));
-                    }
-                }
-                push_point(kappa, &mut run, None);
-            }
-            branches.push(make_branch(run, "sigma_pi2"));
+            branches.extend(equator_branches(
+                beta,
+                -(beta * beta - 1.0) / beta,
+                kappa_c_equator,
+                samples,
+                kappa_max,
+                &stopped,
+            )?);
         }
 
         Ok(Self {
+            shape: None,
             alpha,
-            beta,
+            beta: Some(beta),
+            cut: None,
             nu: body.nu,
             eta: body.eta,
-            diagram_type,
+            diagram_type: Some(diagram_type),
+            kinks: Vec::new(),
+            cusps: Vec::new(),
+            stability_changes_at_kinks: Vec::new(),
             theta_star,
             energy_min: energy_min(alpha, beta),
             kappa_c_equator,
@@ -402,6 +341,136 @@ impl CriticalSet {
             kappa_max,
         })
     }
+}
+
+/// How one body's curve of permanent rotations is evaluated: the ellipsoid's closed forms
+/// (`s1`) or any body's ([`general_fixed_point`]).
+struct Curve<'f> {
+    /// κ² at θ0 (< 0: no permanent rotation there).
+    kappa_sq: &'f dyn Fn(f64) -> f64,
+    /// The permanent rotation at θ0.
+    point: &'f dyn Fn(f64) -> FixedPoint,
+    /// Whether a branch may end at this pole (V″ > 0 there).
+    pole_ends: &'f dyn Fn(f64) -> bool,
+    /// Angles sampled besides the grid, on the curve (θ*, the kinks of U where κ² ≥ 0).
+    extra: Vec<f64>,
+    /// The change of stability between two samples, stable on the first side or not.
+    cusp: &'f dyn Fn(f64, f64, bool) -> Cusp,
+}
+
+/// The branches of `curve` over the halves θ0 < π/2 and θ0 > π/2, each sampled at `samples`
+/// points, truncated at κ ≤ `kappa_max`, and cut into runs of one stability; every change of
+/// stability inside a half is located (a cusp, or a kink of U where V″ jumps), in order.
+/// `stopped(i)` is asked at every sample.
+fn sample_branches(
+    curve: &Curve<'_>,
+    samples: usize,
+    kappa_max: f64,
+    stopped: &dyn Fn(usize) -> Result<()>,
+) -> Result<(Vec<Branch>, Vec<Cusp>)> {
+    let mut branches = Vec::new();
+    let mut cusps = Vec::new();
+    let halves = [(0.0, FRAC_PI_2, "sigma_s0"), (FRAC_PI_2, PI, "sigma_spi")];
+    for (lo, hi, stable_name) in halves {
+        let mut pts: Vec<FixedPoint> = Vec::with_capacity(samples + 1);
+        // Interior samples; a pole is added only where a branch ends at it (U″ > 0 there,
+        // i.e. κ² ≥ 0 on its neighbourhood), never as a lone point.
+        for i in 1..samples {
+            stopped(i)?;
+            let t = lo + (hi - lo) * i as f64 / samples as f64;
+            if (curve.kappa_sq)(t) < 0.0 {
+                continue;
+            }
+            let p = (curve.point)(t);
+            if p.kappa <= kappa_max {
+                pts.push(p);
+            }
+        }
+        let pole = if lo == 0.0 { 0.0 } else { PI };
+        if (curve.pole_ends)(pole) && !pts.is_empty() {
+            pts.push((curve.point)(pole));
+        }
+        for &t in &curve.extra {
+            if t > lo && t < hi {
+                pts.push((curve.point)(t));
+            }
+        }
+        pts.sort_by(|a, b| a.theta0.total_cmp(&b.theta0));
+        pts.dedup_by(|a, b| a.theta0 == b.theta0);
+        // Runs of equal stability; a flip inside a half is the cusp (V″ = 0 on the curve).
+        let mut run: Vec<FixedPoint> = Vec::new();
+        for p in pts {
+            if let Some(last) = run.last() {
+                let contiguous = (p.theta0 - last.theta0) <= 1.5 * (hi - lo) / samples as f64;
+                if last.stable != p.stable || !contiguous {
+                    if last.stable != p.stable && contiguous {
+                        let c = (curve.cusp)(last.theta0, p.theta0, last.stable);
+                        cusps.push(c);
+                        let at = (curve.point)(c.theta);
+                        let mut at_end = at;
+                        at_end.stable = last.stable;
+                        run.push(at_end);
+                        branches.push(make_branch(std::mem::take(&mut run), stable_name));
+                        let mut at_start = at;
+                        at_start.stable = p.stable;
+                        run.push(at_start);
+                    } else {
+                        branches.push(make_branch(std::mem::take(&mut run), stable_name));
+                    }
+                }
+            }
+            run.push(p);
+        }
+        if !run.is_empty() {
+            branches.push(make_branch(run, stable_name));
+        }
+    }
+    Ok((branches, cusps))
+}
+
+/// σ_π/2 of a body symmetric about its equator: θ0 = π/2 at every κ (`s2`), ε = κ²/2 + U(π/2)
+/// with U(π/2) = `height`, stable where V″(π/2) = κ² + U″(π/2) > 0 (U″(π/2) = `curvature`),
+/// i.e. beyond κ_c = `kappa_c` where U″(π/2) < 0; sampled at `samples` + 1 values of κ.
+fn equator_branches(
+    height: f64,
+    curvature: f64,
+    kappa_c: Option<f64>,
+    samples: usize,
+    kappa_max: f64,
+    stopped: &dyn Fn(usize) -> Result<()>,
+) -> Result<Vec<Branch>> {
+    let mut branches = Vec::new();
+    let mut run: Vec<FixedPoint> = Vec::new();
+    let push_point = |kappa: f64, run: &mut Vec<FixedPoint>, force: Option<bool>| {
+        let v2 = kappa * kappa + curvature;
+        let stable = force.unwrap_or(v2 > 0.0);
+        run.push(FixedPoint {
+            theta0: FRAC_PI_2,
+            kappa,
+            energy: 0.5 * kappa * kappa + height,
+            stable,
+            rho_c: f64::INFINITY,
+            rho_p: f64::INFINITY,
+            // ψ̇ = 0 on the equator: the librations about it do not precess.
+            rotation_number: stable.then_some(0.0),
+        });
+    };
+    for i in 0..=samples {
+        stopped(i)?;
+        let kappa = kappa_max * i as f64 / samples as f64;
+        let stable = kappa * kappa + curvature > 0.0;
+        let last_stable = run.last().map(|p| p.stable);
+        if let (Some(kc), Some(last_stable)) = (kappa_c, last_stable) {
+            if last_stable != stable {
+                push_point(kc, &mut run, Some(last_stable));
+                branches.push(make_branch(std::mem::take(&mut run), "sigma_pi2"));
+                push_point(kc, &mut run, Some(stable));
+            }
+        }
+        push_point(kappa, &mut run, None);
+    }
+    branches.push(make_branch(run, "sigma_pi2"));
+    Ok(branches)
 }
 
 /// The name of a branch or an equilibrium seen in the mirror θ → π − θ.
@@ -519,16 +588,246 @@ fn make_branch(points: Vec<FixedPoint>, stable_name: &'static str) -> Branch {
 
 /// The zero of V″(θ0) along the fixed-point curve between two samples of opposite stability.
 fn locate_cusp(body: &EllipsoidBody, lo: f64, hi: f64, lo_stable: bool) -> Cusp {
+    locate_cusp_on(
+        body,
+        &|t| fixed_point_kappa_sq(body, t),
+        &|t| fixed_point(body, t),
+        lo,
+        hi,
+        lo_stable,
+    )
+}
+
+/// [`locate_cusp`] on the curve given by `kappa_sq` and `point` (any body).
+fn locate_cusp_on<S: Shape>(
+    body: &Body<S>,
+    kappa_sq: &dyn Fn(f64) -> f64,
+    point: &dyn Fn(f64) -> FixedPoint,
+    lo: f64,
+    hi: f64,
+    lo_stable: bool,
+) -> Cusp {
     let f = |t: f64| {
-        let k2 = fixed_point_kappa_sq(body, t).max(0.0);
+        let k2 = kappa_sq(t).max(0.0);
         ReducedSystem::new(body, k2.sqrt()).effective_potential_second(t)
     };
     // V″ > 0 on the stable side.
     let theta = bisect(&f, lo, hi, !lo_stable);
-    let p = fixed_point(body, theta);
+    let p = point(theta);
     Cusp {
         theta,
         kappa: p.kappa,
         energy: p.energy,
     }
+}
+
+/// κ² on the curve of permanent rotations of any body (V′(θ0) = 0, the general form of
+/// `s1`): κ² = sin³θ0 U′(θ0) / cosθ0 (0 at a pole).
+pub fn general_kappa_sq<S: Shape>(body: &Body<S>, theta0: f64) -> f64 {
+    let (s, c) = theta0.sin_cos();
+    if s == 0.0 {
+        return 0.0;
+    }
+    s * s * s * body.shape.potential_prime(theta0) / c
+}
+
+/// The permanent rotation of any body at θ0: κ from [`general_kappa_sq`],
+/// ε = κ²/(2 sin²θ0) + U = sinθ0 U′/(2 cosθ0) + U, stable where V″(θ0) > 0; the centre of
+/// mass runs on a circle of radius ρ_c = U tanθ0 and the contact point on one of radius
+/// ρ_p = ρ_c + U′ (the contact point is U′ from the centre of mass horizontally).
+pub fn general_fixed_point<S: Shape>(body: &Body<S>, theta0: f64) -> FixedPoint {
+    let kappa = general_kappa_sq(body, theta0).max(0.0).sqrt();
+    let sys = ReducedSystem::new(body, kappa);
+    let (s, c) = theta0.sin_cos();
+    let u = body.shape.potential(theta0);
+    let up = body.shape.potential_prime(theta0);
+    let energy = if s == 0.0 { u } else { s * up / (2.0 * c) + u };
+    let rho_c = u * s / c;
+    FixedPoint {
+        theta0,
+        kappa,
+        energy,
+        stable: sys.effective_potential_second(theta0) > 0.0,
+        rho_c,
+        rho_p: rho_c + up,
+        rotation_number: crate::limits::linearised_rotation_number(body, theta0, kappa),
+    }
+}
+
+/// The equilibria (κ = 0) of an edged body: both poles, where the body stands on a vertex of
+/// the sphere (`sigma_0`, `sigma_pi`) or lies on a face (`face_0`, `face_pi`: a corner of U,
+/// stable where U rises from it), and the inclined ones (`inclined`), the roots of U′ inside,
+/// found by a scan of 4096 cells and bisection.
+fn edged_equilibria(body: &Body<EdgedShape>) -> Vec<Equilibrium> {
+    let shape = &body.shape;
+    let faces = shape.faces();
+    let mut out = Vec::new();
+    for (pole, face, name, face_name, inward) in [
+        (0.0, faces[0], "sigma_0", "face_0", 1.0),
+        (PI, faces[1], "sigma_pi", "face_pi", -1.0),
+    ] {
+        // sin = 0 exactly at the pole (PI's sine is 1.2e-16).
+        let exact = crate::body::Angle {
+            sin: 0.0,
+            cos: inward,
+        };
+        let energy = shape.potential_at(exact);
+        if face {
+            // U′ just inside the pole: U rises from a stable face.
+            let slope = inward * shape.potential_prime(pole + inward * 1e-9);
+            out.push(Equilibrium {
+                name: face_name,
+                theta: pole,
+                energy,
+                stable: slope > 0.0,
+                isolated: slope <= 0.0,
+            });
+        } else {
+            let upp = shape.potential_second_at(exact);
+            out.push(Equilibrium {
+                name,
+                theta: pole,
+                energy,
+                stable: upp > 0.0,
+                isolated: upp < 0.0,
+            });
+        }
+    }
+    let cells = 4096;
+    let at = |i: usize| PI * i as f64 / cells as f64;
+    let slope = |t: f64| shape.potential_prime(t);
+    for i in 1..cells - 1 {
+        let (lo, hi) = (at(i), at(i + 1));
+        let (a, b) = (slope(lo), slope(hi));
+        if a == 0.0 || a * b < 0.0 {
+            let theta = if a == 0.0 {
+                lo
+            } else {
+                bisect(&slope, lo, hi, a < 0.0)
+            };
+            out.push(Equilibrium {
+                name: "inclined",
+                theta,
+                energy: shape.potential(theta),
+                // U′ from − to +: a minimum.
+                stable: a < 0.0 || (a == 0.0 && b > 0.0),
+                // A branch of permanent rotations ends at κ = 0 on every inclined one.
+                isolated: false,
+            });
+        }
+    }
+    out.sort_by(|a, b| a.theta.total_cmp(&b.theta));
+    out
+}
+
+impl CriticalSet {
+    /// The critical set of an edged body (docs/bodies.md): its curve of permanent rotations
+    /// ([`general_fixed_point`]) sampled as the ellipsoid's is, with the kinks of U sampled and
+    /// listed, a change of stability located (at a kink too, where V″ jumps), the equator
+    /// σ_π/2 of a symmetric body, and its equilibria ([`edged_equilibria`]). No branch ends
+    /// at a face. ε_min is the top of U on [0, π].
+    pub fn of_edged(
+        body: &Body<EdgedShape>,
+        samples: usize,
+        kappa_max: f64,
+        stop: &dyn Fn() -> bool,
+    ) -> Result<Self> {
+        let stopped = |i: usize| asked_to_stop(i, stop);
+        check_kappa_max(kappa_max)?;
+        crate::error::check_samples(samples)?;
+        let samples = samples.max(16);
+        let faces = body.shape.faces();
+        let kinks = body.shape.kinks().to_vec();
+        let curve = Curve {
+            kappa_sq: &|t| general_kappa_sq(body, t),
+            point: &|t| general_fixed_point(body, t),
+            pole_ends: &|pole| {
+                let face = if pole == 0.0 { faces[0] } else { faces[1] };
+                !face && body.shape.potential_second(pole) > 0.0
+            },
+            extra: kinks
+                .iter()
+                .copied()
+                .filter(|&t| {
+                    general_kappa_sq(body, t) >= 0.0
+                        && general_fixed_point(body, t).kappa <= kappa_max
+                })
+                .collect(),
+            cusp: &|lo, hi, lo_stable| {
+                locate_cusp_on(
+                    body,
+                    &|t| general_kappa_sq(body, t),
+                    &|t| general_fixed_point(body, t),
+                    lo,
+                    hi,
+                    lo_stable,
+                )
+            },
+        };
+        let (mut branches, changes) = sample_branches(&curve, samples, kappa_max, &stopped)?;
+        // A change of stability at a kink is V″ jumping through 0, not a cusp.
+        let at_kink = |c: &Cusp| kinks.iter().any(|k| (k - c.theta).abs() <= 1e-9);
+        let cusps: Vec<Cusp> = changes.iter().filter(|c| !at_kink(c)).copied().collect();
+        let kink_changes: Vec<Cusp> = changes.iter().filter(|c| at_kink(c)).copied().collect();
+        let mut kappa_c_equator = None;
+        if body.shape.symmetric_about_equator() {
+            let a = crate::body::Angle::EQUATOR;
+            let curvature = body.shape.potential_second_at(a);
+            kappa_c_equator = (curvature < 0.0).then(|| (-curvature).sqrt());
+            branches.extend(equator_branches(
+                body.shape.potential_at(a),
+                curvature,
+                kappa_c_equator,
+                samples,
+                kappa_max,
+                &stopped,
+            )?);
+        }
+        let equilibria = edged_equilibria(body);
+        let energy_min = equilibria
+            .iter()
+            .map(|e| e.energy)
+            .fold(f64::NEG_INFINITY, f64::max);
+        let disk = body.shape.kind == crate::body::EdgedKind::Disk;
+        Ok(Self {
+            shape: Some(body.shape.kind.name()),
+            alpha: body.shape.alpha,
+            beta: None,
+            cut: (!disk).then_some(body.shape.cut),
+            nu: body.nu,
+            eta: body.eta,
+            diagram_type: None,
+            kinks,
+            stability_changes_at_kinks: kink_changes,
+            cusp: cusps.last().copied(),
+            cusps,
+            theta_star: None,
+            energy_min,
+            kappa_c_equator,
+            equilibria,
+            branches,
+            kappa_max,
+        })
+    }
+}
+
+/// Err(Stopped) at every 65,536th sample `i` if `stop` says so.
+fn asked_to_stop(i: usize, stop: &dyn Fn() -> bool) -> Result<()> {
+    if i.is_multiple_of(65_536) && stop() {
+        Err(AtlasError::Stopped)
+    } else {
+        Ok(())
+    }
+}
+
+/// κ_max must be a finite number > 0.
+fn check_kappa_max(kappa_max: f64) -> Result<()> {
+    if !(kappa_max.is_finite() && kappa_max > 0.0) {
+        return Err(AtlasError::InvalidParameter {
+            name: "kappa-max",
+            value: kappa_max,
+            reason: "must be a finite number > 0",
+        });
+    }
+    Ok(())
 }

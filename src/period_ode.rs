@@ -56,7 +56,8 @@ impl<S: Shape> PeriodSystem<'_, '_, S> {
             self.system.psi_rate(theta),
             vx,
             vy,
-            u * (along.abs() + p.abs()),
+            // |U|: a disk whose centre of mass is off its plane has U < 0 near a pole.
+            u.abs() * (along.abs() + p.abs()),
         ])
     }
 

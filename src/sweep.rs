@@ -302,12 +302,26 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
         .as_bytes(),
     );
     let journal_dir = Journal::dir_for(out);
-    if journal_dir.exists() && !journal_dir.is_dir() {
-        return Err(AtlasError::atlas(
-            &journal_dir,
-            "is not a directory, and a run keeps its resume journal at this path; \
-             move it away (the program never removes it)",
-        ));
+    if let Ok(meta) = std::fs::symlink_metadata(&journal_dir) {
+        // Only a journal this program made is ever removed or resumed there.
+        let reason = if meta.file_type().is_symlink() {
+            Some("is a symbolic link")
+        } else if !meta.is_dir() {
+            Some("is not a directory")
+        } else if !Journal::looks_like_one(&journal_dir) {
+            Some("is a directory that is not a rubber-atlas resume journal")
+        } else {
+            None
+        };
+        if let Some(reason) = reason {
+            return Err(AtlasError::atlas(
+                &journal_dir,
+                format!(
+                    "{reason}, and a run keeps its resume journal at this path; move it away \
+                     (the program never removes it)"
+                ),
+            ));
+        }
     }
     let journal = if journal_dir.exists() {
         let matching = || Journal::open(&journal_dir, fingerprint);

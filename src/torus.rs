@@ -341,9 +341,14 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
     /// first cell. Sites beyond π/2 are held as π − θ.
     fn scan_sites(&self) -> Vec<Site> {
         let cell = PI / SCAN_CELLS as f64;
-        // κ = 0: the poles are critical points themselves, no well hides at them.
+        // κ = 0: the poles are critical points themselves, no well hides at them. Else the
+        // well nearest a pole sits where κ²/sin³θ meets U′: at sinθ ~ (κ²/U″)^¼ by a smooth
+        // pole, but at (κ²/U′)^⅓, much nearer, by a face, where U′ stays finite (≤ 1).
         let innermost = if self.kappa == 0.0 {
             cell
+        } else if self.body.shape.faces() != [false, false] {
+            let k = self.kappa.abs();
+            1e-3 * k.sqrt().min(k.powf(2.0 / 3.0))
         } else {
             1e-3 * self.kappa.abs().sqrt()
         };
@@ -674,13 +679,16 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         let wrapped = (p.site.theta + PI).rem_euclid(TAU) - PI;
         let from_equator = wrapped.abs() - FRAC_PI_2;
         if self.kappa != 0.0 && symmetric {
-            // One well, at π/2; or a mirror pair, one on each side however close.
-            let minima = self
+            // One well, at π/2; or a mirror pair, one on each side however close; or both
+            // (an edged body, a band of sphere between two edges): with an odd number of
+            // wells, the middle one is at π/2.
+            let minima: Vec<&CriticalPoint> = self
                 .critical
                 .iter()
                 .filter(|c| c.kind == CriticalKind::Minimum)
-                .count();
-            return if minima == 1 {
+                .collect();
+            let middle = (minima.len() % 2 == 1).then(|| minima[minima.len() / 2]);
+            return if middle.is_some_and(|m| m.site.theta == p.site.theta) {
                 Side::Equator
             } else if from_equator < 0.0 {
                 Side::Upper

@@ -227,6 +227,19 @@ impl Request {
         }
         crate::error::check_samples(self.samples)?;
         let start = self.start(body)?;
+        // A planar motion onto a face ends there (docs/bodies.md): no trajectory to follow.
+        if start.kappa == 0.0 && body.shape.faces() != [false, false] {
+            let potential = crate::torus::EffectivePotential::new(body, 0.0);
+            let component = start.component_in(&potential)?;
+            if crate::cell::reaches_face(&potential, &component) {
+                return Err(AtlasError::Unsupported {
+                    what: "trajectory",
+                    reason: "kappa = 0 and this motion reaches a flat face of the body, where \
+                             it ends (the body lands on the face); start away from it or with \
+                             kappa != 0",
+                });
+            }
+        }
         let positive = |name, value| {
             crate::error::check_range(
                 name,

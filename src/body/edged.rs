@@ -93,10 +93,19 @@ pub struct EdgedShape {
 }
 
 impl EdgedShape {
-    /// A thin disk of rim radius 1, its centre of mass at α along the axis from its centre
-    /// (α finite; a homogeneous disk has α = 0, ν = 2, η = 4).
+    /// A thin disk of rim radius 1, its centre of mass at α along the axis from its centre,
+    /// |α| ≤ 100 (a homogeneous disk has α = 0, ν = 2, η = 4). The bound keeps the well by
+    /// the pole θ = π (θ = 0 for α < 0), at sinθ ≈ (κ²/|α|)^¼, within the scan for the
+    /// critical points of V (checked on |α| ≤ 100).
     pub fn disk(alpha: f64) -> Result<Self> {
-        check_range("alpha", alpha, None, None, "must be a finite number")?;
+        check_range(
+            "alpha",
+            alpha,
+            Some((-100.0, true)),
+            Some((100.0, true)),
+            "must satisfy -100 <= alpha <= 100 for the disk (the centre of mass within 100 rim \
+             radii of the disk)",
+        )?;
         Ok(Self {
             kind: EdgedKind::Disk,
             alpha,

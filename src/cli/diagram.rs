@@ -7,13 +7,12 @@ use clap::Args;
 use rubber_atlas::cf::AttrValue;
 use rubber_atlas::critical::CriticalSet;
 use rubber_atlas::store::{check_output, write_table};
-use rubber_atlas::EllipsoidBody;
 use std::path::PathBuf;
 
 #[derive(Debug, Args)]
 pub struct DiagramArgs {
     #[command(flatten)]
-    pub shape: ShapeArgs,
+    pub shape: BodyShapeArgs,
     /// ν = i3/i1 (does not change the critical set; recorded in the output).
     #[arg(value_parser = number, long, default_value_t = 0.5, allow_hyphen_values = true)]
     pub nu: f64,
@@ -52,8 +51,12 @@ pub(super) fn diagram(args: DiagramArgs) -> Result<()> {
         args.out.as_deref(),
         &|| "use fewer --samples".into(),
     )?;
-    let body = EllipsoidBody::ellipsoid(args.shape.alpha, args.shape.beta, args.nu, args.eta)?;
-    let set = CriticalSet::of(&body, args.samples, args.kappa_max)?;
+    let set = match args.shape.body(args.nu, args.eta)? {
+        AnyBody::Ellipsoid(body) => CriticalSet::of(&body, args.samples, args.kappa_max)?,
+        AnyBody::Edged(body) => {
+            CriticalSet::of_edged(&body, args.samples, args.kappa_max, &|| false)?
+        }
+    };
     if args.json {
         println!("{}", serde_json::to_string_pretty(&set)?);
         return Ok(());
@@ -71,15 +74,31 @@ pub(super) fn diagram(args: DiagramArgs) -> Result<()> {
     Ok(())
 }
 
+/// The shape and its parameters as the diagram's first line names them.
+fn body_words(set: &CriticalSet) -> String {
+    let mut words = format!("{} alpha = {}", set.shape.unwrap_or("ellipsoid"), set.alpha);
+    for (name, value) in [("beta", set.beta), ("cut", set.cut)] {
+        if let Some(v) = value {
+            words += &format!(", {name} = {v}");
+        }
+    }
+    words
+}
+
 pub(super) fn print_diagram(set: &CriticalSet) {
+    let kind = match set.diagram_type {
+        Some(t) => format!("diagram type ({})", t.label()),
+        None => "no diagram type (the types (a)-(e) are the ellipsoid's)".into(),
+    };
     println!(
-        "ellipsoid alpha = {}, beta = {} (nu = {}, eta = {}): diagram type ({})",
-        set.alpha,
-        set.beta,
+        "{} (nu = {}, eta = {}): {kind}",
+        body_words(set),
         set.nu,
-        set.eta,
-        set.diagram_type.label()
+        set.eta
     );
+    for k in &set.kinks {
+        println!("  kink of U (the contact passes an edge) at theta = {k:.12}");
+    }
     println!(
         "  eps_min (roll over the top at kappa = 0) = {}",
         digits(set.energy_min, 12)
@@ -97,9 +116,22 @@ pub(super) fn print_diagram(set: &CriticalSet) {
             if e.isolated { ", isolated" } else { "" }
         );
     }
-    if let Some(c) = &set.cusp {
+    let cusps = if set.cusps.is_empty() {
+        set.cusp.iter().copied().collect()
+    } else {
+        set.cusps.clone()
+    };
+    for c in &cusps {
         println!(
             "  cusp theta_c = {:.12}  kappa_c = {}  eps_c = {}",
+            c.theta,
+            digits(c.kappa, 12),
+            digits(c.energy, 12)
+        );
+    }
+    for c in &set.stability_changes_at_kinks {
+        println!(
+            "  stability changes at the kink theta = {:.12}  kappa = {}  eps = {}",
             c.theta,
             digits(c.kappa, 12),
             digits(c.energy, 12)
@@ -129,21 +161,26 @@ pub(super) fn print_diagram(set: &CriticalSet) {
 
 pub(super) fn write_diagram(out: &std::path::Path, set: &CriticalSet) -> Result<()> {
     let mut table = rubber_atlas::table::diagram(set);
-    table.attributes.extend(table_attributes(&[
-        ("alpha", AttrValue::Number(set.alpha)),
-        ("beta", AttrValue::Number(set.beta)),
+    let mut attributes = Vec::new();
+    if let Some(shape) = set.shape {
+        attributes.push(("shape", AttrValue::Text(shape.to_string())));
+    }
+    attributes.push(("alpha", AttrValue::Number(set.alpha)));
+    for (name, value) in [("beta", set.beta), ("cut", set.cut)] {
+        if let Some(v) = value {
+            attributes.push((name, AttrValue::Number(v)));
+        }
+    }
+    attributes.extend([
         ("nu", AttrValue::Number(set.nu)),
         ("eta", AttrValue::Number(set.eta)),
         (
             "critical_set_json",
             AttrValue::Text(serde_json::to_string(set)?),
         ),
-    ]));
-    write_table(out, &table).with_context(|| {
-        format!(
-            "writing the diagram of alpha = {}, beta = {}",
-            set.alpha, set.beta
-        )
-    })?;
+    ]);
+    table.attributes.extend(table_attributes(&attributes));
+    write_table(out, &table)
+        .with_context(|| format!("writing the diagram of {}", body_words(set)))?;
     Ok(())
 }

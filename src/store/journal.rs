@@ -42,6 +42,15 @@ impl Journal {
         })
     }
 
+    /// Whether `dir` holds what [`Journal::create`] writes (its fingerprint file, or its
+    /// scene before the fingerprint landed, or nothing yet when a run was killed just after
+    /// making it): a directory the program may resume or remove.
+    pub fn looks_like_one(dir: &Path) -> bool {
+        dir.join(FINGERPRINT_FILE).is_file()
+            || dir.join("scene.toml").is_file()
+            || std::fs::read_dir(dir).is_ok_and(|mut entries| entries.next().is_none())
+    }
+
     /// Opens an existing journal; refuses one of another scene or program version.
     pub fn open(dir: &Path, fingerprint: u64) -> Result<Journal> {
         let path = dir.join(FINGERPRINT_FILE);

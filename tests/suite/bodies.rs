@@ -456,3 +456,160 @@ fn a_planar_motion_that_reaches_a_face_says_so() {
     }
     let _ = AnyBody::Edged(body);
 }
+
+/// The critical set of every edged body: each sampled permanent rotation is a critical point
+/// of V at its κ with its ε and stability, each inclined equilibrium a root of U′, the
+/// symmetric disk's equator stable beyond κ_c = 1; and one permanent rotation of the
+/// truncated ball, run in the full equations, keeps its centre of mass on the circle of
+/// radius ρ_c = U tanθ0.
+#[test]
+fn the_critical_set_of_each_edged_body_holds_on_its_own_equations() {
+    use rubber_atlas::critical::CriticalSet;
+    use rubber_atlas::reduced::ReducedSystem;
+    for shape in shapes() {
+        let body = Body::new(shape, 0.7, 1.3).unwrap();
+        let set = CriticalSet::of_edged(&body, 400, 3.0, &|| false).unwrap();
+        assert!(set.diagram_type.is_none() && set.beta.is_none());
+        assert_eq!(set.kinks, shape.kinks());
+        let mut points = 0;
+        for branch in set.branches.iter().filter(|b| b.name != "sigma_pi2") {
+            for p in &branch.points {
+                let sys = ReducedSystem::new(&body, p.kappa);
+                let slope = sys.effective_potential_prime(p.theta0);
+                let scale = 1.0 + p.kappa * p.kappa / p.theta0.sin().powi(3).max(1e-300);
+                assert!(slope.abs() < 1e-9 * scale, "{shape:?} {p:?}: V′ = {slope}");
+                assert!(
+                    (sys.effective_potential(p.theta0) - p.energy).abs()
+                        < 1e-12 * (1.0 + p.energy.abs())
+                );
+                let v2 = sys.effective_potential_second(p.theta0);
+                let near_kink = shape.kinks().iter().any(|k| (k - p.theta0).abs() < 1e-6);
+                if v2.abs() > 1e-6 && !near_kink {
+                    assert_eq!(p.stable, v2 > 0.0, "{shape:?} {p:?}");
+                }
+                points += 1;
+            }
+        }
+        assert!(points > 100, "{shape:?}: {points} points");
+        for e in &set.equilibria {
+            assert!((e.energy - shape.potential(e.theta)).abs() < 1e-12, "{e:?}");
+            if e.name == "inclined" {
+                assert!(shape.potential_prime(e.theta).abs() < 1e-12, "{e:?}");
+            }
+        }
+        if shape.kind == rubber_atlas::body::EdgedKind::Disk {
+            assert!(set
+                .equilibria
+                .iter()
+                .any(|e| e.name == "face_0" && e.stable));
+            if shape.alpha == 0.0 {
+                assert_eq!(set.kappa_c_equator, Some(1.0));
+            }
+        }
+    }
+    // A permanent rotation of the truncated ball on its edge, in the full equations.
+    let body = Body::new(EdgedShape::truncated_ball(0.2, 0.4).unwrap(), 0.7, 1.3).unwrap();
+    let set = CriticalSet::of_edged(&body, 400, 3.0, &|| false).unwrap();
+    let branch = set
+        .branches
+        .iter()
+        .find(|b| b.stable && b.name == "sigma_spi")
+        .unwrap();
+    let p = branch.points[branch.points.len() / 2];
+    let start = Start {
+        kappa: p.kappa,
+        theta0: p.theta0,
+        theta_dot0: 0.0,
+    };
+    let psi_rate = ReducedSystem::new(&body, p.kappa).psi_rate(p.theta0).abs();
+    let turn = TAU / psi_rate;
+    let full = integrate(&body, &start, Model::Full, 1.2 * turn, 4000, 1e-13, &|| {
+        false
+    })
+    .unwrap();
+    let span = |v: &[f64]| {
+        v.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
+            - v.iter().cloned().fold(f64::INFINITY, f64::min)
+    };
+    let radius = 0.5 * span(&full.x_c).max(span(&full.y_c));
+    assert!(
+        (radius - p.rho_c.abs()).abs() < 1e-5 * (1.0 + p.rho_c.abs()),
+        "{p:?}: circle of radius {radius}"
+    );
+    let drift = full
+        .theta
+        .iter()
+        .map(|t| (t - p.theta0).abs())
+        .fold(0.0, f64::max);
+    assert!(drift < 1e-7, "θ strays {drift} from θ0 = {}", p.theta0);
+}
+
+/// At tiny κ the well by a face sits at sinθ ≈ (κ²/U′)^⅓, far nearer the pole than a smooth
+/// pole's (κ²/U″)^¼: it is found (it was missed below κ ≈ 1e-18), so the components are those
+/// at κ = 1e-6, down to κ = 1e-200.
+#[test]
+fn the_well_by_a_face_is_found_at_the_tiniest_kappa() {
+    for (alpha, cut, energy) in [(-0.1, 0.4, 2.0), (0.2, 0.4, 0.7), (0.2, 0.4, 0.85)] {
+        let body = Body::new(EdgedShape::truncated_ball(alpha, cut).unwrap(), 0.7, 1.3).unwrap();
+        let reference = solve_cell(&body, 1e-6, energy, &CellOptions::default()).unwrap();
+        assert!(!reference.components.is_empty());
+        for kappa in [1e-12, 1e-19, 1e-30, 1e-100, 1e-200] {
+            let cell = solve_cell(&body, kappa, energy, &CellOptions::default()).unwrap();
+            assert_eq!(
+                cell.components.len(),
+                reference.components.len(),
+                "α = {alpha}, ε = {energy}, κ = {kappa}: {cell:?}"
+            );
+            for (a, b) in cell.components.iter().zip(&reference.components) {
+                assert_eq!(a.family, b.family);
+                assert!((a.theta_max - b.theta_max).abs() < 1e-3, "{a:?} vs {b:?}");
+            }
+        }
+    }
+}
+
+/// The symmetric wheel (α = 0) has three wells at small κ: one on each edge and one on the
+/// band of sphere round θ = π/2, whose family is the equator's.
+#[test]
+fn the_symmetric_wheel_has_three_families() {
+    use rubber_atlas::family::Family;
+    let body = Body::new(EdgedShape::wheel(0.0, 0.5).unwrap(), 0.7, 1.3).unwrap();
+    let cell = solve_cell(&body, 0.3, 1.05, &CellOptions::default()).unwrap();
+    let families: Vec<Family> = cell.components.iter().map(|c| c.family).collect();
+    assert_eq!(
+        families,
+        [Family::Well0, Family::WellEquator, Family::WellPi],
+        "{cell:?}"
+    );
+    let (lo, mid, hi) = (
+        &cell.components[0],
+        &cell.components[1],
+        &cell.components[2],
+    );
+    assert!((mid.theta_min + mid.theta_max - PI).abs() < 1e-12);
+    assert!((lo.rotation_number + hi.rotation_number).abs() < 1e-14);
+}
+
+/// A planar trajectory onto a face is refused (the motion ends there); one that stays on
+/// the sphere runs; the disk's α is bounded (|α| ≤ 100, where its wells are found).
+#[test]
+fn planar_trajectories_onto_a_face_are_refused() {
+    use rubber_atlas::trajectory::{Duration, Request, StartAt};
+    let request = |energy| Request {
+        kappa: 0.0,
+        start: StartAt::Energy {
+            energy,
+            component: 0,
+        },
+        duration: Duration::Until(3.0),
+        samples: 10,
+        model: Model::Reduced,
+        tol: 1e-10,
+    };
+    let face = Body::new(EdgedShape::truncated_ball(0.2, 0.4).unwrap(), 0.7, 1.3).unwrap();
+    let refused = request(0.7).run(&face).unwrap_err().to_string();
+    assert!(refused.starts_with("trajectory: kappa = 0"), "{refused}");
+    let sphere = Body::new(EdgedShape::truncated_ball(0.2, 0.9).unwrap(), 0.7, 1.3).unwrap();
+    assert!(request(0.81).run(&sphere).is_ok());
+    assert!(EdgedShape::disk(100.0).is_ok() && EdgedShape::disk(100.5).is_err());
+}

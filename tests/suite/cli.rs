@@ -906,3 +906,66 @@ fn a_run_without_out_writes_beside_its_scene_from_any_folder() {
     // (The scene is read first: a missing one is refused in one line.)
     assert_eq!(o.status.code(), Some(2));
 }
+
+/// Standard output that cannot be written (a full disk: /dev/full) is one line on stderr and
+/// exit status 1, never a panic with a backtrace.
+#[test]
+fn output_that_cannot_be_written_is_one_line_and_exit_1() {
+    let commands: [&[&str]; 3] = [
+        &[
+            "cell", "--alpha", "0.5", "--beta", "3", "--nu", "0.5", "--eta", "0.5", "--kappa",
+            "0.8", "--energy", "2.5",
+        ],
+        &[
+            "cell", "--shape", "disk", "--alpha", "0", "--nu", "2", "--eta", "4", "--kappa", "0.5",
+            "--energy", "2", "--json",
+        ],
+        &["diagram", "--alpha", "0.5", "--beta", "3", "--json"],
+    ];
+    for args in commands {
+        let full = std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap();
+        let o = Command::new(env!("CARGO_BIN_EXE_rubber-atlas"))
+            .args(args)
+            .stdout(full)
+            .env("RUST_BACKTRACE", "1")
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {text}");
+        assert!(
+            text.contains("No space left on device") && text.lines().count() == 1,
+            "{text}"
+        );
+    }
+}
+
+/// `diagram --shape`: the JSON of an edged body names its shape and cut, has no β and no
+/// diagram type, and lists the kinks.
+#[test]
+fn the_diagram_of_an_edged_body_names_its_shape() {
+    let o = Command::new(env!("CARGO_BIN_EXE_rubber-atlas"))
+        .args([
+            "diagram", "--shape", "wheel", "--alpha", "0.25", "--cut", "0.7", "--json",
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["shape"], "wheel");
+    assert_eq!(v["cut"], 0.7);
+    assert!(v.get("beta").is_none() && v["diagram_type"].is_null());
+    assert_eq!(v["kinks"].as_array().unwrap().len(), 2);
+    assert!(!v["stability_changes_at_kinks"]
+        .as_array()
+        .unwrap()
+        .is_empty());
+    let o = Command::new(env!("CARGO_BIN_EXE_rubber-atlas"))
+        .args(["diagram", "--shape", "disk", "--alpha", "0", "--beta", "2"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("takes no --beta"));
+}

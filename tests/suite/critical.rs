@@ -214,7 +214,7 @@ proptest! {
             }
         }
         // Type (c): the cusp is where κ along the left half peaks (a direct maximisation).
-        if set.diagram_type == DiagramType::C {
+        if set.diagram_type == Some(DiagramType::C) {
             let cusp = set.cusp.expect("type (c) has a cusp");
             let ts = set.theta_star.unwrap();
             let (t_peak, k2_peak) = maximise(|t| t.sin().powi(3) * diff(|s| b.shape.potential(s), t, 1e-6) / t.cos(), 1e-3, ts);

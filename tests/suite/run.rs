@@ -464,6 +464,37 @@ fn four_shards_merged_equal_a_single_run() {
         text.contains("is named twice among the shards") && text.lines().count() == 1,
         "{text}"
     );
+    // A directory that is not a journal, and a symbolic link, where the run keeps its
+    // resume journal: refused and kept, with --force too.
+    let user_dir = dir.path().join("kept.h5.partial.d");
+    std::fs::create_dir(&user_dir).unwrap();
+    std::fs::write(user_dir.join("notes.txt"), "mine").unwrap();
+    let link = dir.path().join("linked.h5.partial.d");
+    std::os::unix::fs::symlink(dir.path(), &link).unwrap();
+    for (name, words) in [
+        (
+            "kept.h5",
+            "is a directory that is not a rubber-atlas resume journal",
+        ),
+        ("linked.h5", "is a symbolic link"),
+    ] {
+        let out = dir.path().join(name);
+        let o = run(&[
+            "run",
+            s,
+            "--out",
+            out.to_str().unwrap(),
+            "--force",
+            "--quiet",
+        ]);
+        assert_eq!(o.status.code(), Some(2));
+        assert!(String::from_utf8_lossy(&o.stderr).contains(words));
+    }
+    assert_eq!(
+        std::fs::read_to_string(user_dir.join("notes.txt")).unwrap(),
+        "mine"
+    );
+    assert!(link.exists());
     // A regular file where the run keeps its resume journal: named as such, and kept, with
     // --force too.
     let blocked = dir.path().join("blocked.h5");
