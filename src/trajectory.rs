@@ -96,13 +96,21 @@ impl Start {
         ReducedSystem::new(body, self.kappa).energy(self.theta0, self.theta_dot0)
     }
 
-    /// The energy of this start, refused (naming θ̇(0), or κ) where it overflows.
+    /// The energy of this start, refused (naming θ(0), θ̇(0) or κ) where it overflows.
     pub fn checked_energy<S: Shape>(&self, body: &Body<S>) -> Result<f64> {
         let energy = self.energy(body);
         if energy.is_finite() {
             return Ok(energy);
         }
-        let (name, value) = if self.theta_dot0 != 0.0 {
+        let potential = ReducedSystem::new(body, self.kappa).effective_potential(self.theta0);
+        if !potential.is_finite() && (self.kappa * self.kappa).is_finite() {
+            // κ²/(2 sin²θ0) overflows because θ0 is that near a pole.
+            return Err(AtlasError::InvalidInitialAngle {
+                theta0: self.theta0,
+                reason: "so near a pole that kappa^2/(2 sin^2 theta0) overflows",
+            });
+        }
+        let (name, value) = if self.theta_dot0 != 0.0 && potential.is_finite() {
             ("theta-dot0", self.theta_dot0)
         } else {
             ("kappa", self.kappa)

@@ -484,6 +484,11 @@ fn edge_inputs_get_one_line_and_never_a_panic() {
     fast.extend(BODY);
     fast.extend(["--kappa", "1", "--theta0", "1", "--theta-dot0", "1e200"]);
     assert_refused(&fast, "invalid theta-dot0 = 1e200", None);
+    // A start so near a pole that κ²/(2 sin²θ0) overflows names θ0, not κ.
+    let mut pole: Vec<&str> = vec!["cell"];
+    pole.extend(BODY);
+    pole.extend(["--kappa", "0.6", "--theta0", "1e-200"]);
+    assert_refused(&pole, "invalid theta0 = 1e-200", None);
     let missing = dir.path().join("missing.h5");
     assert_refused(
         &["merge", missing.to_str().unwrap(), "--out", out_s],
