@@ -14,7 +14,7 @@ use crate::scene::Field;
 use crate::table::{Table, Values};
 use crate::trajectory::{Duration, Model, Request, StartAt};
 use crate::verdict::{self, VerdictOptions};
-use crate::EllipsoidBody;
+use crate::{AnyBody, EllipsoidBody};
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -349,6 +349,21 @@ fn shape_kind(name: &str) -> PyResult<Option<crate::EdgedKind>> {
     })
 }
 
+/// The body of `shape` (`ellipsoid`, or an edged one whose cut is given in `beta`).
+fn any_body(shape: &str, alpha: f64, beta: f64, nu: f64, eta: f64) -> PyResult<AnyBody> {
+    Ok(match shape_kind(shape)? {
+        None => AnyBody::Ellipsoid(body(alpha, beta, nu, eta)?),
+        Some(kind) => AnyBody::Edged(
+            crate::Body::new(
+                crate::EdgedShape::of(kind, alpha, beta).map_err(value_error)?,
+                nu,
+                eta,
+            )
+            .map_err(value_error)?,
+        ),
+    })
+}
+
 /// The edged bodies of `points`, each with its cut in `beta` (ignored by the disk).
 fn edged_bodies(
     points: &[CellPoint],
@@ -473,10 +488,10 @@ fn body(alpha: f64, beta: f64, nu: f64, eta: f64) -> PyResult<EllipsoidBody> {
 /// The critical set of one body (paper §4): its fixed-point curves as a table, and its
 /// summary as JSON.
 #[pyfunction]
-#[pyo3(signature = (alpha, beta, nu, eta, samples, kappa_max, allow_large=false))]
+#[pyo3(signature = (alpha, beta, nu, eta, samples, kappa_max, allow_large=false, shape="ellipsoid"))]
 #[allow(clippy::too_many_arguments)]
-fn diagram(
-    py: Python<'_>,
+fn diagram<'py>(
+    py: Python<'py>,
     alpha: f64,
     beta: f64,
     nu: f64,
@@ -484,7 +499,8 @@ fn diagram(
     samples: i64,
     kappa_max: f64,
     allow_large: bool,
-) -> PyResult<(Bound<'_, PyDict>, String)> {
+    shape: &str,
+) -> PyResult<(Bound<'py, PyDict>, String)> {
     let samples = count("samples", samples, 1)?;
     // As the command measured it: 245 bytes per sample at the peak.
     check_memory(
@@ -492,11 +508,12 @@ fn diagram(
         allow_large,
         "use fewer samples, or allow_large=True",
     )?;
-    let body = body(alpha, beta, nu, eta)?;
+    let body = any_body(shape, alpha, beta, nu, eta)?;
     // Ctrl-C is heard every 65,536 samples (it used to wait for the whole set, and a
     // KeyboardInterrupt pending at the first NumPy call became a panic).
-    let set = interruptible(py, &None, |stop| {
-        CriticalSet::of_until(&body, samples, kappa_max, stop)
+    let set = interruptible(py, &None, |stop| match &body {
+        AnyBody::Ellipsoid(b) => CriticalSet::of_until(b, samples, kappa_max, stop),
+        AnyBody::Edged(b) => CriticalSet::of_edged(b, samples, kappa_max, stop),
     })?
     .map_err(value_error)?;
     let summary = serde_json::to_string(&set).map_err(|e| bad(e.to_string()))?;
@@ -506,7 +523,7 @@ fn diagram(
 /// A trajectory (the reduced model or the full one) as a table along `t`, with its start
 /// (κ, ε, θ(0), θ̇(0)).
 #[pyfunction]
-#[pyo3(signature = (alpha, beta, nu, eta, kappa, energy, component, theta0, theta_dot0, periods, t_end, samples, model, tol, allow_large=false))]
+#[pyo3(signature = (alpha, beta, nu, eta, kappa, energy, component, theta0, theta_dot0, periods, t_end, samples, model, tol, allow_large=false, shape="ellipsoid"))]
 #[allow(clippy::too_many_arguments)]
 fn trajectory<'py>(
     py: Python<'py>,
@@ -525,6 +542,7 @@ fn trajectory<'py>(
     model: &str,
     tol: f64,
     allow_large: bool,
+    shape: &str,
 ) -> PyResult<(Bound<'py, PyDict>, [f64; 5])> {
     let component = count("component", component, 0)?;
     let samples = count("samples", samples, 1)?;
@@ -534,7 +552,7 @@ fn trajectory<'py>(
         allow_large,
         "use fewer samples, or allow_large=True",
     )?;
-    let body = body(alpha, beta, nu, eta)?;
+    let body = any_body(shape, alpha, beta, nu, eta)?;
     let start = match (energy, theta0) {
         (Some(energy), None) => StartAt::Energy { energy, component },
         (None, Some(theta0)) => StartAt::Angle { theta0, theta_dot0 },
@@ -559,11 +577,15 @@ fn trajectory<'py>(
         tol,
     };
     // Ctrl-C is heard between integrator runs (at most 100,000 steps each).
-    let (start, traj) = interruptible(py, &None, |stop| request.run_until(&body, stop))?
-        .map_err(trajectory_error)?;
+    let (start, traj, energy) = interruptible(py, &None, |stop| {
+        crate::with_body!(&body, b => request
+            .run_until(b, stop)
+            .map(|(start, traj)| (start, traj, start.energy(b))))
+    })?
+    .map_err(trajectory_error)?;
     let start = [
         start.kappa,
-        start.energy(&body),
+        energy,
         start.theta0,
         start.theta_dot0,
         traj.energy_drift,

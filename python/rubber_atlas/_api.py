@@ -458,6 +458,18 @@ def _shape_inputs(shape: str, beta, cut) -> dict:
     return {"cut": cut}
 
 
+def _one_body(shape, alpha, beta, nu, eta, cut) -> tuple[dict, str, dict, list]:
+    """The checked numbers of one body, the shape's name, and the keywords the core takes: the
+    ellipsoid's (alpha, beta, nu, eta), or an edged body's with its cut in beta's place."""
+    shape = _text("shape", shape, '"ellipsoid", "disk", "truncated_ball" or "wheel"')
+    second = _shape_inputs(shape, beta, cut)
+    body = _reals(alpha=alpha, **second, nu=nu, eta=eta)
+    values = list(body.values())
+    if shape == "disk":
+        values.insert(1, 0.0)
+    return body, shape, ({"shape": shape} if shape != "ellipsoid" else {}), values
+
+
 def _to_kappa_energy(plane: tuple[str, str], flat: list[np.ndarray], shape: str = "ellipsoid") -> list[np.ndarray]:
     """The six flat inputs (α, β or the cut, ν, η and the plane's two) as α, β, ν, η, κ, ε."""
     a, b = flat[4], flat[5]
@@ -1305,8 +1317,9 @@ def _read_csv(path: Path) -> xr.Dataset:
     return ds
 
 
-def diagram(alpha: float, beta: float, nu: float = 0.5, eta: float = 0.5, *, samples: int = 2000,
-            kappa_max: float = 3.0, allow_large: bool = False) -> xr.Dataset:
+def diagram(alpha: float, beta: float | None, nu: float = 0.5, eta: float = 0.5, *, samples: int = 2000,
+            kappa_max: float = 3.0, allow_large: bool = False, shape: str = "ellipsoid",
+            cut: float | None = None) -> xr.Dataset:
     """The critical set of one body: its fixed-point curves (the paper's bifurcation diagram).
 
     Parameters
@@ -1324,6 +1337,11 @@ def diagram(alpha: float, beta: float, nu: float = 0.5, eta: float = 0.5, *, sam
         The largest |κ| the curves are drawn to, > 0.
     allow_large : bool, default False
         Allow `samples` beyond 80 % of the available memory.
+    shape : {"ellipsoid", "disk", "truncated_ball", "wheel"}, default "ellipsoid"
+        The body (docs/bodies.md); for any but the ellipsoid `beta` is None, and the cut
+        balls take `cut`.
+    cut : float, optional
+        h of a cut ball: -1 < h < 1 (``truncated_ball``), 0 < h < 1 (``wheel``).
 
     Returns
     -------
@@ -1352,18 +1370,20 @@ def diagram(alpha: float, beta: float, nu: float = 0.5, eta: float = 0.5, *, sam
     >>> summary["diagram_type"], round(summary["energy_min"], 5)
     ('c', 3.04651)
     """
-    body = _reals(alpha=alpha, beta=beta, nu=nu, eta=eta)
-    table, summary = _core.diagram(*body.values(), _count("samples", samples), _real("kappa_max", kappa_max),
-                                   _switch("allow_large", allow_large))
-    arguments = dict(alpha=alpha, beta=beta, nu=nu, eta=eta, samples=samples, kappa_max=kappa_max)
-    attrs = _root_attrs("diagram", arguments, **body, critical_set_json=summary)
+    body, shape, extra, values = _one_body(shape, alpha, beta, nu, eta, cut)
+    table, summary = _core.diagram(*values, _count("samples", samples), _real("kappa_max", kappa_max),
+                                   _switch("allow_large", allow_large), **extra)
+    arguments = dict(alpha=alpha, **({} if extra else dict(beta=beta)), nu=nu, eta=eta, samples=samples,
+                     kappa_max=kappa_max, **extra, **({"cut": cut} if cut is not None else {}))
+    attrs = _root_attrs("diagram", arguments, **extra, **body, critical_set_json=summary)
     return _table(table, attrs)
 
 
 def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, energy: float | None = None, *,
                component: int | None = None, theta0: float | None = None, theta_dot0: float | None = None,
                periods: float | None = None, t_end: float | None = None, samples: int = 2000,
-               model: str = "reduced", tol: float = 1e-12, allow_large: bool = False) -> xr.Dataset:
+               model: str = "reduced", tol: float = 1e-12, allow_large: bool = False, shape: str = "ellipsoid",
+               cut: float | None = None) -> xr.Dataset:
     """A trajectory of the body over time, as ``rubber-atlas trajectory`` writes it.
 
     Parameters
@@ -1395,6 +1415,11 @@ def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, e
         Tolerance of the integrator, 1e-15 … 0.1.
     allow_large : bool, default False
         Allow `samples` beyond 80 % of the available memory.
+    shape : {"ellipsoid", "disk", "truncated_ball", "wheel"}, default "ellipsoid"
+        The body (docs/bodies.md); for any but the ellipsoid `beta` is None, and the cut
+        balls take `cut`. A planar start (κ = 0) whose motion reaches a face is refused.
+    cut : float, optional
+        h of a cut ball: -1 < h < 1 (``truncated_ball``), 0 < h < 1 (``wheel``).
 
     Returns
     -------
@@ -1426,7 +1451,7 @@ def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, e
     >>> round(float(t.theta[0]), 4) == round(float(t.attrs["theta0"]), 4)
     True
     """
-    body = _reals(alpha=alpha, beta=beta, nu=nu, eta=eta)
+    body, shape, extra, values = _one_body(shape, alpha, beta, nu, eta, cut)
     tol = _real("tol", tol)
     # As the command: each start option goes with its start (it used to be ignored silently).
     if energy is not None and theta_dot0 is not None:
@@ -1436,14 +1461,14 @@ def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, e
     component = 0 if component is None else component
     theta_dot0 = 0.0 if theta_dot0 is None else theta_dot0
     table, (k, e, t0, td0, drift) = _core.trajectory(
-        *body.values(), _real("kappa", kappa), _optional_real("energy", energy), _count("component", component),
+        *values, _real("kappa", kappa), _optional_real("energy", energy), _count("component", component),
         _optional_real("theta0", theta0), _real("theta_dot0", theta_dot0), _optional_real("periods", periods),
         _optional_real("t_end", t_end), _count("samples", samples), _text("model", model, '"reduced" or "full"'), tol,
-        _switch("allow_large", allow_large))
-    arguments = dict(alpha=alpha, beta=beta, nu=nu, eta=eta, kappa=kappa, energy=energy, component=component,
-                     theta0=theta0, theta_dot0=theta_dot0, periods=periods, t_end=t_end, samples=samples,
-                     model=model, tol=tol)
-    attrs = _root_attrs("trajectory", arguments, model=str(model), **body,
+        _switch("allow_large", allow_large), **extra)
+    arguments = dict(alpha=alpha, **({} if extra else dict(beta=beta)), nu=nu, eta=eta, kappa=kappa, energy=energy,
+                     component=component, theta0=theta0, theta_dot0=theta_dot0, periods=periods, t_end=t_end,
+                     samples=samples, model=model, tol=tol, **extra, **({"cut": cut} if cut is not None else {}))
+    attrs = _root_attrs("trajectory", arguments, model=str(model), **extra, **body,
                         kappa=k, energy=e, theta0=t0, theta_dot0=td0, tolerance=tol, energy_drift=drift)
     return _table(table, attrs)
 

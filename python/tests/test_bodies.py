@@ -84,3 +84,26 @@ def test_what_a_shape_does_not_take_is_refused(kwargs, error, words):
         ra.cells(0.25, 2.0, 0.7, 1.3, kappa=0.5, energy=2.0, shape="wheel", cut=0.5)
     with pytest.raises(ValueError, match="not of the ellipsoid"):
         ra.cells(0.25, 2.0, 0.7, 1.3, kappa=0.5, energy=2.0, cut=0.5)
+
+
+def test_trajectory_and_diagram_of_an_edged_body_equal_the_commands(tmp_path):
+    """`trajectory(shape=…)` gives the table of `rubber-atlas trajectory --shape …` (the same
+    values, to the CSV's 17 digits), and `diagram(shape=…)` the JSON of `diagram --json`."""
+    t = ra.trajectory(0.25, None, 0.7, 1.3, 0.5, theta0=0.4, periods=1, samples=40, shape="wheel", cut=0.7)
+    assert t.attrs["shape"] == "wheel" and t.attrs["cut"] == 0.7 and "beta" not in t.attrs
+    out = tmp_path / "w.csv"
+    run("trajectory", "--shape", "wheel", "--alpha", "0.25", "--cut", "0.7", "--nu", "0.7", "--eta", "1.3",
+        "--kappa", "0.5", "--theta0", "0.4", "--periods", "1", "--samples", "40", "--out", out)
+    table = ra.read_table(out)
+    np.testing.assert_array_equal(t.theta.values, table.theta.values)
+    np.testing.assert_array_equal(t.x_c.values, table.x_c.values)
+    d = ra.diagram(0.2, None, shape="truncated_ball", cut=0.4, samples=300)
+    assert json.loads(d.attrs["critical_set_json"]) == json.loads(
+        run("diagram", "--shape", "truncated_ball", "--alpha", "0.2", "--cut", "0.4", "--samples", "300", "--json"))
+
+
+def test_a_planar_trajectory_onto_a_face_is_refused():
+    with pytest.raises(ValueError, match="reaches a flat face"):
+        ra.trajectory(0.2, None, 0.7, 1.3, 0.0, energy=0.7, periods=1, shape="truncated_ball", cut=0.4)
+    with pytest.raises(ValueError, match="takes no beta"):
+        ra.diagram(0.2, 3.0, shape="disk")
