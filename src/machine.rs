@@ -75,7 +75,8 @@ fn address_space_available() -> Option<f64> {
     Some((limit.rlim_cur as f64 - size).max(0.0))
 }
 
-/// Free space for an unprivileged user in the folder that will hold `out`.
+/// Free space for an unprivileged user in the folder that will hold `out` (None where the
+/// file system does not say).
 pub fn free_disk(out: &std::path::Path) -> Option<f64> {
     use std::os::unix::ffi::OsStrExt;
     let dir = match out.parent() {
@@ -86,6 +87,11 @@ pub fn free_disk(out: &std::path::Path) -> Option<f64> {
     // SAFETY: statvfs fills the zeroed struct from a valid NUL-terminated path.
     let mut stat: libc::statvfs = unsafe { std::mem::zeroed() };
     if unsafe { libc::statvfs(c_path.as_ptr(), &mut stat) } != 0 {
+        return None;
+    }
+    // A pseudo file system (/proc, /sys) has no blocks at all: it does not say, and writing
+    // there fails with its own reason.
+    if stat.f_blocks == 0 {
         return None;
     }
     Some(stat.f_bavail as f64 * stat.f_frsize as f64)

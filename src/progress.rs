@@ -172,6 +172,24 @@ impl Progress for Reporter {
         }
     }
 
+    fn retract(&self, cells: u64) {
+        self.done.fetch_sub(cells, Ordering::Relaxed);
+        self.resumed.fetch_sub(cells, Ordering::Relaxed);
+        match &self.mode {
+            Mode::Bar(bar) => {
+                bar.set_position(bar.position().saturating_sub(cells));
+                bar.println(format!(
+                    "a damaged unit of the journal ({cells} cells) is computed again"
+                ));
+            }
+            Mode::Lines { .. } => eprintln!(
+                "run {}: a damaged unit of the journal ({cells} cells) is computed again",
+                self.name
+            ),
+            Mode::Quiet => {}
+        }
+    }
+
     fn laying_out(&self) {
         match &self.mode {
             Mode::Bar(bar) => {

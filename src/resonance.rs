@@ -644,8 +644,19 @@ fn check_window(options: &ResonanceOptions) -> Result<()> {
     if !e0.is_finite() {
         return bad("energy_min", e0, "must be finite");
     }
-    if !(e1.is_finite() && e1 > e0) {
+    if !e1.is_finite() {
         return bad("energy_max", e1, "must be finite and above energy_min");
+    }
+    if e1 <= e0 {
+        // Name both: energy_min may be the window's bottom of V, not a value the user gave.
+        return Err(AtlasError::Atlas {
+            path: format!("invalid energy_max = {}", crate::error::show(e1)),
+            reason: format!(
+                "must be above energy_min = {} (when not given, the lowest minimum of V over \
+                 the window)",
+                crate::error::show(e0)
+            ),
+        });
     }
     if !options.target.is_finite() {
         return bad("rotation_number", options.target, "must be finite");

@@ -23,6 +23,9 @@ pub trait Progress: Sync {
     fn begin(&self, _total: u64, _done: u64) {}
     /// `cells` more cells are done.
     fn advance(&self, _cells: u64) {}
+    /// A unit counted as done at [`Progress::begin`] (`cells` cells, listed in the journal)
+    /// turned out damaged and is computed again.
+    fn retract(&self, _cells: u64) {}
     /// The component axis is being laid out from the grid's critical points (the census,
     /// before [`Progress::begin`]; long only for grids of very many bodies and κ-rows).
     fn laying_out(&self) {}
@@ -404,6 +407,8 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
                             part.units_resumed = 1;
                             return Ok(Some((chunks, part)));
                         }
+                        // Counted as done when the run began: not any more.
+                        progress.retract(cells_of(u) as u64);
                     }
                     // Asked to stop: no new unit (those in flight finish into the journal).
                     if progress.interrupted() {

@@ -687,6 +687,18 @@ pub fn verdict_until(
     stopped()?;
     let set = CriticalSet::of(body, 400, 1e6)?;
     let cusp_kappa = set.cusp.map(|c| c.kappa);
+    // Case 2 has the cusp of type (c), above which κ_max lies. Where the sampled critical
+    // set does not resolve it (α → 0: σ_u shrinks into a sliver beside θ = π/2), the region
+    // of the hypothesis is unknown and no line can be placed in it.
+    if case == Case::Two && cusp_kappa.is_none() {
+        verdict.evidence.undecided = Some(
+            "the cusp of diagram type (c) is not resolved by the sampled critical set (sigma_u \
+             is too narrow at this alpha), so kappa_max and the region of the hypothesis are \
+             unknown"
+                .to_string(),
+        );
+        return Ok(verdict);
+    }
     // The region of the hypothesis: κ > 0 (case 1) or κ > κ_max (case 2).
     let mut undecided = None;
     let lo = match case {

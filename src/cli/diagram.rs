@@ -76,10 +76,14 @@ pub(super) fn diagram(args: DiagramArgs) -> Result<()> {
 
 /// The shape and its parameters as the diagram's first line names them.
 fn body_words(set: &CriticalSet) -> String {
-    let mut words = format!("{} alpha = {}", set.shape.unwrap_or("ellipsoid"), set.alpha);
+    let mut words = format!(
+        "{} alpha = {}",
+        set.shape.unwrap_or("ellipsoid"),
+        show(set.alpha)
+    );
     for (name, value) in [("beta", set.beta), ("cut", set.cut)] {
         if let Some(v) = value {
-            words += &format!(", {name} = {v}");
+            words += &format!(", {name} = {}", show(v));
         }
     }
     words
@@ -93,8 +97,8 @@ pub(super) fn print_diagram(set: &CriticalSet) {
     println!(
         "{} (nu = {}, eta = {}): {kind}",
         body_words(set),
-        set.nu,
-        set.eta
+        show(set.nu),
+        show(set.eta)
     );
     for k in &set.kinks {
         println!("  kink of U (the contact passes an edge) at theta = {k:.12}");

@@ -221,6 +221,17 @@ fn extreme_bodies_are_undecided_with_the_reason() {
         let json = serde_json::to_string(&v).unwrap();
         assert!(!json.contains("NaN"), "{json}");
     }
+    // Nearly symmetric and very oblate: the sampled critical set does not resolve the cusp of
+    // type (c) (σ_u is a sliver beside π/2); the verdict used to fail on "counterexamples" at
+    // κ = 3 … 15, all below the cusp at κ ≈ 31.6, outside the hypothesis's region.
+    for alpha in [1e-15, 1e-300] {
+        let body = EllipsoidBody::ellipsoid(alpha, 1e3, 0.5, 0.5).unwrap();
+        let v = verdict(&body, &options).unwrap();
+        assert_eq!((v.case, v.holds), (verdict::Case::Two, None), "α = {alpha}");
+        assert!(v.counterexamples.is_empty());
+        let reason = v.evidence.undecided.clone().expect("a reason");
+        assert!(reason.contains("cusp"), "{reason}");
+    }
     // A body the hypothesis does not cover answers at once too (α = 0, β = 1e6 took 39 s).
     let body = EllipsoidBody::ellipsoid(0.0, 1e6, 0.5, 0.5).unwrap();
     let v = verdict(&body, &options).unwrap();

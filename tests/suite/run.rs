@@ -789,3 +789,51 @@ fn sigint_and_sigterm_stop_a_run_after_its_units_in_flight_and_it_resumes() {
     assert_same_arrays(&reference, &out);
     assert!(!journal.exists());
 }
+
+/// A resumed run that finds a damaged unit in the journal computes it again, says so, and
+/// counts it once: the progress never passes the total (it showed 5000/4000 cells).
+#[test]
+fn a_damaged_journal_unit_is_computed_again_and_counted_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = slow_scene(dir.path());
+    let s = scene.to_str().unwrap();
+    let reference = run_quietly(s, &dir.path().join("reference.h5"));
+    let out = dir.path().join("o.h5");
+    let o = out.to_str().unwrap();
+    let journal = dir.path().join("o.h5.partial.d");
+    let mut child = Command::new(BIN)
+        .args(["run", s, "--out", o, "--quiet"])
+        .spawn()
+        .unwrap();
+    wait_for_units(&mut child, &journal, 2);
+    // SAFETY: a signal to our own child process.
+    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    let status = child.wait().unwrap();
+    if status.success() {
+        return; // finished before the signal landed: nothing to resume
+    }
+    let unit = std::fs::read_dir(&journal)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|e| e == "bin"))
+        .unwrap();
+    std::fs::OpenOptions::new()
+        .write(true)
+        .open(&unit)
+        .unwrap()
+        .set_len(10)
+        .unwrap();
+    let resumed = run(&["run", s, "--out", o, "--resume"]);
+    let text = String::from_utf8_lossy(&resumed.stderr);
+    assert!(resumed.status.success(), "{text}");
+    assert!(text.contains("a damaged unit of the journal"), "{text}");
+    for line in text.lines().filter(|l| l.contains(" cells (")) {
+        let counts = line.split(": ").nth(1).unwrap().split(' ').next().unwrap();
+        let (done, total) = counts.split_once('/').unwrap();
+        assert!(
+            done.parse::<u64>().unwrap() <= total.parse::<u64>().unwrap(),
+            "{line}"
+        );
+    }
+    assert_same_arrays(&reference, &out);
+}
