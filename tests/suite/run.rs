@@ -629,6 +629,17 @@ fn run_quietly(scene: &str, out: &Path) -> PathBuf {
     out.to_path_buf()
 }
 
+/// The slow scene in a fresh folder (kept while the first value lives), the path of the
+/// scene, its reference run, and the output and journal paths of a run under test.
+fn slow_run() -> (tempfile::TempDir, String, PathBuf, PathBuf, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = slow_scene(dir.path()).to_str().unwrap().to_string();
+    let reference = run_quietly(&scene, &dir.path().join("reference.h5"));
+    let out = dir.path().join("o.h5");
+    let journal = dir.path().join("o.h5.partial.d");
+    (dir, scene, reference, out, journal)
+}
+
 /// Waits until the run writing `journal` has `units` unit files there (or has ended).
 fn wait_for_units(child: &mut std::process::Child, journal: &Path, units: usize) {
     let start = Instant::now();
@@ -734,13 +745,8 @@ fn a_run_stopped_before_its_first_cell_says_that_nothing_was_kept() {
 
 #[test]
 fn sigint_and_sigterm_stop_a_run_after_its_units_in_flight_and_it_resumes() {
-    let dir = tempfile::tempdir().unwrap();
-    let scene = slow_scene(dir.path());
-    let s = scene.to_str().unwrap();
-    let reference = run_quietly(s, &dir.path().join("reference.h5"));
-    let out = dir.path().join("o.h5");
-    let o = out.to_str().unwrap();
-    let journal = dir.path().join("o.h5.partial.d");
+    let (_dir, scene, reference, out, journal) = slow_run();
+    let (s, o) = (scene.as_str(), out.to_str().unwrap());
     // SIGINT, SIGTERM, and two SIGINTs at once (the second ends the process without
     // waiting); each stop is resumed by the next round, the last one to the end.
     let rounds: [(&[i32], i32, &str); 3] = [
@@ -794,13 +800,8 @@ fn sigint_and_sigterm_stop_a_run_after_its_units_in_flight_and_it_resumes() {
 /// counts it once: the progress never passes the total (it showed 5000/4000 cells).
 #[test]
 fn a_damaged_journal_unit_is_computed_again_and_counted_once() {
-    let dir = tempfile::tempdir().unwrap();
-    let scene = slow_scene(dir.path());
-    let s = scene.to_str().unwrap();
-    let reference = run_quietly(s, &dir.path().join("reference.h5"));
-    let out = dir.path().join("o.h5");
-    let o = out.to_str().unwrap();
-    let journal = dir.path().join("o.h5.partial.d");
+    let (_dir, scene, reference, out, journal) = slow_run();
+    let (s, o) = (scene.as_str(), out.to_str().unwrap());
     let mut child = Command::new(BIN)
         .args(["run", s, "--out", o, "--quiet"])
         .spawn()
