@@ -885,6 +885,9 @@ def cells(
     dims, arrays, coords, places = _broadcast(given, names, outputs,
                                               check=lambda n: _check_memory(n, field_list, options[-1]))
     shape_name, shape = shape, arrays[0].shape
+    if shape_name != "ellipsoid" and "beta" in dims:
+        raise ValueError(f"the dimension 'beta' is named after the ellipsoid's beta, which shape={shape_name!r} "
+                         "does not take: rename the dimension")
     # The input beside α: β, the cut, or none (the disk).
     second = {"ellipsoid": "beta", "disk": None}.get(shape_name, "cut")
     no_second = second is None

@@ -86,6 +86,15 @@ def test_what_a_shape_does_not_take_is_refused(kwargs, error, words):
         ra.cells(0.25, 2.0, 0.7, 1.3, kappa=0.5, energy=2.0, cut=0.5)
 
 
+def test_a_cut_along_a_dimension_named_beta_is_refused():
+    import xarray as xr
+    with pytest.raises(ValueError, match="dimension 'beta'"):
+        ra.cells(0.5, None, 0.5, 0.5, kappa=0.8, energy=2.5, shape="wheel",
+                 cut=xr.DataArray([0.3, 0.5], dims="beta"))
+    ds = ra.cells(0.5, None, 0.5, 0.5, kappa=0.8, energy=2.5, shape="wheel", cut=xr.DataArray([0.3, 0.5], dims="cut"))
+    assert ds.rotation_number.dims[0] == "cut"
+
+
 def test_trajectory_and_diagram_of_an_edged_body_equal_the_commands(tmp_path):
     """`trajectory(shape=…)` gives the table of `rubber-atlas trajectory --shape …` (the same
     values, to the CSV's 17 digits), and `diagram(shape=…)` the JSON of `diagram --json`."""
