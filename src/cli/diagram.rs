@@ -133,6 +133,12 @@ pub(super) fn print_diagram(set: &CriticalSet) {
             digits(c.energy, 12)
         );
     }
+    if set.diagram_type == Some(rubber_atlas::critical::DiagramType::C) && cusps.is_empty() {
+        println!(
+            "  cusp not resolved: sigma_u lies within the sampling (or the spacing of doubles) \
+             of theta = pi/2 at this alpha"
+        );
+    }
     for c in &set.stability_changes_at_kinks {
         println!(
             "  stability changes at the kink theta = {:.12}  kappa = {}  eps = {}",

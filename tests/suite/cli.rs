@@ -974,3 +974,24 @@ fn the_diagram_of_an_edged_body_names_its_shape() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("takes no --beta"));
 }
+
+/// A type (c) body whose cusp the sampled curve does not resolve (α → 0 at β = 1000: σ_u lies
+/// within 1e-18 of π/2) says so instead of a diagram that silently lacks it.
+#[test]
+fn an_unresolved_cusp_is_said() {
+    let o = Command::new(env!("CARGO_BIN_EXE_rubber-atlas"))
+        .args(["diagram", "--alpha", "1e-15", "--beta", "1e3"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success());
+    assert!(
+        text.contains("diagram type (c)") && text.contains("cusp not resolved"),
+        "{text}"
+    );
+    let o = Command::new(env!("CARGO_BIN_EXE_rubber-atlas"))
+        .args(["diagram", "--alpha", "0.5", "--beta", "3"])
+        .output()
+        .unwrap();
+    assert!(!String::from_utf8_lossy(&o.stdout).contains("not resolved"));
+}
