@@ -549,6 +549,22 @@ pub enum AnyBody {
 }
 
 impl AnyBody {
+    /// The validated body of `kind` (None: the ellipsoid), with centre-of-mass offset α,
+    /// `second` = β of the ellipsoid or the cut h of a cut ball (ignored by the disk), and
+    /// mass parameters ν, η.
+    pub fn new(
+        kind: Option<EdgedKind>,
+        alpha: f64,
+        second: f64,
+        nu: f64,
+        eta: f64,
+    ) -> Result<Self> {
+        Ok(match kind {
+            None => AnyBody::Ellipsoid(EllipsoidBody::ellipsoid(alpha, second, nu, eta)?),
+            Some(kind) => AnyBody::Edged(Body::new(EdgedShape::of(kind, alpha, second)?, nu, eta)?),
+        })
+    }
+
     /// The shape's name: `ellipsoid`, `disk`, `truncated_ball` or `wheel`.
     pub fn shape_name(&self) -> &'static str {
         match self {
@@ -566,22 +582,6 @@ impl AnyBody {
                 vec![("alpha", b.shape.alpha)]
             }
             AnyBody::Edged(b) => vec![("alpha", b.shape.alpha), ("cut", b.shape.cut)],
-        }
-    }
-
-    /// ν.
-    pub fn nu(&self) -> f64 {
-        match self {
-            AnyBody::Ellipsoid(b) => b.nu,
-            AnyBody::Edged(b) => b.nu,
-        }
-    }
-
-    /// η.
-    pub fn eta(&self) -> f64 {
-        match self {
-            AnyBody::Ellipsoid(b) => b.eta,
-            AnyBody::Edged(b) => b.eta,
         }
     }
 }

@@ -405,10 +405,10 @@ fn far_out<S: Shape>(
     // Ū ≥ 1: ordinary cells leave here before U is evaluated (this runs for every libration).
     // The limit is derived for bodies smooth up to the poles: not for edged ones.
     if kappa == 0.0
-        || !crate::limits::has_high_energy_limit(&potential.body.shape)
         || component.kind != MotionKind::Libration
         || energy.is_nan()
         || energy < FAR_OUT
+        || !crate::limits::has_high_energy_limit(&potential.body.shape)
     {
         return None;
     }

@@ -299,11 +299,11 @@ impl CriticalSet {
         }
 
         let curve = Curve {
+            body,
             kappa_sq: &|t| fixed_point_kappa_sq(body, t),
             point: &|t| fixed_point(body, t),
             pole_ends: &|pole| body.shape.potential_second(pole) > 0.0,
             extra: theta_star.into_iter().collect(),
-            cusp: &|lo, hi, lo_stable| locate_cusp(body, lo, hi, lo_stable),
         };
         let (mut branches, cusps) = sample_branches(&curve, samples, kappa_max, &stopped)?;
         let cusp = cusps.last().copied();
@@ -345,7 +345,9 @@ impl CriticalSet {
 
 /// How one body's curve of permanent rotations is evaluated: the ellipsoid's closed forms
 /// (`s1`) or any body's ([`general_fixed_point`]).
-struct Curve<'f> {
+struct Curve<'f, S: Shape> {
+    /// The body (its V″ decides the stability, and locates a change of it).
+    body: &'f Body<S>,
     /// κ² at θ0 (< 0: no permanent rotation there).
     kappa_sq: &'f dyn Fn(f64) -> f64,
     /// The permanent rotation at θ0.
@@ -354,16 +356,14 @@ struct Curve<'f> {
     pole_ends: &'f dyn Fn(f64) -> bool,
     /// Angles sampled besides the grid, on the curve (θ*, the kinks of U where κ² ≥ 0).
     extra: Vec<f64>,
-    /// The change of stability between two samples, stable on the first side or not.
-    cusp: &'f dyn Fn(f64, f64, bool) -> Cusp,
 }
 
 /// The branches of `curve` over the halves θ0 < π/2 and θ0 > π/2, each sampled at `samples`
 /// points, truncated at κ ≤ `kappa_max`, and cut into runs of one stability; every change of
 /// stability inside a half is located (a cusp, or a kink of U where V″ jumps), in order.
 /// `stopped(i)` is asked at every sample.
-fn sample_branches(
-    curve: &Curve<'_>,
+fn sample_branches<S: Shape>(
+    curve: &Curve<'_, S>,
     samples: usize,
     kappa_max: f64,
     stopped: &dyn Fn(usize) -> Result<()>,
@@ -404,7 +404,7 @@ fn sample_branches(
                 let contiguous = (p.theta0 - last.theta0) <= 1.5 * (hi - lo) / samples as f64;
                 if last.stable != p.stable || !contiguous {
                     if last.stable != p.stable && contiguous {
-                        let c = (curve.cusp)(last.theta0, p.theta0, last.stable);
+                        let c = locate_cusp(curve, last.theta0, p.theta0, last.stable);
                         cusps.push(c);
                         let at = (curve.point)(c.theta);
                         let mut at_end = at;
@@ -587,33 +587,14 @@ fn make_branch(points: Vec<FixedPoint>, stable_name: &'static str) -> Branch {
 }
 
 /// The zero of V″(θ0) along the fixed-point curve between two samples of opposite stability.
-fn locate_cusp(body: &EllipsoidBody, lo: f64, hi: f64, lo_stable: bool) -> Cusp {
-    locate_cusp_on(
-        body,
-        &|t| fixed_point_kappa_sq(body, t),
-        &|t| fixed_point(body, t),
-        lo,
-        hi,
-        lo_stable,
-    )
-}
-
-/// [`locate_cusp`] on the curve given by `kappa_sq` and `point` (any body).
-fn locate_cusp_on<S: Shape>(
-    body: &Body<S>,
-    kappa_sq: &dyn Fn(f64) -> f64,
-    point: &dyn Fn(f64) -> FixedPoint,
-    lo: f64,
-    hi: f64,
-    lo_stable: bool,
-) -> Cusp {
+fn locate_cusp<S: Shape>(curve: &Curve<'_, S>, lo: f64, hi: f64, lo_stable: bool) -> Cusp {
     let f = |t: f64| {
-        let k2 = kappa_sq(t).max(0.0);
-        ReducedSystem::new(body, k2.sqrt()).effective_potential_second(t)
+        let k2 = (curve.kappa_sq)(t).max(0.0);
+        ReducedSystem::new(curve.body, k2.sqrt()).effective_potential_second(t)
     };
     // V″ > 0 on the stable side.
     let theta = bisect(&f, lo, hi, !lo_stable);
-    let p = point(theta);
+    let p = (curve.point)(theta);
     Cusp {
         theta,
         kappa: p.kappa,
@@ -739,6 +720,7 @@ impl CriticalSet {
         let faces = body.shape.faces();
         let kinks = body.shape.kinks().to_vec();
         let curve = Curve {
+            body,
             kappa_sq: &|t| general_kappa_sq(body, t),
             point: &|t| general_fixed_point(body, t),
             pole_ends: &|pole| {
@@ -753,16 +735,6 @@ impl CriticalSet {
                         && general_fixed_point(body, t).kappa <= kappa_max
                 })
                 .collect(),
-            cusp: &|lo, hi, lo_stable| {
-                locate_cusp_on(
-                    body,
-                    &|t| general_kappa_sq(body, t),
-                    &|t| general_fixed_point(body, t),
-                    lo,
-                    hi,
-                    lo_stable,
-                )
-            },
         };
         let (mut branches, changes) = sample_branches(&curve, samples, kappa_max, &stopped)?;
         // A change of stability at a kink is V″ jumping through 0, not a cusp.

@@ -351,17 +351,7 @@ fn shape_kind(name: &str) -> PyResult<Option<crate::EdgedKind>> {
 
 /// The body of `shape` (`ellipsoid`, or an edged one whose cut is given in `beta`).
 fn any_body(shape: &str, alpha: f64, beta: f64, nu: f64, eta: f64) -> PyResult<AnyBody> {
-    Ok(match shape_kind(shape)? {
-        None => AnyBody::Ellipsoid(body(alpha, beta, nu, eta)?),
-        Some(kind) => AnyBody::Edged(
-            crate::Body::new(
-                crate::EdgedShape::of(kind, alpha, beta).map_err(value_error)?,
-                nu,
-                eta,
-            )
-            .map_err(value_error)?,
-        ),
-    })
+    AnyBody::new(shape_kind(shape)?, alpha, beta, nu, eta).map_err(value_error)
 }
 
 /// The edged bodies of `points`, each with its cut in `beta` (ignored by the disk).

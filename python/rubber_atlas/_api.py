@@ -427,7 +427,7 @@ def _excess_to_energy(alpha: np.ndarray, beta: np.ndarray, nu: np.ndarray, eta: 
     `kappa`/`excess_energy` plane computes it (the Rust core, in parallel)."""
     _first_bad("excess_energy", excess_energy, ~np.isfinite(excess_energy), "must be a finite number")
     arrays = (np.ascontiguousarray(a, dtype=np.float64) for a in (alpha, beta, nu, eta, kappa))
-    bottom = _core.bottoms(*arrays, shape=shape) if shape != "ellipsoid" else _core.bottoms(*arrays)
+    bottom = _core.bottoms(*arrays, shape=shape)
     return bottom + excess_energy
 
 
@@ -483,8 +483,7 @@ def _to_kappa_energy(plane: tuple[str, str], flat: list[np.ndarray], shape: str 
         # Overflows and s² underflowing to 0 give inf, refused below with the inputs named.
         with np.errstate(over="ignore", divide="ignore", under="ignore"):
             return flat[:4] + [a / b, 1.0 / (b * b)]
-    extra = {"shape": shape} if shape != "ellipsoid" else {}
-    return flat[:4] + [a, _excess_to_energy(*flat[:4], a, b, **extra)]
+    return flat[:4] + [a, _excess_to_energy(*flat[:4], a, b, shape=shape)]
 
 
 def _show_bytes(n: float) -> str:
@@ -588,8 +587,7 @@ def _solve_batch(flat: list[np.ndarray], start: int, options: tuple, layout: str
     "layout": …, and for the family layout possibly the component's "flag_values" and
     "flag_meanings"}."""
     try:
-        extra = {"shape": shape} if shape != "ellipsoid" else {}
-        result = _core.cells(*flat, *options, layout=layout, **extra)
+        result = _core.cells(*flat, *options, layout=layout, shape=shape)
     except ValueError as e:
         if start == 0:
             raise

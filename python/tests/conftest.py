@@ -6,6 +6,7 @@ import os
 import subprocess
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -17,6 +18,22 @@ def run(*args) -> str:
     out = subprocess.run([BIN, *map(str, args)], capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
     return out.stdout
+
+
+def same_double(a, b) -> bool:
+    """The same float64, bit for bit."""
+    return np.float64(a).tobytes() == np.float64(b).tobytes()
+
+
+def assert_component_equals(component, expected: dict, keys, where) -> None:
+    """A component of a `cells` result (one cell, one slot) against the object `cell --json`
+    prints for it: each of `keys` bit for bit, JSON null (NaN or an infinity) as a value that
+    is not finite."""
+    for key in keys:
+        if expected[key] is None:
+            assert not np.isfinite(float(component[key])), (where, key)
+        else:
+            assert same_double(component[key], expected[key]), (where, key, float(component[key]), expected[key])
 
 
 SCENE = """name = "{name}"

@@ -16,7 +16,7 @@ import pytest
 import xarray as xr
 
 import rubber_atlas as ra
-from conftest import BIN, ROOT, run
+from conftest import BIN, ROOT, assert_component_equals, run, same_double
 
 COMPONENT_KEYS = ["theta_min", "theta_max", "period", "omega_theta", "omega_psi", "rotation_number",
                   "drift", "drift_radius", "error_estimate"]
@@ -34,10 +34,6 @@ def test_the_package_is_the_installed_one_and_not_the_repository():
 def bits(x) -> np.ndarray:
     """The bytes of an array's values (NaN equal to NaN of the same bits)."""
     return np.atleast_1d(np.asarray(x)).view(np.uint8)
-
-
-def same_double(a, b) -> bool:
-    return np.float64(a).tobytes() == np.float64(b).tobytes()
 
 
 def test_cells_equal_the_cell_command_bit_for_bit_on_random_cells():
@@ -65,11 +61,7 @@ def test_cells_equal_the_cell_command_bit_for_bit_on_random_cells():
         with_motion += bool(expected)
         for slot, e in enumerate(expected):
             c = cell.isel(component=slot)
-            for key in COMPONENT_KEYS:
-                if e[key] is None:  # JSON null: NaN or an infinity
-                    assert not np.isfinite(float(c[key])), (i, key)
-                else:
-                    assert same_double(c[key], e[key]), (i, key, float(c[key]), e[key])
+            assert_component_equals(c, e, COMPONENT_KEYS, i)
             for key, names in flags.items():
                 if key in e:
                     assert names[int(c[key])] == e[key], (i, key)

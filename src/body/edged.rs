@@ -61,6 +61,12 @@ impl Part {
         self.p * a.sin.abs() + self.q * a.cos + self.r
     }
 
+    /// U′ = p sgn(sinθ) cosθ − q sinθ.
+    #[inline]
+    fn slope(&self, a: Angle) -> f64 {
+        self.p * a.sin.signum() * a.cos - self.q * a.sin
+    }
+
     /// U′/sinθ = p cosθ/|sinθ| − q.
     #[inline]
     fn slope_over_sin(&self, a: Angle) -> f64 {
@@ -313,8 +319,7 @@ impl Shape for EdgedShape {
 
     #[inline]
     fn potential_prime_at(&self, a: Angle) -> f64 {
-        let part = self.part(a);
-        part.p * a.sin.signum() * a.cos - part.q * a.sin
+        self.part(a).slope(a)
     }
 
     #[inline]
@@ -330,9 +335,16 @@ impl Shape for EdgedShape {
     /// |r|² = U² + U′².
     #[inline]
     fn contact_distance_sq_at(&self, a: Angle) -> f64 {
-        let u = self.potential_at(a);
-        let up = self.potential_prime_at(a);
-        u * u + up * up
+        self.potential_and_contact_distance_sq_at(a).1
+    }
+
+    /// U and |r|² = U² + U′² from one lookup of the part in contact (the solver's inner loop).
+    #[inline]
+    fn potential_and_contact_distance_sq_at(&self, a: Angle) -> (f64, f64) {
+        let part = self.part(a);
+        let u = part.height(a);
+        let up = part.slope(a);
+        (u, u * u + up * up)
     }
 
     /// (U(x) − U(y)) / sin(x − y) on one part, without cancellation: with d = x − y,

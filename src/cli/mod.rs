@@ -16,7 +16,7 @@ use rubber_atlas::cf::AttrValue;
 use rubber_atlas::error::{show, show_digits as digits, AtlasError};
 use rubber_atlas::machine::{disk_short, memory_short};
 use rubber_atlas::trajectory::Start;
-use rubber_atlas::{AnyBody, Body, EdgedShape, EllipsoidBody};
+use rubber_atlas::{AnyBody, EdgedKind};
 
 use cell::CellArgs;
 use diagram::DiagramArgs;
@@ -222,12 +222,13 @@ impl BodyShapeArgs {
     /// The validated body with mass parameters ν, η; a parameter the shape does not take,
     /// or one it needs and was not given, is refused in one line.
     pub fn body(&self, nu: f64, eta: f64) -> Result<AnyBody> {
-        let name = |kind: ShapeKindArg| {
-            kind.to_possible_value()
-                .map(|v| v.get_name().to_string())
-                .unwrap_or_default()
+        let kind = match self.shape {
+            ShapeKindArg::Ellipsoid => None,
+            ShapeKindArg::Disk => Some(EdgedKind::Disk),
+            ShapeKindArg::TruncatedBall => Some(EdgedKind::TruncatedBall),
+            ShapeKindArg::Wheel => Some(EdgedKind::Wheel),
         };
-        let shape = name(self.shape);
+        let shape = kind.map_or("ellipsoid", |k| k.name());
         let refuse = |what: &str| -> Result<AnyBody> {
             Err(AtlasError::Atlas {
                 path: "options".into(),
@@ -235,32 +236,19 @@ impl BodyShapeArgs {
             }
             .into())
         };
-        match (self.shape, self.beta, self.cut) {
-            (ShapeKindArg::Ellipsoid, None, _) => refuse("--beta is required"),
-            (ShapeKindArg::Ellipsoid, Some(_), Some(_)) | (ShapeKindArg::Disk, _, Some(_)) => {
-                refuse("takes no --cut (only truncated_ball and wheel do)")
+        // β for the ellipsoid, the cut for the cut balls, nothing for the disk.
+        let second = match (kind, self.beta, self.cut) {
+            (None, None, _) => return refuse("--beta is required"),
+            (None, Some(_), Some(_)) | (Some(EdgedKind::Disk), _, Some(_)) => {
+                return refuse("takes no --cut (only truncated_ball and wheel do)")
             }
-            (ShapeKindArg::Ellipsoid, Some(beta), None) => Ok(AnyBody::Ellipsoid(
-                EllipsoidBody::ellipsoid(self.alpha, beta, nu, eta)?,
-            )),
-            (_, Some(_), _) => refuse("takes no --beta (only the ellipsoid does)"),
-            (ShapeKindArg::Disk, None, None) => Ok(AnyBody::Edged(Body::new(
-                EdgedShape::disk(self.alpha)?,
-                nu,
-                eta,
-            )?)),
-            (_, None, None) => refuse("--cut is required"),
-            (ShapeKindArg::TruncatedBall, None, Some(cut)) => Ok(AnyBody::Edged(Body::new(
-                EdgedShape::truncated_ball(self.alpha, cut)?,
-                nu,
-                eta,
-            )?)),
-            (ShapeKindArg::Wheel, None, Some(cut)) => Ok(AnyBody::Edged(Body::new(
-                EdgedShape::wheel(self.alpha, cut)?,
-                nu,
-                eta,
-            )?)),
-        }
+            (None, Some(beta), None) => beta,
+            (Some(_), Some(_), _) => return refuse("takes no --beta (only the ellipsoid does)"),
+            (Some(EdgedKind::Disk), None, None) => 0.0,
+            (Some(_), None, None) => return refuse("--cut is required"),
+            (Some(_), None, Some(cut)) => cut,
+        };
+        Ok(AnyBody::new(kind, self.alpha, second, nu, eta)?)
     }
 }
 
