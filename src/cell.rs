@@ -120,6 +120,10 @@ pub struct ErrorEstimates {
     pub rotation_number: f64,
     pub drift: f64,
     pub drift_radius: f64,
+    /// Of each part of `drift_vector`: the drift's error plus the turn of the path by ψ's
+    /// error (the path's size times the ψ advance's error; far out on ε, where the limit's N
+    /// replaced the quadrature's, also times how far the quadrature's advance is off).
+    pub drift_vector: f64,
 }
 
 /// The values of one component (one invariant torus).
@@ -236,6 +240,7 @@ pub fn solve_high_energy_limit<S: Shape>(
             rotation_number: n.error,
             drift: f64::NAN,
             drift_radius: f64::NAN,
+            drift_vector: f64::NAN,
         },
         drift_vector: [f64::NAN; 2],
         work: 0,
@@ -263,7 +268,7 @@ pub fn solve_cell<S: Shape>(
     energy: f64,
     options: &CellOptions,
 ) -> Result<CellResult> {
-    crate::error::check_range("kappa", kappa, None, None, "must be finite")?;
+    crate::error::check_kappa(kappa)?;
     crate::error::check_range("energy", energy, None, None, "must be finite")?;
     options.validate()?;
     options.check_for(body)?;
@@ -682,10 +687,22 @@ fn finish(
     let planar = component.kind == MotionKind::Libration
         && raw.psi_advance == 0.0
         && raw.psi_advance_error == 0.0;
-    let (drift, drift_error, drift_vector) = match raw.drift {
-        Some(_) if planar => (0.0, 0.0, [0.0, 0.0]),
-        Some(d) => (d.value[0].hypot(d.value[1]), d.error, d.value),
-        None => (f64::NAN, f64::NAN, [f64::NAN; 2]),
+    // The ψ that turns every node of the drift integral is known to the ψ advance's error
+    // (|Δζ| is changed by a turn only to second order: its error leaves this out). Where the
+    // limit's N replaced the quadrature's, that ψ is off by as much as its advance is off from
+    // the limit's.
+    let turn = far_out.map_or(0.0, |limit| {
+        (raw.psi_advance + TAU * limit.value).abs() + TAU * limit.error
+    });
+    let (drift, drift_error, drift_vector, drift_vector_error) = match raw.drift {
+        Some(_) if planar => (0.0, 0.0, [0.0, 0.0], 0.0),
+        Some(d) => (
+            d.value[0].hypot(d.value[1]),
+            d.error,
+            d.value,
+            d.error + (raw.psi_advance_error + turn) * d.scale,
+        ),
+        None => (f64::NAN, f64::NAN, [f64::NAN; 2], f64::NAN),
     };
     let (drift_radius, radius_error) = drift_radius(drift, drift_error, n, n_err);
     let bounded = raw.drift.and_then(|d| {
@@ -711,6 +728,7 @@ fn finish(
         rotation_number: n_err,
         drift: drift_error,
         drift_radius: radius_error,
+        drift_vector: drift_vector_error,
     };
     let drift_ok = planar
         || raw
@@ -793,6 +811,7 @@ fn unresolved(component: &Component) -> ComponentResult {
         rotation_number: f64::INFINITY,
         drift: f64::INFINITY,
         drift_radius: f64::INFINITY,
+        drift_vector: f64::NAN,
     };
     ComponentResult {
         theta_min: component.theta_min(),
@@ -906,6 +925,7 @@ fn on_separatrix<S: Shape>(
             rotation_number: 0.0,
             drift: f64::NAN,
             drift_radius: f64::NAN,
+            drift_vector: f64::NAN,
         },
         drift_vector: [f64::NAN; 2],
         work: 0,
@@ -966,6 +986,7 @@ fn fixed_point<S: Shape>(
             rotation_number: rel * n.abs(),
             drift: rel * drift,
             drift_radius: rel * radius,
+            drift_vector: f64::NAN,
         },
         drift_vector: [f64::NAN; 2],
         work: 0,

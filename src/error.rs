@@ -112,6 +112,30 @@ pub fn show_digits(value: f64, digits: usize) -> String {
     }
 }
 
+/// The largest |κ| any surface takes: κ² (and κ²/sin²θ near the poles) stays far from overflow.
+pub const MAX_KAPPA: f64 = 1e150;
+
+/// Refuses a κ that is not finite, above [`MAX_KAPPA`] in size, or subnormal (0 < |κ| <
+/// 2.2e-308: κ² underflows to 0 while the turning points next to the poles, at about κ/√(2ε),
+/// have no normal double left to be found at).
+pub(crate) fn check_kappa(kappa: f64) -> Result<f64> {
+    check_range(
+        "kappa",
+        kappa,
+        Some((-MAX_KAPPA, true)),
+        Some((MAX_KAPPA, true)),
+        "|kappa| must be at most 1e150 (kappa^2 would overflow)",
+    )?;
+    if kappa != 0.0 && kappa.abs() < f64::MIN_POSITIVE {
+        return Err(AtlasError::InvalidParameter {
+            name: "kappa",
+            value: kappa,
+            reason: "is subnormal: give 0 or |kappa| >= 2.2e-308",
+        });
+    }
+    Ok(kappa)
+}
+
 /// Shorthand for results of this crate.
 pub type Result<T> = std::result::Result<T, AtlasError>;
 

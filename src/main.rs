@@ -1,7 +1,7 @@
 //! The `rubber-atlas` command: parses the command line (see [`cli`]), runs it, and maps the
 //! outcome to an exit code: 0 success, 2 bad input (one line naming the bad value), 1 a
-//! computation that failed, 75 an output another process is writing, 130 / 143 a run
-//! stopped by SIGINT / SIGTERM (its journal kept for --resume).
+//! computation that failed, 75 an output another process is writing, 130 / 143 / 129 a
+//! command stopped by SIGINT / SIGTERM / SIGHUP (a run's journal kept for --resume).
 
 mod cli;
 mod progress;
@@ -62,6 +62,20 @@ fn main() -> ExitCode {
     };
     match cli::run(args) {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e)
+            if e.chain().any(|c| {
+                matches!(
+                    c.downcast_ref::<rubber_atlas::AtlasError>(),
+                    Some(rubber_atlas::AtlasError::Stopped)
+                )
+            }) =>
+        {
+            let (signal, status) = stop::received();
+            eprintln!(
+                "rubber-atlas: stopped by {signal} before the work was done; nothing was written"
+            );
+            ExitCode::from(status)
+        }
         Err(e) => {
             eprintln!("error: {}", one_line(&format!("{e:#}")));
             if e.chain().any(|c| {

@@ -3,7 +3,7 @@
 //! value and names the file, the key and the reason of the first problem it finds.
 
 use crate::cell::{CellOptions, Method};
-use crate::error::{show, AtlasError, Result};
+use crate::error::{show, AtlasError, Result, MAX_KAPPA};
 use crate::family::Layout;
 use crate::EllipsoidBody;
 use std::path::Path;
@@ -120,8 +120,6 @@ impl Axis {
     }
 }
 
-/// The largest |κ| of a cell: κ² (in V) stays finite with room to spare.
-const MAX_KAPPA: f64 = 1e150;
 /// The smallest s > 0 of a compactified plane: ε = 1/s² ≤ 1e300.
 const MIN_S: f64 = 1e-150;
 
@@ -492,6 +490,29 @@ impl Scene {
                 format!(
                     "{} is above {MAX_KAPPA:e} (kappa^2 would overflow)",
                     show(largest(&kappa))
+                ),
+            ));
+        }
+        // The smallest |κ| > 0 of a cell: κ itself, or λ/s at the largest s.
+        let least_kappa = if plane == Plane::Compact {
+            smallest_positive(&kappa) / largest(&energy)
+        } else {
+            kappa
+                .values
+                .iter()
+                .filter(|v| **v != 0.0)
+                .fold(f64::INFINITY, |m, v| m.min(v.abs()))
+        };
+        if least_kappa < f64::MIN_POSITIVE {
+            return Err(reader.error(
+                if plane == Plane::Compact {
+                    "axes.lambda"
+                } else {
+                    "axes.kappa"
+                },
+                format!(
+                    "a cell has kappa = {}, subnormal: give 0 or |kappa| >= 2.2e-308",
+                    show(least_kappa)
                 ),
             ));
         }

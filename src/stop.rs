@@ -1,7 +1,8 @@
-//! SIGINT, SIGTERM and SIGHUP during `run`: the first asks the run to stop once the units in
-//! flight are in the journal (see [`rubber_atlas::sweep::Progress::interrupted`]); a second
-//! ends the process at once, with one line saying how to continue. Either way a resumed run
-//! continues from the journal.
+//! SIGINT, SIGTERM and SIGHUP during `run` and the other long commands (`trajectory`,
+//! `diagram`, `resonance`, `verdict`): the first asks the work to stop (a run once the units in
+//! flight are in the journal, see [`rubber_atlas::sweep::Progress::interrupted`]; the others
+//! at their next check, writing nothing); a second ends the process at once, with one line
+//! saying what is kept.
 
 use signal_hook::consts::signal::{SIGHUP, SIGINT, SIGTERM};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -13,16 +14,11 @@ static SIGNAL: AtomicUsize = AtomicUsize::new(0);
 /// allocate).
 static AT_ONCE: OnceLock<Vec<u8>> = OnceLock::new();
 
-/// Installs the handlers (once, before the work starts); `resume` is the command that
-/// continues the run.
-pub fn install(resume: &str) -> std::io::Result<()> {
-    let _ = AT_ONCE.set(
-        format!(
-            "rubber-atlas: stopped at once by a second signal; the units finished so far are \
-             kept; continue with: {resume}\n"
-        )
-        .into_bytes(),
-    );
+/// Installs the handlers (once, before the work starts); `kept` says what a second signal
+/// leaves behind (for a run: the units finished so far, and the command that continues it).
+pub fn install(kept: &str) -> std::io::Result<()> {
+    let _ = AT_ONCE
+        .set(format!("rubber-atlas: stopped at once by a second signal; {kept}\n").into_bytes());
     for signal in [SIGINT, SIGTERM, SIGHUP] {
         // The immediate stop must be registered first: it acts only on a signal that finds
         // the run already stopping.

@@ -67,13 +67,7 @@ impl Start {
 
     /// Checks that κ, θ(0) and θ̇(0) are finite, with 0 < θ(0) < π when κ ≠ 0.
     pub fn check(&self) -> Result<()> {
-        if !self.kappa.is_finite() {
-            return Err(AtlasError::InvalidParameter {
-                name: "kappa",
-                value: self.kappa,
-                reason: "must be a finite number",
-            });
-        }
+        crate::error::check_kappa(self.kappa)?;
         let t = self.theta0;
         if !(t.is_finite() && (self.kappa == 0.0 || (t > 0.0 && t < std::f64::consts::PI))) {
             return Err(AtlasError::InvalidInitialAngle {
@@ -193,7 +187,7 @@ pub struct Request {
 impl Request {
     /// The checked start of this request on `body`.
     pub fn start<S: Shape>(&self, body: &Body<S>) -> Result<Start> {
-        crate::error::check_range("kappa", self.kappa, None, None, "must be a finite number")?;
+        crate::error::check_kappa(self.kappa)?;
         match self.start {
             StartAt::Energy { energy, component } => {
                 crate::error::check_range("energy", energy, None, None, "must be a finite number")?;

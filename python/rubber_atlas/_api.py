@@ -729,7 +729,8 @@ def cells(
         η = m b3²/i1 > 0.
     kappa : float, array_like or xarray.DataArray, optional
         κ, the value of the linear integral F2 = J(θ) ω3 (its sign is the direction of
-        rolling), any real number up to 1e150 in size; with `energy` or `excess_energy`.
+        rolling), 0 or any real number from 2.2e-308 (the least normal double) up to 1e150 in
+        size; with `energy` or `excess_energy`.
     energy : float, array_like or xarray.DataArray, optional
         ε, the energy in units of m g b3, any real number (below the bottom of V there is
         no motion).
@@ -738,8 +739,8 @@ def cells(
         `energy` (the bottom is found by the Rust core, as an atlas's
         ``kappa``/``excess_energy`` plane finds it).
     lambda_ : float, array_like or xarray.DataArray, optional
-        λ = κ/√ε, finite; with `s` instead of `kappa` and `energy` (κ = λ/s). Motion at high
-        energy needs λ ≤ √2.
+        λ = κ/√ε, finite; with `s` instead of `kappa` and `energy` (κ = λ/s, so λ/s is held to
+        κ's range). Motion at high energy needs λ ≤ √2.
     s : float, array_like or xarray.DataArray, optional
         s = 1/√ε > 0 (ε = 1/s²). s = 0, the high-energy limit ε = ∞, is refused for now.
     tol : float, default 1e-10

@@ -353,3 +353,11 @@ def test_third_round_findings_are_refused_in_one_line():
     # The trajectory says how well it kept the energy.
     t = ra.trajectory(*BODY, kappa=0.8, energy=2.5, periods=1, samples=10)
     assert 0 <= t.attrs["energy_drift"] < 1e-10
+
+
+def test_fourth_round_kappa_is_held_to_one_range_everywhere():
+    """Issue 22: lambda_/s reached kappa = 1.2e150, which scenes refuse; a subnormal kappa gave NaN."""
+    refused(ValueError, lambda: ra.cells(*BODY, lambda_=1.2, s=1e-150, progress=False), "kappa", "lambda_", "1e150")
+    refused(ValueError, lambda: ra.cells(*BODY, kappa=[0.5, 1e-310], energy=2.5, progress=False), "kappa[1]",
+            "subnormal")
+    refused(ValueError, lambda: ra.trajectory(*BODY, kappa=-5e-324, energy=2.5, periods=1), "kappa", "subnormal")

@@ -213,6 +213,8 @@ LONG_CALLS = {
     "boundaries": "ra.boundaries(0.5, 0.5, 0.5, beta_min=0.05, beta_max=50, scan=200)",
     # About 15 s each on one core; they ran to the end under Ctrl-C.
     "trajectory": "ra.trajectory(0.5, 3.0, 0.5, 0.5, kappa=0.8, energy=2.5, t_end=1e6, model='full')",
+    # A billion periods of the reduced model (issue 22: not tried before).
+    "trajectory_reduced": "ra.trajectory(0.5, 3.0, 0.5, 0.5, kappa=0.8, energy=2.5, periods=1e9, samples=100)",
     "resonance": "ra.resonance(0.5, 3.0, 0.5, 0.5, '-1/7', grid=400)",
     # 48 s; a SIGINT in the first call became a Rust panic.
     "diagram": "ra.diagram(0.5, 3.0, samples=50_000_000)",

@@ -52,9 +52,11 @@ pub(super) fn diagram(args: DiagramArgs) -> Result<()> {
         &|| "use fewer --samples".into(),
     )?;
     let set = match args.shape.body(args.nu, args.eta)? {
-        AnyBody::Ellipsoid(body) => CriticalSet::of(&body, args.samples, args.kappa_max)?,
+        AnyBody::Ellipsoid(body) => {
+            CriticalSet::of_until(&body, args.samples, args.kappa_max, &crate::stop::requested)?
+        }
         AnyBody::Edged(body) => {
-            CriticalSet::of_edged(&body, args.samples, args.kappa_max, &|| false)?
+            CriticalSet::of_edged(&body, args.samples, args.kappa_max, &crate::stop::requested)?
         }
     };
     if args.json {

@@ -285,6 +285,15 @@ pub enum ModelArg {
 
 /// Runs one parsed command line.
 pub fn run(cli: Cli) -> Result<()> {
+    // The long commands stop at their next check on SIGINT, SIGTERM or SIGHUP, writing
+    // nothing (`run` installs its own handlers, which keep its journal).
+    if matches!(
+        cli.command,
+        Command::Diagram(_) | Command::Trajectory(_) | Command::Resonance(_) | Command::Verdict(_)
+    ) {
+        crate::stop::install("nothing was written")
+            .context("cannot install the SIGINT and SIGTERM handlers")?;
+    }
     match cli.command {
         Command::Diagram(args) => diagram::diagram(args),
         Command::Trajectory(args) => trajectory::trajectory(args),

@@ -132,7 +132,7 @@ pub(super) fn resonance(args: ResonanceArgs) -> Result<()> {
         println!("{}", serde_json::to_string_pretty(&value)?);
         return Ok(());
     }
-    let curves = resonance::trace_curves(&body, &options)?;
+    let curves = resonance::trace_curves_until(&body, &options, &crate::stop::requested)?;
     if args.json {
         let mut value = header;
         value["curves"] = serde_json::to_value(&curves)?;

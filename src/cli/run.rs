@@ -170,7 +170,10 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
         shell_quote(&args.scene.display().to_string()),
         shell_quote(&out.display().to_string()),
     );
-    crate::stop::install(&resume).context("cannot install the SIGINT and SIGTERM handlers")?;
+    crate::stop::install(&format!(
+        "the units finished so far are kept; continue with: {resume}"
+    ))
+    .context("cannot install the SIGINT and SIGTERM handlers")?;
     let reporter = Reporter::new(args.quiet, &scene.name);
     let summary = match sweep::run(&scene, &request, &reporter) {
         Err(AtlasError::Interrupted { done, total, .. }) => {

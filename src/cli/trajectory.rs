@@ -92,7 +92,7 @@ pub(super) fn trajectory(args: TrajectoryArgs) -> Result<()> {
         tol: args.tol,
     };
     let (start, traj, energy) = rubber_atlas::with_body!(&body, b => request
-        .run(b)
+        .run_until(b, &crate::stop::requested)
         .map(|(start, traj)| (start, traj, start.energy(b))))?;
     let (tol, t_end) = (args.tol, traj.t.last().copied().unwrap_or(0.0));
     let mut table = rubber_atlas::table::trajectory(&traj);

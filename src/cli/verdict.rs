@@ -94,7 +94,7 @@ pub(super) fn verdict(args: VerdictArgs) -> Result<()> {
                 scan: args.scan.unwrap_or(defaults.scan),
                 verdict: options,
             },
-            &|| false,
+            &crate::stop::requested,
             &|at| {
                 let (message, done, of) = match at {
                     verdict::BoundarySearch::Scanned { done, of } => {
@@ -155,7 +155,7 @@ pub(super) fn verdict(args: VerdictArgs) -> Result<()> {
         coarse_first: true,
         ..options
     };
-    let v = verdict::verdict(&body, &options)?;
+    let v = verdict::verdict_until(&body, &options, &crate::stop::requested)?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());

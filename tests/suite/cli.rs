@@ -995,3 +995,74 @@ fn an_unresolved_cusp_is_said() {
         .unwrap();
     assert!(!String::from_utf8_lossy(&o.stdout).contains("not resolved"));
 }
+
+/// SIGINT, SIGTERM and SIGHUP stop the long commands at their next check (they ended
+/// silently), with one line, the shell's status for the signal and no file written.
+#[test]
+fn the_long_commands_stop_on_a_signal_in_one_line_writing_nothing() {
+    use std::process::Stdio;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("t.csv");
+    let body = ["--alpha", "0.5", "--nu", "0.5", "--eta", "0.5"];
+    let commands: [(Vec<&str>, i32, i32); 3] = [
+        (
+            vec![
+                "trajectory",
+                "--beta",
+                "3",
+                "--kappa",
+                "0.8",
+                "--energy",
+                "2.5",
+                "--periods",
+                "1e8",
+                "--samples",
+                "100",
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            libc::SIGINT,
+            130,
+        ),
+        (vec!["verdict", "--boundaries"], libc::SIGTERM, 143),
+        (
+            vec![
+                "diagram",
+                "--beta",
+                "3",
+                "--samples",
+                "50000000",
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            libc::SIGHUP,
+            129,
+        ),
+    ];
+    for (args, signal, code) in commands {
+        let child = Command::new(env!("CARGO_BIN_EXE_rubber-atlas"))
+            .args(&args)
+            .args(body)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(700));
+        let asked = std::time::Instant::now();
+        // SAFETY: a signal to our own child process.
+        unsafe { libc::kill(child.id() as i32, signal) };
+        let output = child.wait_with_output().unwrap();
+        let waited = asked.elapsed();
+        let text = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(code), "{args:?}: {text}");
+        assert!(text.contains("stopped by SIG"), "{args:?}: {text}");
+        assert!(text.contains("nothing was written"), "{args:?}: {text}");
+        assert_eq!(text.lines().count(), 1, "{args:?}: {text}");
+        assert!(output.stdout.is_empty(), "{args:?}");
+        assert!(
+            std::fs::read_dir(dir.path()).unwrap().next().is_none(),
+            "{args:?}"
+        );
+        assert!(waited.as_secs_f64() < 10.0, "{args:?}: {waited:?}");
+    }
+}

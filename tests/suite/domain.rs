@@ -74,6 +74,26 @@ fn check_answer(alpha: f64, beta: f64, nu: f64, eta: f64, kappa: f64, energy: f6
         if c.drift_radius.is_finite() {
             assert!(c.errors.drift_radius >= 0.0, "no bound on R: {at}");
         }
+        // A libration's way back mirrors its way out, so Δζ = −2 e^{iΔψ/2} Re(e^{−iΔψ/2} A)
+        // (A the way out's integral) lies on the line of e^{iΔψ/2} = e^{−iπN}: the vector's
+        // direction (from the drift integral) within its error of N's (from the ψ integral, or
+        // far out the high-energy limit's). Far out it was 1e8 times its error off.
+        let d = c.drift;
+        if c.motion == MotionKind::Libration
+            && d.is_finite()
+            && c.errors.rotation_number < 1e-3
+            && c.errors.drift_vector.is_finite()
+        {
+            let (s, co) = (std::f64::consts::PI * c.rotation_number).sin_cos();
+            let off = (c.drift_vector[0] * s + c.drift_vector[1] * co).abs();
+            let bound = std::f64::consts::SQRT_2 * c.errors.drift_vector
+                + d * std::f64::consts::PI * c.errors.rotation_number
+                + 16.0 * f64::EPSILON * d;
+            assert!(
+                off <= bound,
+                "drift vector {off:e} off its line (bound {bound:e}): {at}"
+            );
+        }
         if c.status == Status::Ok {
             assert!(
                 c.rotation_number.is_finite() && c.period.is_finite() && c.period > 0.0,
@@ -188,13 +208,22 @@ fn the_cells_issue_22_found_answer_honestly() {
     let c = one(0.8, 1e100);
     assert!(c.errors.rotation_number < 1e-50, "{c:?}");
     assert_eq!(c.bounded, None, "{c:?}");
-    // 0 < |κ| down to the least subnormal has motion (κ² underflows: it was `no_motion`);
-    // where N is unknown to ±1/2 the path's fate is too.
-    for kappa in [1e-100, 2.3e-308, 1e-310, 5e-324, -5e-324] {
+    // 0 < |κ| down to the least normal double has motion (κ² underflows: it was
+    // `no_motion`); where N is unknown to ±1/2 the path's fate is too.
+    for kappa in [1e-100, 2.3e-308, -2.3e-308] {
         let cell = solve_cell(&body, kappa, 2.5, &options).unwrap();
         assert_eq!(cell.status, Status::Ok, "{kappa:e}: {cell:?}");
         assert_eq!(cell.components.len(), 2, "{kappa:e}: {cell:?}");
         check_answer(0.5, 3.0, 0.5, 0.5, kappa, 2.5);
+    }
+    // A subnormal κ gave every value NaN, and κ above 1e150 (which scenes refuse) was taken
+    // by `cell`: both are refused, naming κ.
+    for kappa in [1e-310, 5e-324, -5e-324, 2e150, -1e151] {
+        let refused = solve_cell(&body, kappa, 1e301, &options).unwrap_err();
+        assert!(
+            matches!(refused, AtlasError::InvalidParameter { name: "kappa", .. }),
+            "{kappa:e}: {refused}"
+        );
     }
 }
 
