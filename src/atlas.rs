@@ -464,14 +464,22 @@ impl Block {
     }
 }
 
-/// A work unit: rows `rows` of κ of the slice (α_{ia}, β_{ib}).
+/// A work unit: rows `rows` of κ of the slices (α_{ia}, β_{ib}) for ib in `betas` (several
+/// β only where a slice is smaller than a unit, and then with every row).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Unit {
     /// Position in [`units`].
     pub index: usize,
     pub alpha_index: usize,
-    pub beta_index: usize,
+    pub betas: Range<usize>,
     pub rows: Range<usize>,
+}
+
+impl Unit {
+    /// The unit's cells in a grid of `columns` ε values.
+    pub fn cells(&self, columns: usize) -> usize {
+        self.betas.len() * self.rows.len() * columns
+    }
 }
 
 /// κ-rows per work unit: about [`UNIT_CELLS`] cells. A unit is also one chunk of the file.
@@ -480,25 +488,45 @@ pub fn rows_per_unit(shape: [usize; 4]) -> usize {
     UNIT_CELLS.div_ceil(ne.max(1)).clamp(1, nk.max(1))
 }
 
-/// The number of work units of a grid of shape `shape` (see [`unit`]).
-pub fn unit_count(shape: [usize; 4]) -> usize {
-    let [na, nb, nk, _] = shape;
-    na * nb * nk.div_ceil(rows_per_unit(shape))
+/// β values per work unit: 1, or where a whole slice is under [`SMALL_SLICE`] cells as many
+/// slices as make [`UNIT_CELLS`] (a grid of one-cell slices wrote a chunk and a journal file
+/// per cell: 2 kB of file and 200 µs a cell).
+pub fn betas_per_unit(shape: [usize; 4]) -> usize {
+    let [_, nb, nk, ne] = shape;
+    let slice = nk.max(1) * ne.max(1);
+    if slice >= SMALL_SLICE {
+        return 1;
+    }
+    (UNIT_CELLS / slice).clamp(1, nb.max(1))
 }
 
-/// Work unit `index` of the grid's units, slice after slice (α slowest), each of about
-/// [`UNIT_CELLS`] cells (whole κ-rows). The split depends on the grid alone, never on
-/// threads or shards. Made on demand: a grid of many small slices has many units.
+/// Slices of fewer cells are grouped into units of several β ([`betas_per_unit`]); larger
+/// ones keep one slice a unit, so that shards can still split β (and the files of earlier
+/// builds keep their chunks).
+const SMALL_SLICE: usize = UNIT_CELLS / 16;
+
+/// The number of work units of a grid of shape `shape` (see [`unit`]).
+pub fn unit_count(shape: [usize; 4]) -> usize {
+    let [na, _, nk, _] = shape;
+    na * Region::positions(shape)[1] * nk.div_ceil(rows_per_unit(shape))
+}
+
+/// Work unit `index` of the grid's units, group of slices after group (α slowest), each of
+/// about [`UNIT_CELLS`] cells (whole κ-rows of one slice, or whole slices of consecutive β).
+/// The split depends on the grid alone, never on threads or shards. Made on demand: a grid
+/// of many slices has many units.
 pub fn unit(shape: [usize; 4], index: usize) -> Unit {
     let [_, nb, nk, _] = shape;
     let rows_per_unit = rows_per_unit(shape);
-    let per_slice = nk.div_ceil(rows_per_unit);
-    let (slice, block) = (index / per_slice, index % per_slice);
-    let start = block * rows_per_unit;
+    let betas_per_unit = betas_per_unit(shape);
+    let per_group = nk.div_ceil(rows_per_unit);
+    let groups = nb.div_ceil(betas_per_unit);
+    let (group, block) = (index / per_group, index % per_group);
+    let (start, first_beta) = (block * rows_per_unit, (group % groups) * betas_per_unit);
     Unit {
         index,
-        alpha_index: slice / nb,
-        beta_index: slice % nb,
+        alpha_index: group / groups,
+        betas: first_beta..(first_beta + betas_per_unit).min(nb),
         rows: start..(start + rows_per_unit).min(nk),
     }
 }
@@ -611,11 +639,11 @@ impl Shard {
             let at = |i: usize| (lengths[axis] as u128 * i as u128 / counts[axis] as u128) as usize;
             ranges[axis] = at(i)..at(i + 1);
         }
-        let rows = rows_per_unit(shape);
-        let [alpha, beta, blocks] = ranges;
+        let (rows, betas) = (rows_per_unit(shape), betas_per_unit(shape));
+        let [alpha, groups, blocks] = ranges;
         Region {
             alpha,
-            beta,
+            beta: groups.start * betas..(groups.end * betas).min(shape[1]),
             rows: blocks.start * rows..(blocks.end * rows).min(shape[2]),
             columns: shape[3],
         }
@@ -625,15 +653,16 @@ impl Shard {
     pub fn units(&self, shape: [usize; 4]) -> impl Iterator<Item = Unit> {
         let region = self.region(shape);
         let rows_per_unit = rows_per_unit(shape);
-        let per_slice = shape[2].div_ceil(rows_per_unit);
+        let per_group = shape[2].div_ceil(rows_per_unit);
         let blocks = region.rows.start / rows_per_unit..region.rows.end.div_ceil(rows_per_unit);
-        let nb = shape[1];
+        let groups = region.groups(shape);
+        let per_alpha = Region::positions(shape)[1];
         region.alpha.clone().flat_map(move |ia| {
             let blocks = blocks.clone();
-            region.beta.clone().flat_map(move |ib| {
+            groups.clone().flat_map(move |g| {
                 blocks
                     .clone()
-                    .map(move |b| unit(shape, (ia * nb + ib) * per_slice + b))
+                    .map(move |b| unit(shape, (ia * per_alpha + g) * per_group + b))
             })
         })
     }
@@ -700,32 +729,52 @@ impl Region {
         ]
     }
 
-    /// κ-rows per chunk of a file of this region of a grid of shape `grid`: a work unit's
-    /// (each unit is one chunk), or fewer where the region has fewer rows (a chunk may not
+    /// (β, κ-rows) per chunk of a file of this region of a grid of shape `grid`: a work
+    /// unit's (each unit is one chunk), or fewer where the region has fewer (a chunk may not
     /// be larger than its dataset).
-    pub fn chunk_rows(&self, grid: [usize; 4]) -> usize {
-        rows_per_unit(grid).min(self.rows.len()).max(1)
+    pub fn chunk(&self, grid: [usize; 4]) -> [usize; 2] {
+        [
+            betas_per_unit(grid).min(self.beta.len()).max(1),
+            rows_per_unit(grid).min(self.rows.len()).max(1),
+        ]
+    }
+
+    /// Cells per chunk of every variable ([`Region::chunk`]).
+    pub fn chunk_cells(&self, grid: [usize; 4]) -> usize {
+        let [betas, rows] = self.chunk(grid);
+        betas * rows * self.columns
+    }
+
+    /// The groups of β (of [`betas_per_unit`] each) this region spans.
+    fn groups(&self, grid: [usize; 4]) -> Range<usize> {
+        let betas = betas_per_unit(grid);
+        self.beta.start / betas..self.beta.end.div_ceil(betas)
     }
 
     /// The work units in this region of a grid of shape `grid`.
     pub fn unit_count(&self, grid: [usize; 4]) -> usize {
         let rows_per_unit = rows_per_unit(grid);
         let blocks = self.rows.end.div_ceil(rows_per_unit) - self.rows.start / rows_per_unit;
-        self.alpha.len() * self.beta.len() * blocks
+        self.alpha.len() * self.groups(grid).len() * blocks
     }
 
     /// Whether `unit` lies in this region (units never straddle shards' regions).
     pub fn holds(&self, unit: &Unit) -> bool {
         self.alpha.contains(&unit.alpha_index)
-            && self.beta.contains(&unit.beta_index)
+            && self.beta.contains(&unit.betas.start)
             && self.rows.contains(&unit.rows.start)
     }
 
-    /// The positions shards can split a grid of shape `shape` at: its α values, β values
-    /// and blocks of κ-rows (one work unit each per slice).
+    /// The positions shards can split a grid of shape `shape` at: its α values, groups of β
+    /// values (one each but where slices are small) and blocks of κ-rows (one work unit each
+    /// per group).
     pub fn positions(shape: [usize; 4]) -> [usize; 3] {
         let [na, nb, nk, _] = shape;
-        [na, nb, nk.div_ceil(rows_per_unit(shape))]
+        [
+            na,
+            nb.div_ceil(betas_per_unit(shape)),
+            nk.div_ceil(rows_per_unit(shape)),
+        ]
     }
 }
 
@@ -844,34 +893,36 @@ pub fn component_axis(scene: &Scene, stop: &(dyn Fn() -> bool + Sync)) -> Compon
     ComponentAxis::of(scene.layout, &census(scene, stop))
 }
 
-/// Computes the κ-rows `rows` (in that order) of slice (ia, ib), rows shared out by rayon one
-/// at a time (rows differ several-fold in cost), into the slots of `axis`; `progress` is
-/// called with the number of cells after each row. Every cell is computed on its own, so
-/// the values do not depend on the number of threads or on which rows are computed
-/// together.
+/// Computes the κ-rows `rows` (in that order) of the slices (ia, ib), ib in `betas` (β
+/// slowest), rows shared out by rayon one at a time (rows differ several-fold in cost), into
+/// the slots of `axis`; `progress` is called with the number of cells after each row. Every
+/// cell is computed on its own, so the values do not depend on the number of threads or on
+/// which rows are computed together.
 pub fn compute_rows(
     scene: &Scene,
     variables: &[Variable],
     axis: &ComponentAxis,
     alpha_index: usize,
-    beta_index: usize,
+    betas: Range<usize>,
     rows: &[usize],
     progress: &(dyn Fn(usize) + Sync),
 ) -> Block {
-    let body = scene.body(alpha_index, beta_index);
+    let bodies: Vec<_> = betas.map(|ib| scene.body(alpha_index, ib)).collect();
     let columns = scene.energy.values.len();
     let options = &scene.options;
-    let blocks: Vec<Block> = rows
+    let jobs: Vec<(usize, usize)> = (0..bodies.len())
+        .flat_map(|b| rows.iter().map(move |&row| (b, row)))
+        .collect();
+    let blocks: Vec<Block> = jobs
         .par_iter()
         .with_max_len(1)
-        .map(|&row| {
+        .map(|&(b, row)| {
+            let body = &bodies[b];
             let mut block = Block::empty(variables, columns, axis.len());
-            visit_row(scene, &body, row, |j, point, level| {
+            visit_row(scene, body, row, |j, point, level| {
                 fill_cell(&mut block, variables, axis, j, point, || match level {
                     CellLevel::Level(potential, energy) => solve_level(potential, energy, options),
-                    CellLevel::HighEnergy(lambda) => {
-                        solve_high_energy_limit(&body, lambda, options)
-                    }
+                    CellLevel::HighEnergy(lambda) => solve_high_energy_limit(body, lambda, options),
                 });
             });
             progress(columns);

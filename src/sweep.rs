@@ -210,8 +210,9 @@ pub fn footprint(scene: &Scene, shard: Shard, threads: usize) -> Footprint {
     let shape = scene.shape();
     let [na, nb, nk, ne] = shape.map(|n| n as f64);
     let rows = atlas::rows_per_unit(shape) as f64;
+    let betas = atlas::betas_per_unit(shape) as f64;
     let per_slice = (nk / rows).ceil();
-    let total = na * nb * per_slice;
+    let total = na * (nb / betas).ceil() * per_slice;
     // This shard's share of the units: its box of the layout (the largest one), or all.
     let share = match shard.layout(shape) {
         Some(counts) => Region::positions(shape)
@@ -221,7 +222,7 @@ pub fn footprint(scene: &Scene, shard: Shard, threads: usize) -> Footprint {
             .product(),
         None => total,
     };
-    let unit_cells = rows * ne;
+    let unit_cells = betas * rows * ne;
     // The component axis before its census: at most every slot of the layout.
     let slots = ComponentAxis::full(scene.layout, COMPONENT_SLOTS).len();
     let bytes_per_cell = atlas::scene_variables(scene)
@@ -348,8 +349,8 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
     let variables = atlas::scene_variables(scene);
     let shape = scene.shape();
     let region = request.shard.region(shape);
-    let chunk_rows = region.chunk_rows(shape);
-    let cells_of = |u: &Unit| u.rows.len() * scene.energy.len();
+    let chunk_cells = region.chunk_cells(shape);
+    let cells_of = |u: &Unit| u.cells(scene.energy.len());
     // Units with a file in the journal; each is checked when it is read, below, and computed
     // again if its file turns out damaged.
     let listed = journal.listed_units()?;
@@ -420,13 +421,13 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
                         &variables,
                         &axis,
                         u.alpha_index,
-                        u.beta_index,
+                        u.betas.clone(),
                         &rows,
                         &advance,
                     );
                     let mut part = Summary::default();
                     part.count(&variables, &block);
-                    let chunks = encode_unit(&variables, &block, chunk_rows, scene.energy.len());
+                    let chunks = encode_unit(&variables, &block, chunk_cells);
                     journal.write(u.index, &chunks, &part.words())?;
                     part.cells_computed = block.cells as u64;
                     Ok(Some((chunks, part)))
@@ -591,7 +592,7 @@ pub fn merge(
     }
     let mut attributes = scene_attributes(&scene, Shard::WHOLE, atlas::unit_count(shape));
     let whole = Region::whole(shape);
-    let chunk_rows = whole.chunk_rows(shape);
+    let chunk_cells = whole.chunk_cells(shape);
     // Provenance of the computation: the first shard's program and commit.
     let (_, first_file) = by_index[0].as_ref().unwrap();
     for key in ["program_version", "git_commit"] {
@@ -634,7 +635,7 @@ pub fn merge(
             for u in shard.units(shape) {
                 let block = source.read_unit(&u)?;
                 summary.count(&variables, &block);
-                let encoded = encode_unit(&variables, &block, chunk_rows, scene.energy.len());
+                let encoded = encode_unit(&variables, &block, chunk_cells);
                 file.write_encoded(&u, &encoded)?;
             }
         }
@@ -652,13 +653,14 @@ pub fn merge(
 /// Cells of a batch of small slices: enough work for every thread, little memory.
 const BATCH_CELLS: usize = 1 << 16;
 
-/// `units` in batches computed in parallel and then written: each slice whole (its units
-/// end together), and consecutive slices together until a batch holds [`BATCH_CELLS`] cells.
+/// `units` in batches computed in parallel and then written: each slice (or group of small
+/// slices, [`atlas::betas_per_unit`]) whole, its units ending together, and consecutive ones
+/// together until a batch holds [`BATCH_CELLS`] cells.
 fn batches(
     units: impl Iterator<Item = Unit>,
     shape: [usize; 4],
 ) -> impl Iterator<Item = Vec<Unit>> {
-    let slice_cells = shape[2] * shape[3];
+    let slice_cells = shape[2] * shape[3] * atlas::betas_per_unit(shape);
     let mut units = units.peekable();
     std::iter::from_fn(move || {
         let mut batch: Vec<Unit> = Vec::new();
@@ -666,11 +668,11 @@ fn batches(
         while let Some(u) = units.peek() {
             let new_slice = batch
                 .last()
-                .is_none_or(|b| (b.alpha_index, b.beta_index) != (u.alpha_index, u.beta_index));
+                .is_none_or(|b| (b.alpha_index, &b.betas) != (u.alpha_index, &u.betas));
             if new_slice && !batch.is_empty() && cells + slice_cells > BATCH_CELLS {
                 break;
             }
-            cells += u.rows.len() * shape[3];
+            cells += u.cells(shape[3]);
             batch.push(units.next().expect("peeked"));
         }
         (!batch.is_empty()).then_some(batch)

@@ -949,13 +949,18 @@ def cells(
     return ds
 
 
-def open_atlas(path: str | Path, **kwargs) -> xr.Dataset:
+def open_atlas(path: str | Path, check: bool = False, **kwargs) -> xr.Dataset:
     """Open an atlas written by ``rubber-atlas run`` or ``merge`` (a shard too).
 
     Parameters
     ----------
     path : str or pathlib.Path
         The atlas file (HDF5). An unfinished run's ``*.partial.h5`` is refused.
+    check : bool, default False
+        Read every stored value once, chunk by chunk, before returning, and refuse a file
+        whose values cannot all be read (a corrupted chunk) with a ValueError naming the
+        variable. It reads the whole file (about as long as ``.load()``; its memory stays at
+        one chunk).
     **kwargs
         Passed to `xarray.open_dataset`; ``engine`` defaults to "h5netcdf".
 
@@ -975,7 +980,8 @@ def open_atlas(path: str | Path, **kwargs) -> xr.Dataset:
     ------
     ValueError
         The file is not a complete rubber-atlas atlas (a table, a `cells` result written by
-        xarray, an unfinished run, not HDF5 at all, a folder, missing).
+        xarray, an unfinished run, not HDF5 at all, a folder, missing); with `check`, a value
+        in it cannot be read.
     TypeError
         `path` is not a file's name.
 
@@ -984,8 +990,8 @@ def open_atlas(path: str | Path, **kwargs) -> xr.Dataset:
     The values are read when they are used: a file damaged after it was written (a
     corrupted chunk) opens, and reading the damaged values raises HDF5's OSError ("Can't
     synchronously read data"), from xarray (``.load()``, ``.values``); from the ``.rubber``
-    accessor, a ValueError that names the file as damaged. Checking every value on opening
-    would read the whole file.
+    accessor, a ValueError that names the file as damaged. ``check=True`` finds the damage on
+    opening instead, at the price of reading the whole file.
 
     See Also
     --------
@@ -1015,6 +1021,7 @@ def open_atlas(path: str | Path, **kwargs) -> xr.Dataset:
     path = _file(path)
     if path.name.endswith(".partial.h5"):
         raise ValueError(f"{path}: an unfinished run's file; resume the run with --resume")
+    check = _switch("check", check)
     kwargs.setdefault("engine", "h5netcdf")
     try:
         ds = xr.open_dataset(path, **kwargs)
@@ -1024,7 +1031,34 @@ def open_atlas(path: str | Path, **kwargs) -> xr.Dataset:
         ds.close()
         raise ValueError(f"{path}: not a rubber-atlas atlas (a file of `rubber-atlas run` or `merge` has the "
                          "attributes program and scene and the variable cell_status)")
+    if check:
+        try:
+            _read_every_chunk(path)
+        except ValueError:
+            ds.close()
+            raise
     return ds
+
+
+def _read_every_chunk(path: Path) -> None:
+    """Reads every value of the HDF5 file `path` once, a chunk at a time; a ValueError names
+    the first variable whose values cannot be read."""
+    import h5py
+
+    with h5py.File(path, "r") as f:
+        datasets = []
+        f.visititems(lambda name, item: datasets.append(name) if isinstance(item, h5py.Dataset) else None)
+        for name in datasets:
+            data = f[name]
+            try:
+                if data.chunks is None:
+                    data[()]
+                else:
+                    for block in data.iter_chunks():
+                        data[block]
+            except OSError as e:
+                raise ValueError(f"{path}: the file is damaged: the values of {name!r} cannot be read "
+                                 f"({_one_line(e)}); compute it again") from None
 
 
 def _file(path) -> Path:

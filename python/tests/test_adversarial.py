@@ -302,6 +302,11 @@ def test_a_damaged_atlas_is_named_as_damaged_by_the_accessor(slice_atlas, tmp_pa
         for call in (lambda: atlas.rubber.components(**ATLAS_BODY, kappa=0.5, energy=2.5),
                      lambda: atlas.rubber.plot_slice()):
             refused(ValueError, call, str(damaged), "damaged")
+    # Opened with check=True, the damage is found at once (xarray's .load() raised HDF5's OSError).
+    refused(ValueError, lambda: ra.open_atlas(damaged, check=True), str(damaged), "damaged", "'rotation_number'")
+    with ra.open_atlas(slice_atlas, check=True) as whole:
+        assert whole.rotation_number.load().size > 0
+    refused(TypeError, lambda: ra.open_atlas(slice_atlas, check="yes"), "check")
 
 
 def test_dataarray_coordinates_that_would_be_misread_are_refused():

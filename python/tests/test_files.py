@@ -102,10 +102,11 @@ def test_tables_have_a_dimension_coordinate_and_numeric_attributes(files):
 
 @pytest.mark.parametrize("axes, count", [
     # Shards split alpha and beta (2 x 2), beta (3), and the kappa rows (4 blocks).
-    (dict(alpha="[0.2, 0.5]", beta="[0.8, 3.0]", kappa="{ start = 0.0, stop = 1.5, num = 12 }",
-          energy="{ start = 0.5, stop = 4.0, num = 10 }"), 4),
-    (dict(alpha="[0.5]", beta="[0.5, 1.5, 3.0]", kappa="{ start = 0.0, stop = 1.5, num = 7 }",
-          energy="{ start = 0.5, stop = 4.0, num = 8 }"), 3),
+    # (Slices of at least 256 cells: smaller ones are grouped along beta into one unit.)
+    (dict(alpha="[0.2, 0.5]", beta="[0.8, 3.0]", kappa="{ start = 0.0, stop = 1.5, num = 16 }",
+          energy="{ start = 0.5, stop = 4.0, num = 16 }"), 4),
+    (dict(alpha="[0.5]", beta="[0.5, 1.5, 3.0]", kappa="{ start = 0.0, stop = 1.5, num = 16 }",
+          energy="{ start = 0.5, stop = 4.0, num = 16 }"), 3),
     (dict(alpha="[0.5]", beta="[3.0]", kappa="{ start = 0.0, stop = 2.0, num = 700 }",
           energy="{ start = 0.5, stop = 4.5, num = 24 }"), 4),
 ])

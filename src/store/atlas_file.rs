@@ -144,13 +144,13 @@ impl AtlasFile {
 
         let shape = scene.shape();
         let [na, nb, nk, ne] = region.shape();
-        let rows = region.chunk_rows(shape);
+        let [betas, rows] = region.chunk(shape);
         let mut datasets = Vec::with_capacity(variables.len());
         for v in variables {
             let per_cell = v.kind.per_cell();
             let d = if v.kind == Kind::CellValue {
                 file.new_dataset::<f64>()
-                    .chunk([1, 1, rows, ne])
+                    .chunk([1, betas, rows, ne])
                     .shuffle()
                     .deflate(DEFLATE_LEVEL)
                     .fill_value(f64::NAN)
@@ -165,7 +165,7 @@ impl AtlasFile {
                     0u8
                 };
                 file.new_dataset::<u8>()
-                    .chunk([1, 1, rows, ne])
+                    .chunk([1, betas, rows, ne])
                     .shuffle()
                     .deflate(DEFLATE_LEVEL)
                     .fill_value(fill)
@@ -173,7 +173,7 @@ impl AtlasFile {
                     .create(v.name)?
             } else if v.kind == Kind::Value {
                 file.new_dataset::<f64>()
-                    .chunk([1, 1, rows, ne, slots])
+                    .chunk([1, betas, rows, ne, slots])
                     .shuffle()
                     .deflate(DEFLATE_LEVEL)
                     .fill_value(f64::NAN)
@@ -181,7 +181,7 @@ impl AtlasFile {
                     .create(v.name)?
             } else {
                 file.new_dataset::<u8>()
-                    .chunk([1, 1, rows, ne, slots])
+                    .chunk([1, betas, rows, ne, slots])
                     .shuffle()
                     .deflate(DEFLATE_LEVEL)
                     .fill_value(FLAG_FILL)
@@ -350,7 +350,7 @@ impl AtlasFile {
             let r = &self.region;
             let mut offset = vec![
                 (unit.alpha_index - r.alpha.start) as u64,
-                (unit.beta_index - r.beta.start) as u64,
+                (unit.betas.start - r.beta.start) as u64,
                 (unit.rows.start - r.rows.start) as u64,
                 0,
             ];
@@ -380,39 +380,43 @@ impl AtlasFile {
     /// Reads the values of `unit`.
     pub fn read_unit(&self, unit: &Unit) -> Result<Block> {
         let g = &self.region;
-        let (ia, ib) = (
-            unit.alpha_index - g.alpha.start,
-            unit.beta_index - g.beta.start,
-        );
+        let ia = unit.alpha_index - g.alpha.start;
+        let ib = unit.betas.start - g.beta.start..unit.betas.end - g.beta.start;
         let r = unit.rows.start - g.rows.start..unit.rows.end - g.rows.start;
         let read = || -> hdf5::Result<Block> {
             let mut columns = Vec::with_capacity(self.variables.len());
             for (v, d) in self.variables.iter().zip(&self.datasets) {
                 columns.push(match v.kind {
                     Kind::CellFlag => Column::U8(
-                        d.read_slice::<u8, _, ndarray::Ix2>(s![ia, ib, r.clone(), ..])?
+                        d.read_slice::<u8, _, ndarray::Ix3>(s![ia, ib.clone(), r.clone(), ..])?
                             .into_raw_vec_and_offset()
                             .0,
                     ),
                     Kind::Flag => Column::U8(
-                        d.read_slice::<u8, _, ndarray::Ix3>(s![ia, ib, r.clone(), .., ..])?
+                        d.read_slice::<u8, _, ndarray::Ix4>(s![ia, ib.clone(), r.clone(), .., ..])?
                             .into_raw_vec_and_offset()
                             .0,
                     ),
                     Kind::Value => Column::F64(
-                        d.read_slice::<f64, _, ndarray::Ix3>(s![ia, ib, r.clone(), .., ..])?
-                            .into_raw_vec_and_offset()
-                            .0,
+                        d.read_slice::<f64, _, ndarray::Ix4>(s![
+                            ia,
+                            ib.clone(),
+                            r.clone(),
+                            ..,
+                            ..
+                        ])?
+                        .into_raw_vec_and_offset()
+                        .0,
                     ),
                     Kind::CellValue => Column::F64(
-                        d.read_slice::<f64, _, ndarray::Ix2>(s![ia, ib, r.clone(), ..])?
+                        d.read_slice::<f64, _, ndarray::Ix3>(s![ia, ib.clone(), r.clone(), ..])?
                             .into_raw_vec_and_offset()
                             .0,
                     ),
                 });
             }
             Ok(Block {
-                cells: unit.rows.len() * self.region.columns,
+                cells: unit.cells(self.region.columns),
                 slots: self.axis.len(),
                 columns,
             })
@@ -448,18 +452,12 @@ impl EncodedUnit {
     }
 }
 
-/// Encodes `block`, the values of one unit, as chunks of `chunk_rows` κ-rows of `columns`
-/// cells ([`Region::chunk_rows`]), as HDF5's shuffle and deflate filters would (a unit is
-/// one chunk of every variable). Done in
+/// Encodes `block`, the values of one unit, as chunks of `chunk_cells` cells
+/// ([`Region::chunk_cells`]), as HDF5's shuffle and deflate filters would (a unit is one
+/// chunk of every variable). Done in
 /// the worker threads: HDF5 runs its filters on the one thread that writes, which cost a
 /// 2-thread run a third of its speed.
-pub fn encode_unit(
-    variables: &[Variable],
-    block: &Block,
-    chunk_rows: usize,
-    columns: usize,
-) -> EncodedUnit {
-    let chunk_cells = chunk_rows * columns;
+pub fn encode_unit(variables: &[Variable], block: &Block, chunk_cells: usize) -> EncodedUnit {
     let chunks = variables
         .iter()
         .zip(&block.columns)

@@ -524,7 +524,7 @@ fn merge_refuses_impossible_shard_attributes() {
     std::fs::write(
         &scene,
         "name = \"m\"\n[body]\nnu = 0.5\neta = 0.5\n[axes]\nalpha = [0.5]\nbeta = [0.8, 3.0]\n\
-         kappa = { start = 0.0, stop = 1.0, num = 4 }\nenergy = { start = 1.0, stop = 3.0, num = 4 }\n\
+         kappa = { start = 0.0, stop = 1.0, num = 16 }\nenergy = { start = 1.0, stop = 3.0, num = 16 }\n\
          [outputs]\nfields = [\"rotation_number\", \"status\"]\n",
     )
     .unwrap();

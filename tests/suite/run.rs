@@ -566,6 +566,59 @@ fn four_shards_merged_equal_a_single_run() {
 /// Issue 14 item 4: a shard file holds just its box of the grid (here half of the α values),
 /// every cell of it computed and equal to a single run's, so that xarray combines the
 /// shards by their coordinates.
+/// A grid of tiny slices (issue 22: 1000 × 1000 one-cell slices wrote a chunk and a journal
+/// file per cell, 2 kB and 200 µs a cell) is computed in units of many β: one chunk and one
+/// journal file each; its shards split α and merge to the same arrays.
+#[test]
+fn tiny_slices_are_grouped_into_units_and_their_shards_merge() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("tiny.toml");
+    std::fs::write(
+        &scene,
+        scene_text(
+            "tiny",
+            "quadrature",
+            "alpha = { start = 0.1, stop = 0.7, num = 3 }\n\
+             beta = { start = 0.5, stop = 3.0, num = 300 }\n\
+             kappa = [0.8]\nenergy = [2.0, 2.5]",
+        ),
+    )
+    .unwrap();
+    let s = scene.to_str().unwrap();
+    let single = run_quietly(s, &dir.path().join("single.h5"));
+    let chunks = hdf5::File::open(&single)
+        .unwrap()
+        .dataset("rotation_number")
+        .unwrap()
+        .chunk()
+        .unwrap();
+    assert_eq!(chunks[..4], [1, 300, 1, 2]);
+    let shards: Vec<String> = (1..=3)
+        .map(|i| {
+            let path = dir.path().join(format!("tiny-{i}.h5"));
+            ok(&run(&[
+                "run",
+                s,
+                "--out",
+                path.to_str().unwrap(),
+                "--shard",
+                &format!("{i}/3"),
+                "--quiet",
+            ]));
+            path.to_str().unwrap().to_string()
+        })
+        .collect();
+    // β is one group: more shards than α values are refused, in one line.
+    let four = run(&["run", s, "--out", "x.h5", "--shard", "1/4"]);
+    assert_eq!(four.status.code(), Some(2));
+    let merged = dir.path().join("merged.h5");
+    let mut args: Vec<&str> = vec!["merge"];
+    args.extend(shards.iter().map(String::as_str));
+    args.extend(["--out", merged.to_str().unwrap()]);
+    ok(&run(&args));
+    assert_same_arrays(&single, &merged);
+}
+
 #[test]
 fn a_shard_file_holds_just_its_region_equal_to_a_single_run() {
     use rubber_atlas::atlas::cell_status;

@@ -43,9 +43,26 @@ mod atlas {
     fn units_cover_the_grid_once_and_shards_partition_them() {
         let shape = [2, 3, 50, 100];
         let all: Vec<Unit> = units(shape).collect();
-        let cells: usize = all.iter().map(|u| u.rows.len() * shape[3]).sum();
+        let cells: usize = all.iter().map(|u| u.cells(shape[3])).sum();
         assert_eq!(cells, 2 * 3 * 50 * 100);
-        for shape in [shape, [7, 2, 50, 100], [1, 1, 6000, 3], [3, 9, 10, 4000]] {
+        // Slices under 256 cells are grouped along β into units of about 4096 cells:
+        // [3, 40, 8, 20] in groups of 25 β (the second short), [5, 50, 2, 7] of all 50,
+        // [4, 9, 1, 1] of all 9; a slice of 5000 cells is a unit (or more) of its own.
+        assert_eq!(betas_per_unit([3, 11, 8, 20]), 11);
+        assert_eq!(betas_per_unit([3, 40, 8, 20]), 25);
+        assert_eq!(betas_per_unit([2, 3, 50, 100]), 1);
+        for shape in [
+            shape,
+            [7, 2, 50, 100],
+            [1, 1, 6000, 3],
+            [3, 9, 10, 4000],
+            [3, 40, 8, 20],
+            [5, 50, 2, 7],
+            [4, 9, 1, 1],
+        ] {
+            let all: Vec<Unit> = units(shape).collect();
+            let cells: usize = all.iter().map(|u| u.cells(shape[3])).sum();
+            assert_eq!(cells, shape.iter().product::<usize>(), "{shape:?}");
             let all: Vec<Unit> = units(shape).collect();
             assert_eq!(all.len(), unit_count(shape));
             assert!(all.iter().enumerate().all(|(i, u)| u.index == i));
@@ -70,6 +87,7 @@ mod atlas {
                         seen[u.index] += 1;
                         // A unit lies in its shard's region whole.
                         assert!(u.rows.end <= region.rows.end, "{shape:?} {shard}");
+                        assert!(u.betas.end <= region.beta.end, "{shape:?} {shard}");
                     }
                     cells += region.shape().iter().product::<usize>();
                 }
