@@ -471,10 +471,6 @@ fn table_dict<'py>(py: Python<'py>, table: Table) -> PyResult<Bound<'py, PyDict>
     Ok(d)
 }
 
-fn body(alpha: f64, beta: f64, nu: f64, eta: f64) -> PyResult<EllipsoidBody> {
-    EllipsoidBody::ellipsoid(alpha, beta, nu, eta).map_err(value_error)
-}
-
 /// The critical set of one body (paper §4): its fixed-point curves as a table, and its
 /// summary as JSON.
 #[pyfunction]
@@ -586,10 +582,10 @@ fn trajectory<'py>(
 /// The resonance curves N = `rotation_number` in a window of the (κ, ε) plane, as a table
 /// along `sample`, and the window's smallest energy.
 #[pyfunction]
-#[pyo3(signature = (alpha, beta, nu, eta, rotation_number, kappa_min, kappa_max, energy_min, energy_max, grid, tol))]
+#[pyo3(signature = (alpha, beta, nu, eta, rotation_number, kappa_min, kappa_max, energy_min, energy_max, grid, tol, shape="ellipsoid"))]
 #[allow(clippy::too_many_arguments)]
-fn resonance(
-    py: Python<'_>,
+fn resonance<'py>(
+    py: Python<'py>,
     alpha: f64,
     beta: f64,
     nu: f64,
@@ -601,21 +597,26 @@ fn resonance(
     energy_max: f64,
     grid: i64,
     tol: f64,
-) -> PyResult<(Bound<'_, PyDict>, f64)> {
+    shape: &str,
+) -> PyResult<(Bound<'py, PyDict>, f64)> {
     let grid = count("grid", grid, 1)?;
-    let body = body(alpha, beta, nu, eta)?;
-    let options = ResonanceOptions::window(
-        &body,
+    let body = any_body(shape, alpha, beta, nu, eta)?;
+    let options = crate::with_body!(&body, b => ResonanceOptions::window(
+        b,
         rotation_number,
         (kappa_min, kappa_max),
         energy_min,
         energy_max,
         grid,
         tol,
-    );
+    ));
     // Ctrl-C is heard between seed rows and continuation steps.
-    let curves = interruptible(py, &None, |stop| trace_curves_until(&body, &options, stop))?
-        .map_err(value_error)?;
+    let curves = interruptible(
+        py,
+        &None,
+        |stop| crate::with_body!(&body, b => trace_curves_until(b, &options, stop)),
+    )?
+    .map_err(value_error)?;
     Ok((
         table_dict(py, crate::table::resonance(&curves))?,
         options.energy.0,

@@ -1523,7 +1523,7 @@ def _rotation_number(value) -> float:
 
 def resonance(alpha: float, beta: float, nu: float, eta: float, rotation_number, *, kappa_min: float = 0.01,
               kappa_max: float = 2.0, energy_min: float | None = None, energy_max: float = 5.0,
-              grid: int = 48, tol: float = 1e-10) -> xr.Dataset:
+              grid: int = 48, tol: float = 1e-10, shape: str = "ellipsoid", cut: float | None = None) -> xr.Dataset:
     """The curves N = p/q of the (κ, ε) plane in a window, traced by continuation.
 
     Parameters
@@ -1542,6 +1542,11 @@ def resonance(alpha: float, beta: float, nu: float, eta: float, rotation_number,
         Cells per side of the coarse grid on which the curves are first bracketed, ≥ 4.
     tol : float, default 1e-10
         Solver tolerance (1e-15 … 0.1); points are located to it.
+    shape : {"ellipsoid", "disk", "truncated_ball", "wheel"}, default "ellipsoid"
+        The body (docs/bodies.md). The edged bodies take no `beta` (give None): the disk has
+        α alone, the cut balls α and `cut`.
+    cut : float, optional
+        h of the cut balls (required for them, refused for the others).
 
     Returns
     -------
@@ -1568,18 +1573,25 @@ def resonance(alpha: float, beta: float, nu: float, eta: float, rotation_number,
     True
     >>> sorted(set(curves.component.values.tolist()))
     [0, 1]
+
+    The N = 0 curve of a truncated ball:
+
+    >>> ball = ra.resonance(0.2, None, 0.7, 1.3, 0, shape="truncated_ball", cut=0.4, grid=24)
+    >>> ball.attrs["shape"], bool((abs(ball.rotation_number) <= ball.error_estimate + 1e-10).all())
+    ('truncated_ball', True)
     """
     target = _rotation_number(rotation_number)
-    body = _reals(alpha=alpha, beta=beta, nu=nu, eta=eta)
+    body, shape, extra, values = _one_body(shape, alpha, beta, nu, eta, cut)
     window = _reals(kappa_min=kappa_min, kappa_max=kappa_max, energy_max=energy_max)
     tol = _real("tol", tol)
-    table, e_min = _core.resonance(*body.values(), target, window["kappa_min"], window["kappa_max"],
+    table, e_min = _core.resonance(*values, target, window["kappa_min"], window["kappa_max"],
                                    _optional_real("energy_min", energy_min), window["energy_max"],
-                                   _count("grid", grid), tol)
-    arguments = dict(alpha=alpha, beta=beta, nu=nu, eta=eta, rotation_number=rotation_number,
-                     kappa_min=kappa_min, kappa_max=kappa_max, energy_min=energy_min,
-                     energy_max=energy_max, grid=grid, tol=tol)
-    attrs = _root_attrs("resonance", arguments, **body, rotation_number=target, tolerance=tol,
+                                   _count("grid", grid), tol, **extra)
+    arguments = dict(alpha=alpha, **({} if extra else dict(beta=beta)), nu=nu, eta=eta,
+                     rotation_number=rotation_number, kappa_min=kappa_min, kappa_max=kappa_max,
+                     energy_min=energy_min, energy_max=energy_max, grid=grid, tol=tol, **extra,
+                     **({"cut": cut} if cut is not None else {}))
+    attrs = _root_attrs("resonance", arguments, **extra, **body, rotation_number=target, tolerance=tol,
                         kappa_window=np.array([window["kappa_min"], window["kappa_max"]], dtype=float),
                         energy_window=np.array([e_min, window["energy_max"]], dtype=float))
     return _table(table, attrs)

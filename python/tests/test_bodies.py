@@ -107,3 +107,24 @@ def test_a_planar_trajectory_onto_a_face_is_refused():
         ra.trajectory(0.2, None, 0.7, 1.3, 0.0, energy=0.7, periods=1, shape="truncated_ball", cut=0.4)
     with pytest.raises(ValueError, match="takes no beta"):
         ra.diagram(0.2, 3.0, shape="disk")
+
+
+def test_resonance_of_an_edged_body_equals_the_command(tmp_path):
+    """`resonance(shape=…)` gives the curves of `rubber-atlas resonance --shape …`, named after
+    the shape's parameters; what a shape does not take is refused."""
+    curves = ra.resonance(0.1, None, 1.0, 2.0, "1/4", shape="wheel", cut=0.5, grid=24, kappa_max=3.0,
+                          energy_max=8.0)
+    assert curves.attrs["shape"] == "wheel" and curves.attrs["cut"] == 0.5 and "beta" not in curves.attrs
+    out = tmp_path / "w.csv"
+    run("resonance", "--shape", "wheel", "--alpha", "0.1", "--cut", "0.5", "--nu", "1", "--eta", "2",
+        "--rotation-number", "1/4", "--grid", "24", "--kappa-max", "3", "--energy-max", "8", "--out", out)
+    table = ra.read_table(out)
+    assert table.attrs["shape"] == "wheel" and curves.sizes["sample"] > 10
+    for name in ("kappa", "energy", "rotation_number", "theta_min"):
+        np.testing.assert_array_equal(curves[name].values, table[name].values)
+    # Each point is on N = P/Q to within its estimate (and the tolerance).
+    assert (abs(curves.rotation_number - 0.25) <= curves.error_estimate + 1e-10).all()
+    with pytest.raises(ValueError, match="takes no beta"):
+        ra.resonance(0.1, 3.0, 1.0, 2.0, 0, shape="disk")
+    with pytest.raises(TypeError, match="needs cut"):
+        ra.resonance(0.1, None, 1.0, 2.0, 0, shape="truncated_ball")

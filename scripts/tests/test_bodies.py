@@ -93,3 +93,39 @@ def test_the_cut_balls_refuse_what_they_do_not_take():
         p = subprocess.run([BIN, *base, *extra], capture_output=True, text=True)
         assert p.returncode == 2, (extra, p.stderr)
         assert words in p.stderr and len(p.stderr.strip().splitlines()) == 1, (extra, p.stderr)
+
+
+# (shape, α, cut, ν, η, N, extra options): resonance curves of each edged body.
+RESONANCES = [
+    ("truncated_ball", 0.2, 0.4, 0.7, 1.3, "0", []),
+    ("disk", 0.1, None, 0.5, 2.0, "1/7", []),
+    ("wheel", 0.1, 0.5, 1.0, 2.0, "1/4", ["--kappa-max", "3", "--energy-max", "8"]),
+]
+
+
+@pytest.mark.parametrize("case", RESONANCES, ids=[c[0] for c in RESONANCES])
+def test_resonance_curves_of_edged_bodies_are_on_resonance_at_50_digits(case):
+    """`rubber-atlas resonance --shape …`: points of every curve (first, middle, last) have the
+    50-digit N of their component within the point's estimate, and that N is P/Q to the
+    tolerance."""
+    shape, alpha, cut, nu, eta, target, extra = case
+    tol = 1e-10
+    args = [BIN, "resonance", "--shape", shape, "--alpha", repr(alpha), "--nu", repr(nu), "--eta", repr(eta),
+            "--rotation-number", target, "--grid", "24", "--tol", repr(tol), "--json", *extra]
+    if cut is not None:
+        args += ["--cut", repr(cut)]
+    out = json.loads(subprocess.run(args, check=True, capture_output=True, text=True).stdout)
+    assert out["shape"] == shape and out["alpha"] == alpha and out["curves"], out
+    p, q = (int(x) for x in target.split("/")) if "/" in target else (int(target), 1)
+    checked = 0
+    for curve in out["curves"]:
+        points = curve["points"]
+        for point in (points[0], points[len(points) // 2], points[-1]):
+            cell = EdgedCell(shape, alpha, cut or 0, nu, eta, point["kappa"])
+            ref = [c for c in cell.components(point["energy"]) if abs(c.theta_min - point["theta_min"]) < 1e-9]
+            assert len(ref) == 1, (point, [c.theta_min for c in cell.components(point["energy"])])
+            where = f"{case}: {point} vs {ref[0]}"
+            assert abs(ref[0].rotation_number - point["rotation_number"]) <= point["error_estimate"] + 1e-15, where
+            assert abs(ref[0].rotation_number - p / q) <= tol + point["error_estimate"], where
+            checked += 1
+    assert checked >= 3

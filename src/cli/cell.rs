@@ -66,13 +66,7 @@ pub(super) fn cell(args: CellArgs) -> Result<()> {
     let energy = result.energy;
     if args.json {
         // The ellipsoid's object as it always was; another shape adds its name.
-        let mut value = serde_json::Map::new();
-        if !matches!(body, AnyBody::Ellipsoid(_)) {
-            value.insert("shape".into(), body.shape_name().into());
-        }
-        for (name, x) in body.shape_parameters() {
-            value.insert(name.into(), x.into());
-        }
+        let mut value = body_json(&body);
         let rest = serde_json::json!({
             "nu": args.level.nu,
             "eta": args.level.eta,
@@ -89,18 +83,9 @@ pub(super) fn cell(args: CellArgs) -> Result<()> {
         println!("{}", serde_json::to_string_pretty(&value)?);
         return Ok(());
     }
-    let shape: Vec<String> = body
-        .shape_parameters()
-        .iter()
-        .map(|(name, x)| format!("{name}={}", show(*x)))
-        .collect();
-    let shape_name = match body {
-        AnyBody::Ellipsoid(_) => String::new(),
-        _ => format!("{} ", body.shape_name()),
-    };
     println!(
-        "cell {shape_name}{} nu={} eta={} kappa={} energy={} ({}, tol {:e}): {}",
-        shape.join(" "),
+        "cell {} nu={} eta={} kappa={} energy={} ({}, tol {:e}): {}",
+        body_text(&body),
         show(args.level.nu),
         show(args.level.eta),
         show(args.level.kappa),

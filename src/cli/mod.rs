@@ -283,6 +283,47 @@ pub enum ModelArg {
     Full,
 }
 
+/// The body as the outputs name it: the ellipsoid's (α, β) as they always were; another
+/// shape's name first, then its parameters.
+fn body_fields(body: &AnyBody) -> Vec<(&'static str, AttrValue)> {
+    let mut fields = Vec::new();
+    if !matches!(body, AnyBody::Ellipsoid(_)) {
+        fields.push(("shape", AttrValue::Text(body.shape_name().to_string())));
+    }
+    fields.extend(
+        body.shape_parameters()
+            .into_iter()
+            .map(|(name, x)| (name, AttrValue::Number(x))),
+    );
+    fields
+}
+
+/// [`body_fields`] as the start of a JSON object.
+fn body_json(body: &AnyBody) -> serde_json::Map<String, serde_json::Value> {
+    let mut value = serde_json::Map::new();
+    if !matches!(body, AnyBody::Ellipsoid(_)) {
+        value.insert("shape".into(), body.shape_name().into());
+    }
+    for (name, x) in body.shape_parameters() {
+        value.insert(name.into(), x.into());
+    }
+    value
+}
+
+/// [`body_fields`] as text: `alpha=0.5 beta=3`, or `wheel alpha=0.1 cut=0.5`.
+fn body_text(body: &AnyBody) -> String {
+    let mut words = Vec::new();
+    if !matches!(body, AnyBody::Ellipsoid(_)) {
+        words.push(body.shape_name().to_string());
+    }
+    words.extend(
+        body.shape_parameters()
+            .into_iter()
+            .map(|(name, x)| format!("{name}={}", show(x))),
+    );
+    words.join(" ")
+}
+
 /// Runs one parsed command line.
 pub fn run(cli: Cli) -> Result<()> {
     // The long commands stop at their next check on SIGINT, SIGTERM or SIGHUP, writing

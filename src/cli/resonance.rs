@@ -7,13 +7,12 @@ use rubber_atlas::cf::AttrValue;
 use rubber_atlas::error::AtlasError;
 use rubber_atlas::resonance::{self, ResonanceOptions};
 use rubber_atlas::store::{check_output, write_table};
-use rubber_atlas::EllipsoidBody;
 use std::path::PathBuf;
 
 #[derive(Debug, Args)]
 pub struct ResonanceArgs {
     #[command(flatten)]
-    pub shape: ShapeArgs,
+    pub shape: BodyShapeArgs,
     /// ν = i3/i1, 0 < ν <= 2.
     #[arg(value_parser = number, long, allow_hyphen_values = true)]
     pub nu: f64,
@@ -90,29 +89,37 @@ pub(super) fn resonance(args: ResonanceArgs) -> Result<()> {
         }
         .into());
     }
-    let body = EllipsoidBody::ellipsoid(args.shape.alpha, args.shape.beta, args.nu, args.eta)?;
+    let body = args.shape.body(args.nu, args.eta)?;
     let target = parse_rotation_number(&args.rotation_number)?;
-    let options = ResonanceOptions::window(
-        &body,
+    let options = rubber_atlas::with_body!(&body, b => ResonanceOptions::window(
+        b,
         target,
         (args.kappa_min, args.kappa_max),
         args.energy_min,
         args.energy_max,
         args.grid,
         args.tol,
-    );
-    let header = serde_json::json!({
-        "alpha": args.shape.alpha,
-        "beta": args.shape.beta,
-        "nu": args.nu,
-        "eta": args.eta,
-        "rotation_number": target,
-        "kappa_window": [options.kappa.0, options.kappa.1],
-        "energy_window": [options.energy.0, options.energy.1],
-        "tolerance": args.tol,
-    });
+    ));
+    // The ellipsoid's header as it always was; another shape adds its name and parameters.
+    let mut header = serde_json::Value::Object(body_json(&body));
+    for (key, value) in [
+        ("nu", serde_json::json!(args.nu)),
+        ("eta", serde_json::json!(args.eta)),
+        ("rotation_number", serde_json::json!(target)),
+        (
+            "kappa_window",
+            serde_json::json!([options.kappa.0, options.kappa.1]),
+        ),
+        (
+            "energy_window",
+            serde_json::json!([options.energy.0, options.energy.1]),
+        ),
+        ("tolerance", serde_json::json!(args.tol)),
+    ] {
+        header[key] = value;
+    }
     if args.fold {
-        let fold = resonance::fold(&body, &options)?;
+        let fold = rubber_atlas::with_body!(&body, b => resonance::fold(b, &options))?;
         let mut value = header;
         match fold {
             Some(f) => {
@@ -132,7 +139,11 @@ pub(super) fn resonance(args: ResonanceArgs) -> Result<()> {
         println!("{}", serde_json::to_string_pretty(&value)?);
         return Ok(());
     }
-    let curves = resonance::trace_curves_until(&body, &options, &crate::stop::requested)?;
+    let curves = rubber_atlas::with_body!(&body, b => resonance::trace_curves_until(
+        b,
+        &options,
+        &crate::stop::requested
+    ))?;
     if args.json {
         let mut value = header;
         value["curves"] = serde_json::to_value(&curves)?;
@@ -141,15 +152,15 @@ pub(super) fn resonance(args: ResonanceArgs) -> Result<()> {
     }
     if let Some(out) = &args.out {
         let mut table = rubber_atlas::table::resonance(&curves);
-        table.attributes.extend(table_attributes(&[
-            ("alpha", AttrValue::Number(args.shape.alpha)),
-            ("beta", AttrValue::Number(args.shape.beta)),
+        let mut attributes = body_fields(&body);
+        attributes.extend([
             ("nu", AttrValue::Number(args.nu)),
             ("eta", AttrValue::Number(args.eta)),
             ("rotation_number", AttrValue::Number(target)),
             ("tolerance", AttrValue::Number(args.tol)),
             ("header_json", AttrValue::Text(header.to_string())),
-        ]));
+        ]);
+        table.attributes.extend(table_attributes(&attributes));
         write_table(out, &table)?;
         println!(
             "wrote {} curves ({} points) to {}",
@@ -160,9 +171,8 @@ pub(super) fn resonance(args: ResonanceArgs) -> Result<()> {
         return Ok(());
     }
     println!(
-        "N = {target} for alpha={} beta={} nu={} eta={}: {} curve(s) in kappa [{}, {}], energy [{}, {}]",
-        show(args.shape.alpha),
-        show(args.shape.beta),
+        "N = {target} for {} nu={} eta={}: {} curve(s) in kappa [{}, {}], energy [{}, {}]",
+        body_text(&body),
         show(args.nu),
         show(args.eta),
         curves.len(),

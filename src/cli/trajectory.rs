@@ -99,14 +99,7 @@ pub(super) fn trajectory(args: TrajectoryArgs) -> Result<()> {
     // The ellipsoid's attributes as they always were; another shape adds its name.
     let mut attributes: Vec<(&str, AttrValue)> =
         vec![("model", AttrValue::Text(json_name(&model)))];
-    if !matches!(body, AnyBody::Ellipsoid(_)) {
-        attributes.push(("shape", AttrValue::Text(body.shape_name().to_string())));
-    }
-    attributes.extend(
-        body.shape_parameters()
-            .into_iter()
-            .map(|(name, x)| (name, AttrValue::Number(x))),
-    );
+    attributes.extend(body_fields(&body));
     attributes.extend([
         ("nu", AttrValue::Number(args.level.nu)),
         ("eta", AttrValue::Number(args.level.eta)),
