@@ -968,8 +968,7 @@ pub fn bodies_of<S: Shape>(
                 reason: e.to_string(),
             };
             crate::error::check_kappa(p.kappa).map_err(at)?;
-            crate::error::check_range("energy", p.energy, None, None, "must be finite")
-                .map_err(at)?;
+            crate::error::check_energy(p.energy).map_err(at)?;
             make(p).map_err(at)
         })
         .collect()

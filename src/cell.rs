@@ -269,7 +269,7 @@ pub fn solve_cell<S: Shape>(
     options: &CellOptions,
 ) -> Result<CellResult> {
     crate::error::check_kappa(kappa)?;
-    crate::error::check_range("energy", energy, None, None, "must be finite")?;
+    crate::error::check_energy(energy)?;
     options.validate()?;
     options.check_for(body)?;
     solve_level(&EffectivePotential::new(body, kappa), energy, options)

@@ -801,5 +801,12 @@ fn check_kappa_max(kappa_max: f64) -> Result<()> {
             reason: "must be a finite number > 0",
         });
     }
-    Ok(())
+    // κ's range of every surface.
+    crate::error::check_kappa(kappa_max)
+        .map(|_| ())
+        .map_err(|_| AtlasError::InvalidParameter {
+            name: "kappa-max",
+            value: kappa_max,
+            reason: "must be at most 1e150 and at least 2.2e-308 (kappa's range)",
+        })
 }

@@ -115,6 +115,20 @@ pub fn show_digits(value: f64, digits: usize) -> String {
 /// The largest |κ| any surface takes: κ² (and κ²/sin²θ near the poles) stays far from overflow.
 pub const MAX_KAPPA: f64 = 1e150;
 
+/// The largest |ε| any surface takes (a scene's (λ, s) plane reaches it at s = 1e-150).
+pub const MAX_ENERGY: f64 = 1e300;
+
+/// Refuses an ε that is not finite or above [`MAX_ENERGY`] in size.
+pub(crate) fn check_energy(energy: f64) -> Result<f64> {
+    check_range(
+        "energy",
+        energy,
+        Some((-MAX_ENERGY, true)),
+        Some((MAX_ENERGY, true)),
+        "|energy| must be at most 1e300",
+    )
+}
+
 /// Refuses a κ that is not finite, above [`MAX_KAPPA`] in size, or subnormal (0 < |κ| <
 /// 2.2e-308: κ² underflows to 0 while the turning points next to the poles, at about κ/√(2ε),
 /// have no normal double left to be found at).

@@ -741,6 +741,10 @@ fn provenance(call: &str) -> Vec<(String, String)> {
 
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // NumPy's C API is looked up (and kept) now, on import: looked up first while a
+    // Ctrl-C was pending (a long `diagram` as the first call), it failed inside the numpy
+    // crate, which panics on that.
+    PyArray1::<f64>::zeros(m.py(), 0, false);
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("git_commit", env!("RUBBER_ATLAS_GIT_COMMIT"))?;
     m.add("COMPONENT_SLOTS", COMPONENT_SLOTS)?;

@@ -36,8 +36,9 @@ impl<'a, S: Shape> ReducedSystem<'a, S> {
         if self.kappa == 0.0 {
             return u; // κ = 0: V = U on the whole circle, poles included
         }
-        let s = theta.sin();
-        0.5 * self.kappa * self.kappa / (s * s) + u
+        // (κ/sinθ)², not κ²/sin²θ: both underflow to 0/0 next to a pole at tiny κ.
+        let w = self.kappa / theta.sin();
+        0.5 * w * w + u
     }
 
     /// V′(θ) = −κ² cosθ / sin³θ + U′(θ).
@@ -48,7 +49,8 @@ impl<'a, S: Shape> ReducedSystem<'a, S> {
             return up;
         }
         let (s, c) = theta.sin_cos();
-        -self.kappa * self.kappa * c / (s * s * s) + up
+        let w = self.kappa / s;
+        -w * w * c / s + up
     }
 
     /// V″(θ) = κ² (sin²θ + 3 cos²θ) / sin⁴θ + U″(θ).
@@ -59,8 +61,8 @@ impl<'a, S: Shape> ReducedSystem<'a, S> {
             return upp;
         }
         let (s, c) = theta.sin_cos();
-        let s2 = s * s;
-        self.kappa * self.kappa * (s2 + 3.0 * c * c) / (s2 * s2) + upp
+        let w = self.kappa / s;
+        w * w * (1.0 + 3.0 * (c / s) * (c / s)) + upp
     }
 
     /// Energy ε = B(θ) p² / 2 + V(θ) (paper §2.3, below `eqsys`).

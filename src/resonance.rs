@@ -641,12 +641,27 @@ fn check_window(options: &ResonanceOptions) -> Result<()> {
     if !(k1.is_finite() && k1 > k0) {
         return bad("kappa_max", k1, "must be finite and above kappa_min");
     }
+    // κ's and ε's ranges of every surface: the window's corners are cells.
+    let named = |name: &'static str| {
+        move |e: AtlasError| match e {
+            AtlasError::InvalidParameter { value, reason, .. } => AtlasError::InvalidParameter {
+                name,
+                value,
+                reason,
+            },
+            other => other,
+        }
+    };
+    crate::error::check_kappa(k0).map_err(named("kappa_min"))?;
+    crate::error::check_kappa(k1).map_err(named("kappa_max"))?;
     if !e0.is_finite() {
         return bad("energy_min", e0, "must be finite");
     }
     if !e1.is_finite() {
         return bad("energy_max", e1, "must be finite and above energy_min");
     }
+    crate::error::check_energy(e0).map_err(named("energy_min"))?;
+    crate::error::check_energy(e1).map_err(named("energy_max"))?;
     if e1 <= e0 {
         // Name both: energy_min may be the window's bottom of V, not a value the user gave.
         return Err(AtlasError::Atlas {

@@ -3,7 +3,7 @@
 //! value and names the file, the key and the reason of the first problem it finds.
 
 use crate::cell::{CellOptions, Method};
-use crate::error::{show, AtlasError, Result, MAX_KAPPA};
+use crate::error::{show, AtlasError, Result, MAX_ENERGY, MAX_KAPPA};
 use crate::family::Layout;
 use crate::EllipsoidBody;
 use std::path::Path;
@@ -493,27 +493,40 @@ impl Scene {
                 ),
             ));
         }
-        // The smallest |κ| > 0 of a cell: κ itself, or λ/s at the largest s.
-        let least_kappa = if plane == Plane::Compact {
-            smallest_positive(&kappa) / largest(&energy)
-        } else {
-            kappa
-                .values
-                .iter()
-                .filter(|v| **v != 0.0)
-                .fold(f64::INFINITY, |m, v| m.min(v.abs()))
-        };
-        if least_kappa < f64::MIN_POSITIVE {
+        // The smallest |κ| > 0 of a cell: κ itself (signed), or λ/s at the largest s.
+        if plane == Plane::Compact {
+            let (lambda, s) = (smallest_positive(&kappa), largest(&energy));
+            if lambda.is_finite() && s > 0.0 && lambda / s < f64::MIN_POSITIVE {
+                return Err(reader.error(
+                    "axes.lambda",
+                    format!(
+                        "lambda = {} at s = {} gives kappa = lambda/s = {}, below 2.2e-308 \
+                         (subnormal, or 0 by underflow): keep lambda/s at least 2.2e-308",
+                        show(lambda),
+                        show(s),
+                        show(lambda / s)
+                    ),
+                ));
+            }
+        } else if let Some(least) = kappa
+            .values
+            .iter()
+            .filter(|v| **v != 0.0)
+            .min_by(|a, b| a.abs().total_cmp(&b.abs()))
+            .filter(|v| v.abs() < f64::MIN_POSITIVE)
+        {
             return Err(reader.error(
-                if plane == Plane::Compact {
-                    "axes.lambda"
-                } else {
-                    "axes.kappa"
-                },
+                "axes.kappa",
                 format!(
                     "a cell has kappa = {}, subnormal: give 0 or |kappa| >= 2.2e-308",
-                    show(least_kappa)
+                    show(*least)
                 ),
+            ));
+        }
+        if plane != Plane::Compact && largest(&energy) > MAX_ENERGY {
+            return Err(reader.error(
+                &format!("axes.{column_name}"),
+                format!("{} is above {MAX_ENERGY:e} in size", show(largest(&energy))),
             ));
         }
         if plane == Plane::Compact {

@@ -213,18 +213,30 @@ fn temp_path(path: &Path) -> PathBuf {
 /// header, then rows: shortest round-trip decimals) or HDF5 (one 1-D variable per column
 /// along the table's dimension, whose coordinate is a dimension scale; CF attributes).
 pub fn write_table(path: &Path, table: &Table) -> Result<()> {
+    write_table_until(path, table, &|| false)
+}
+
+/// [`write_table`], given up with [`AtlasError::Stopped`] and nothing at `path` when `stop`
+/// says so (asked before the file is renamed into place, and every 65,536 CSV rows).
+pub fn write_table_until(path: &Path, table: &Table, stop: &dyn Fn() -> bool) -> Result<()> {
     let format = TableFormat::from_path(path)?;
+    if stop() {
+        return Err(AtlasError::Stopped);
+    }
     let tmp = temp_path(path);
     let written = match format {
-        TableFormat::Csv => write_csv(&tmp, table),
+        TableFormat::Csv => write_csv(&tmp, table, stop),
         #[cfg(feature = "hdf5")]
         TableFormat::Hdf5 => write_hdf5(&tmp, table),
         #[cfg(not(feature = "hdf5"))]
         TableFormat::Hdf5 => Err("built without the hdf5 feature: write .csv".to_string()),
     };
-    if let Err(e) = written {
+    if written.is_err() || stop() {
         let _ = std::fs::remove_file(&tmp);
-        return Err(output_error(path, e));
+        return Err(match written {
+            Err(e) if !stop() => output_error(path, e),
+            _ => AtlasError::Stopped,
+        });
     }
     std::fs::rename(&tmp, path).map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
@@ -232,7 +244,11 @@ pub fn write_table(path: &Path, table: &Table) -> Result<()> {
     })
 }
 
-fn write_csv(path: &Path, table: &Table) -> std::result::Result<(), String> {
+fn write_csv(
+    path: &Path,
+    table: &Table,
+    stop: &dyn Fn() -> bool,
+) -> std::result::Result<(), String> {
     let file = std::fs::File::create(path).map_err(|e| e.to_string())?;
     let mut w = std::io::BufWriter::new(file);
     let io = |e: std::io::Error| e.to_string();
@@ -246,6 +262,9 @@ fn write_csv(path: &Path, table: &Table) -> std::result::Result<(), String> {
         .map_err(text)?;
     let mut record = Vec::with_capacity(table.columns.len());
     for i in 0..table.rows() {
+        if i % 65_536 == 0 && stop() {
+            return Err("stopped".into());
+        }
         record.clear();
         record.extend(table.columns.iter().map(|c| match &c.values {
             Values::F64(v) => format!("{:e}", v[i]),

@@ -285,11 +285,32 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
     // (A census cut short by a signal lays out nothing: the run stops before any work.)
     progress.laying_out();
     let axis = atlas::component_axis(scene, &|| progress.interrupted());
+    let shape = scene.shape();
+    let region = request.shard.region(shape);
+    let cells_of = |u: &Unit| u.cells(scene.energy.len());
+    let units_total = atlas::unit_count(shape);
+    let kept_cells = |listed: &std::collections::BTreeSet<usize>| -> u64 {
+        listed
+            .iter()
+            .filter(|&&i| i < units_total)
+            .map(|&i| atlas::unit(shape, i))
+            .filter(|u| region.holds(u))
+            .map(|u| cells_of(&u) as u64)
+            .sum()
+    };
+    let total = region.shape().iter().product::<usize>() as u64;
     if progress.interrupted() {
+        // A resumed run stopped here keeps what its journal holds (it said 0 cells kept).
+        let journal_dir = Journal::dir_for(out);
+        let done = if Journal::looks_like_one(&journal_dir) {
+            kept_cells(&Journal::units_listed_in(&journal_dir).unwrap_or_default())
+        } else {
+            0
+        };
         return Err(AtlasError::Interrupted {
             path: out.display().to_string(),
-            done: 0,
-            total: scene.cells() as u64,
+            done,
+            total,
         });
     }
     // The journal belongs to this scene, build, shard and component axis: a unit kept for
@@ -347,24 +368,10 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
     };
 
     let variables = atlas::scene_variables(scene);
-    let shape = scene.shape();
-    let region = request.shard.region(shape);
     let chunk_cells = region.chunk_cells(shape);
-    let cells_of = |u: &Unit| u.cells(scene.energy.len());
     // Units with a file in the journal; each is checked when it is read, below, and computed
     // again if its file turns out damaged.
     let listed = journal.listed_units()?;
-    let units_total = atlas::unit_count(shape);
-    let kept_cells = |listed: &std::collections::BTreeSet<usize>| -> u64 {
-        listed
-            .iter()
-            .filter(|&&i| i < units_total)
-            .map(|&i| atlas::unit(shape, i))
-            .filter(|u| region.holds(u))
-            .map(|u| cells_of(&u) as u64)
-            .sum()
-    };
-    let total = region.shape().iter().product::<usize>() as u64;
     let done_cells = kept_cells(&listed);
     let mut summary = Summary {
         units: region.unit_count(shape),

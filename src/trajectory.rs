@@ -190,7 +190,7 @@ impl Request {
         crate::error::check_kappa(self.kappa)?;
         match self.start {
             StartAt::Energy { energy, component } => {
-                crate::error::check_range("energy", energy, None, None, "must be a finite number")?;
+                crate::error::check_energy(energy)?;
                 Start::at_energy(body, self.kappa, energy, component)
             }
             StartAt::Angle { theta0, theta_dot0 } => {

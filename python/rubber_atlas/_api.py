@@ -480,9 +480,16 @@ def _to_kappa_energy(plane: tuple[str, str], flat: list[np.ndarray], shape: str 
         _first_bad("s", b, b == 0, "s = 0 is the high-energy limit energy = infinity, which cells does "
                    "not compute; give s > 0 (energy = 1/s^2)")
         _first_bad("s", b, ~(b > 0) | ~np.isfinite(b), "s = 1 / sqrt(energy) must be a finite number > 0")
-        # Overflows and s² underflowing to 0 give inf, refused below with the inputs named.
+        # As a scene's (λ, s) plane: λ ≥ 0, s ≥ 1e-150 (ε ≤ 1e300), λ/s not below 2.2e-308.
+        _first_bad("lambda", a, a < 0, "lambda = kappa / sqrt(energy) must be >= 0 (the sign of kappa is "
+                   "the direction of rolling: give kappa and energy for kappa < 0)")
+        _first_bad("s", b, b < 1e-150, "s below 1e-150 is energy = 1/s^2 above 1e300")
+        # Overflows give inf, refused below with the inputs named.
         with np.errstate(over="ignore", divide="ignore", under="ignore"):
-            return flat[:4] + [a / b, 1.0 / (b * b)]
+            kappa = a / b
+            _first_bad("lambda", a, (a > 0) & (kappa < 2.2250738585072014e-308),
+                       "lambda / s is below 2.2e-308 (subnormal, or 0 by underflow): keep it at least 2.2e-308")
+            return flat[:4] + [kappa, 1.0 / (b * b)]
     return flat[:4] + [a, _excess_to_energy(*flat[:4], a, b, shape=shape)]
 
 
@@ -732,17 +739,18 @@ def cells(
         rolling), 0 or any real number from 2.2e-308 (the least normal double) up to 1e150 in
         size; with `energy` or `excess_energy`.
     energy : float, array_like or xarray.DataArray, optional
-        ε, the energy in units of m g b3, any real number (below the bottom of V there is
-        no motion).
+        ε, the energy in units of m g b3, any real number up to 1e300 in size (below the
+        bottom of V there is no motion).
     excess_energy : float, array_like or xarray.DataArray, optional
         ε − V_min(κ), the energy above the bottom of V at each κ (m g b3); instead of
         `energy` (the bottom is found by the Rust core, as an atlas's
         ``kappa``/``excess_energy`` plane finds it).
     lambda_ : float, array_like or xarray.DataArray, optional
-        λ = κ/√ε, finite; with `s` instead of `kappa` and `energy` (κ = λ/s, so λ/s is held to
-        κ's range). Motion at high energy needs λ ≤ √2.
+        λ = κ/√ε ≥ 0, finite; with `s` instead of `kappa` and `energy` (κ = λ/s, so λ/s is held
+        to κ's range). Motion at high energy needs λ ≤ √2.
     s : float, array_like or xarray.DataArray, optional
-        s = 1/√ε > 0 (ε = 1/s²). s = 0, the high-energy limit ε = ∞, is refused for now.
+        s = 1/√ε ≥ 1e-150 (ε = 1/s² ≤ 1e300), as in scenes. s = 0, the high-energy limit
+        ε = ∞, is refused for now.
     tol : float, default 1e-10
         Relative tolerance of the solver, 1e-15 ≤ tol ≤ 0.1.
     method : {"quadrature", "ode"}, default "quadrature"
@@ -960,7 +968,9 @@ def open_atlas(path: str | Path, check: bool = False, **kwargs) -> xr.Dataset:
         Read every stored value once, chunk by chunk, before returning, and refuse a file
         whose values cannot all be read (a corrupted chunk) with a ValueError naming the
         variable. It reads the whole file (about as long as ``.load()``; its memory stays at
-        one chunk).
+        one chunk). It finds what HDF5 cannot decode, not every changed byte: the file has no
+        checksums, so a byte changed inside an uncompressed coordinate (α, β) or an
+        attribute reads as another value.
     **kwargs
         Passed to `xarray.open_dataset`; ``engine`` defaults to "h5netcdf".
 
@@ -1025,8 +1035,14 @@ def open_atlas(path: str | Path, check: bool = False, **kwargs) -> xr.Dataset:
     kwargs.setdefault("engine", "h5netcdf")
     try:
         ds = xr.open_dataset(path, **kwargs)
-    except (OSError, ValueError) as e:
-        raise ValueError(f"{path}: not a rubber-atlas atlas: {_one_line(e)}") from None
+    except TypeError as e:
+        if "keyword" in str(e):
+            raise  # a keyword open_dataset does not take: the caller's mistake, as it is
+        raise ValueError(f"{path}: not a rubber-atlas atlas, or a damaged one: {_one_line(e)}") from None
+    except (OSError, ValueError, KeyError, RuntimeError, AttributeError, IndexError) as e:
+        # (A damaged object header makes h5py raise almost anything: KeyError, RuntimeError,
+        # TypeError "Unknown string encoding", …)
+        raise ValueError(f"{path}: not a rubber-atlas atlas, or a damaged one: {_one_line(e)}") from None
     if not _is_atlas(ds):
         ds.close()
         raise ValueError(f"{path}: not a rubber-atlas atlas (a file of `rubber-atlas run` or `merge` has the "
@@ -1045,20 +1061,21 @@ def _read_every_chunk(path: Path) -> None:
     the first variable whose values cannot be read."""
     import h5py
 
-    with h5py.File(path, "r") as f:
-        datasets = []
-        f.visititems(lambda name, item: datasets.append(name) if isinstance(item, h5py.Dataset) else None)
-        for name in datasets:
-            data = f[name]
-            try:
+    name = "the file's index"
+    try:
+        with h5py.File(path, "r") as f:
+            datasets = []
+            f.visititems(lambda n, item: datasets.append(n) if isinstance(item, h5py.Dataset) else None)
+            for name in datasets:
+                data = f[name]
                 if data.chunks is None:
                     data[()]
                 else:
                     for block in data.iter_chunks():
                         data[block]
-            except OSError as e:
-                raise ValueError(f"{path}: the file is damaged: the values of {name!r} cannot be read "
-                                 f"({_one_line(e)}); compute it again") from None
+    except (OSError, KeyError, RuntimeError, ValueError, TypeError, AttributeError, IndexError) as e:
+        raise ValueError(f"{path}: the file is damaged: the values of {name!r} cannot be read "
+                         f"({_one_line(e)}); compute it again") from None
 
 
 def _file(path) -> Path:

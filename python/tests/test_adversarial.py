@@ -4,6 +4,7 @@ error, never a silently wrong result."""
 from __future__ import annotations
 
 import shutil
+from pathlib import Path
 import warnings
 import subprocess
 import sys
@@ -309,6 +310,23 @@ def test_a_damaged_atlas_is_named_as_damaged_by_the_accessor(slice_atlas, tmp_pa
     refused(TypeError, lambda: ra.open_atlas(slice_atlas, check="yes"), "check")
 
 
+
+def test_damage_to_an_atlas_index_is_a_value_error_naming_the_file(slice_atlas, tmp_path):
+    """A byte changed in the file's index and headers (its first 20 kB): h5py said KeyError or
+    RuntimeError from inside open_atlas. Now: the file opens, or one ValueError names it."""
+    data = Path(slice_atlas).read_bytes()
+    refusals = 0
+    for offset in range(300, min(20_000, len(data)), 487):
+        damaged = tmp_path / f"d{offset}.h5"
+        damaged.write_bytes(data[:offset] + bytes([data[offset] ^ 0xFF]) + data[offset + 1:])
+        try:
+            ra.open_atlas(damaged, check=True).close()
+        except ValueError as e:
+            assert str(damaged) in str(e) and "\n" not in str(e), e
+            refusals += 1
+    assert refusals > 0
+
+
 def test_dataarray_coordinates_that_would_be_misread_are_refused():
     named = xr.DataArray([0.5, 0.8], dims="x", coords={"rotation_number": ("x", [1.0, 2.0])})
     refused(ValueError, lambda: ra.cells(*BODY, named, 2.5), "'rotation_number'", "kappa")
@@ -366,3 +384,15 @@ def test_fourth_round_kappa_is_held_to_one_range_everywhere():
     refused(ValueError, lambda: ra.cells(*BODY, kappa=[0.5, 1e-310], energy=2.5, progress=False), "kappa[1]",
             "subnormal")
     refused(ValueError, lambda: ra.trajectory(*BODY, kappa=-5e-324, energy=2.5, periods=1), "kappa", "subnormal")
+
+
+def test_fifth_round_the_lambda_s_plane_is_held_to_the_scenes_rules():
+    """Issue 22: cells took a negative lambda_, s below 1e-150 and lambda_/s underflowing to 0
+    (scenes refuse them), and energy above 1e300; trajectory at a tiny kappa said
+    "invalid energy = NaN"."""
+    refused(ValueError, lambda: ra.cells(*BODY, lambda_=-0.5, s=0.5, progress=False), "lambda", ">= 0")
+    refused(ValueError, lambda: ra.cells(*BODY, lambda_=0.5, s=9.99e-151, progress=False), "s", "1e300")
+    refused(ValueError, lambda: ra.cells(*BODY, lambda_=1e-300, s=1e150, progress=False), "lambda", "2.2e-308")
+    refused(ValueError, lambda: ra.cells(*BODY, kappa=1.0, energy=1e308, progress=False), "energy", "1e300")
+    t = ra.trajectory(*BODY, kappa=1e-200, energy=2.5, periods=1, samples=10, model="full")
+    assert t.sizes["t"] == 11

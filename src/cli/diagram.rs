@@ -6,7 +6,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use rubber_atlas::cf::AttrValue;
 use rubber_atlas::critical::CriticalSet;
-use rubber_atlas::store::{check_output, write_table};
+use rubber_atlas::store::{check_output, write_table_until};
 use std::path::PathBuf;
 
 #[derive(Debug, Args)]
@@ -60,7 +60,11 @@ pub(super) fn diagram(args: DiagramArgs) -> Result<()> {
         }
     };
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&set)?);
+        let text = serde_json::to_string_pretty(&set)?;
+        if crate::stop::requested() {
+            return Err(AtlasError::Stopped.into());
+        }
+        println!("{text}");
         return Ok(());
     }
     if let Some(out) = &args.out {
@@ -192,7 +196,7 @@ pub(super) fn write_diagram(out: &std::path::Path, set: &CriticalSet) -> Result<
         ),
     ]);
     table.attributes.extend(table_attributes(&attributes));
-    write_table(out, &table)
+    write_table_until(out, &table, &crate::stop::requested)
         .with_context(|| format!("writing the diagram of {}", body_words(set)))?;
     Ok(())
 }

@@ -6,7 +6,7 @@ use clap::Args;
 use rubber_atlas::cf::AttrValue;
 use rubber_atlas::error::AtlasError;
 use rubber_atlas::resonance::{self, ResonanceOptions};
-use rubber_atlas::store::{check_output, write_table};
+use rubber_atlas::store::{check_output, write_table_until};
 use std::path::PathBuf;
 
 #[derive(Debug, Args)]
@@ -161,7 +161,7 @@ pub(super) fn resonance(args: ResonanceArgs) -> Result<()> {
             ("header_json", AttrValue::Text(header.to_string())),
         ]);
         table.attributes.extend(table_attributes(&attributes));
-        write_table(out, &table)?;
+        write_table_until(out, &table, &crate::stop::requested)?;
         println!(
             "wrote {} curves ({} points) to {}",
             curves.len(),

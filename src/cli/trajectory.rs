@@ -6,7 +6,7 @@ use anyhow::Result;
 use clap::{ArgGroup, Args};
 use rubber_atlas::cf::AttrValue;
 use rubber_atlas::error::AtlasError;
-use rubber_atlas::store::{check_output, write_table};
+use rubber_atlas::store::{check_output, write_table_until};
 use rubber_atlas::trajectory::{self, Duration, Model, StartAt};
 use std::path::PathBuf;
 
@@ -111,7 +111,7 @@ pub(super) fn trajectory(args: TrajectoryArgs) -> Result<()> {
         ("energy_drift", AttrValue::Number(traj.energy_drift)),
     ]);
     table.attributes.extend(table_attributes(&attributes));
-    write_table(&args.out, &table)?;
+    write_table_until(&args.out, &table, &crate::stop::requested)?;
     eprintln!(
         "wrote {} samples over t in [0, {}] ({} model, energy kept to {:.1e}) to {}",
         traj.t.len(),

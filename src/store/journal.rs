@@ -82,9 +82,14 @@ impl Journal {
 
     /// The units with a file in the journal (not yet verified; [`Journal::read`] checks).
     pub fn listed_units(&self) -> Result<BTreeSet<usize>> {
+        Self::units_listed_in(&self.dir)
+    }
+
+    /// The units with a file in the journal folder `dir`, whichever run made it.
+    pub fn units_listed_in(dir: &Path) -> Result<BTreeSet<usize>> {
         let mut out = BTreeSet::new();
-        for entry in std::fs::read_dir(&self.dir).map_err(|e| AtlasError::atlas(&self.dir, e))? {
-            let entry = entry.map_err(|e| AtlasError::atlas(&self.dir, e))?;
+        for entry in std::fs::read_dir(dir).map_err(|e| AtlasError::atlas(dir, e))? {
+            let entry = entry.map_err(|e| AtlasError::atlas(dir, e))?;
             let name = entry.file_name();
             let name = name.to_string_lossy();
             if let Some(i) = name

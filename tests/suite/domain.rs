@@ -357,6 +357,24 @@ fn turning_points_far_out_and_the_trajectories_from_them() {
             }
         }
     }
+    // At a tiny κ the start by the pole has κ²/sin²θ0 = 0/0 unless taken as (κ/sinθ0)²: it
+    // was refused as "invalid energy = NaN". Now the full model runs it; the reduced model's
+    // steps underflow there, and it says so.
+    for kappa in [1e-200, 2.3e-308, -1e-300] {
+        for model in [Model::Reduced, Model::Full] {
+            let asked = Request {
+                kappa,
+                ..request(2.5, model)
+            };
+            match asked.run(&body) {
+                Ok((_, traj)) => assert!(traj.energy_drift <= 1e-9, "{kappa:e} {model:?}"),
+                Err(e) => assert!(
+                    model == Model::Reduced && matches!(e, AtlasError::Integration { .. }),
+                    "{kappa:e} {model:?}: {e}"
+                ),
+            }
+        }
+    }
     let (_, ordinary) = request(2.5, Model::Full).run(&body).unwrap();
     assert!(ordinary.energy_drift < 1e-10, "{}", ordinary.energy_drift);
     // Asked to stop, it stops (Ctrl-C in Python).
