@@ -74,12 +74,16 @@ pub(super) fn verdict(args: VerdictArgs) -> Result<()> {
     if args.boundaries {
         let defaults = verdict::BoundaryOptions::default();
         // A bar on a terminal (the search takes a minute or two): the scan's verdicts, then
-        // the changes being located.
-        let bar = if std::io::stderr().is_terminal() {
+        // the changes being located; elsewhere (a batch job's log) a plain line every ten
+        // seconds, as `run` prints.
+        let terminal = std::io::stderr().is_terminal();
+        let bar = if terminal {
             indicatif::ProgressBar::new(0)
         } else {
             indicatif::ProgressBar::hidden()
         };
+        let started = std::time::Instant::now();
+        let last_line = std::sync::Mutex::new(started);
         bar.set_style(
             indicatif::ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} ({elapsed})")
                 .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
@@ -107,6 +111,16 @@ pub(super) fn verdict(args: VerdictArgs) -> Result<()> {
                 bar.set_message(message);
                 bar.set_length(of as u64);
                 bar.set_position(done as u64);
+                if !terminal {
+                    let mut last = last_line.lock().unwrap_or_else(|e| e.into_inner());
+                    if last.elapsed() >= std::time::Duration::from_secs(10) {
+                        *last = std::time::Instant::now();
+                        eprintln!(
+                            "verdict --boundaries: {message} {done}/{of} ({:.0} s)",
+                            started.elapsed().as_secs_f64()
+                        );
+                    }
+                }
             },
         );
         bar.finish_and_clear();
