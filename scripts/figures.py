@@ -12,7 +12,9 @@ wrote):
          `trajectory` on each component of several energy levels;
 - res:   resonance curves N = p/q over the type (c) diagram (`resonance`), and the centre of
          mass and contact point at N = 0, κ = 0.5 (`trajectory`);
-- xy:    the trajectories of Fig. xy: N = −1/7 (κ = 0.8) and quasi-periodic (κ = 1, θ(0) = 2.1).
+- xy:    the trajectories of Fig. xy: N = −1/7 (κ = 0.8) and quasi-periodic (κ = 1, θ(0) = 2.1);
+- bodies: N over (κ, ε) of the disk, the truncated ball and the wheel (docs/bodies.md), with
+         their resonance curves N = 0, ±1/4, ±1/7 (`cells` and `resonance` with `shape=`).
 
     .venv/bin/python scripts/figures.py all --out docs/figures
     .venv/bin/python scripts/figures.py bif --out docs/figures
@@ -31,6 +33,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+import xarray as xr  # noqa: E402
 
 import rubber_atlas as ra  # noqa: E402
 from rubber_atlas import open_atlas  # noqa: E402
@@ -237,6 +240,44 @@ def fig_xy(out: Path) -> Path:
     return save(fig, out / "xy.png")
 
 
+# The edged bodies of docs/bodies.md: (title, shape, α, cut, ν, η, κ window, ε window).
+EDGED = [
+    ("disk, α = 0.3 (ν = 2, η = 4)", "disk", 0.3, None, 2.0, 4.0, (0.02, 1.5), (0.35, 2.5)),
+    ("truncated ball, α = 0.2, h = 0.4 (ν = 0.7, η = 1.3)", "truncated_ball", 0.2, 0.4, 0.7, 1.3,
+     (0.02, 1.5), (0.65, 3.0)),
+    ("wheel, α = 0.25, h = 0.7 (ν = 0.7, η = 1.3)", "wheel", 0.25, 0.7, 0.7, 1.3, (0.02, 1.5), (0.7, 3.0)),
+]
+
+
+def fig_bodies(out: Path, n: int = 121, targets=("0", "1/4", "-1/4", "1/7", "-1/7"), grid: int = 32) -> Path:
+    """N of the torus of lowest θ_min over (κ, ε) for each edged body, with the resonance
+    curves N = p/q traced by continuation (each point on N = p/q within its estimate)."""
+    fig, axes = plt.subplots(1, len(EDGED), figsize=(6 * len(EDGED), 5), layout="constrained")
+    for ax, (title, shape, alpha, cut, nu, eta, (k0, k1), (e0, e1)) in zip(axes, EDGED):
+        kappa, energy = np.linspace(k0, k1, n), np.linspace(e0, e1, n)
+        cells = ra.cells(alpha, None, nu, eta, kappa=xr.DataArray(kappa, dims="kappa"),
+                         energy=xr.DataArray(energy, dims="energy"), shape=shape, cut=cut,
+                         fields=["rotation_number"], layout="theta_min", progress=False)
+        n_low = cells.rotation_number.isel(component=0).transpose("energy", "kappa")
+        cmap = plt.get_cmap("RdBu_r").copy()
+        cmap.set_bad("0.8")
+        mesh = ax.pcolormesh(kappa, energy, n_low, cmap=cmap, vmin=-1.0, vmax=1.0, shading="nearest")
+        for i, t in enumerate(targets):
+            curves = ra.resonance(alpha, None, nu, eta, t, shape=shape, cut=cut, kappa_min=k0, kappa_max=k1,
+                                  energy_max=e1, grid=grid)
+            for j in np.unique(curves.curve.values):
+                c = curves.where(curves.curve == j, drop=True)
+                ax.plot(c.kappa, c.energy, color=f"C{i + 1}", lw=1.2, label=f"N = {t}" if j == 0 else None)
+        ax.set_xlim(k0, k1)
+        ax.set_ylim(e0, e1)
+        ax.set_xlabel("κ")
+        ax.set_ylabel("ε")
+        ax.set_title(title, fontsize=10)
+        ax.legend(fontsize=7, loc="upper left")
+    fig.colorbar(mesh, ax=axes, label="N of the torus of lowest θ_min (grey: no motion)")
+    return save(fig, out / "bodies.png")
+
+
 def save(fig, path: Path) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     if fig.get_layout_engine() is None:
@@ -246,7 +287,8 @@ def save(fig, path: Path) -> Path:
     return path
 
 
-FIGURES = {"ab": fig_ab, "wvth": fig_wvth, "bif": fig_bif, "phase": fig_phase, "res": fig_res, "xy": fig_xy}
+FIGURES = {"ab": fig_ab, "wvth": fig_wvth, "bif": fig_bif, "phase": fig_phase, "res": fig_res, "xy": fig_xy,
+           "bodies": fig_bodies}
 
 
 def main() -> None:

@@ -23,6 +23,7 @@ CASES = {
     "phase": lambda out: figures.fig_phase(out, levels=3),
     "res": lambda out: figures.fig_res(out, targets=("0", "-1/7"), grid=16),
     "xy": lambda out: figures.fig_xy(out),
+    "bodies": lambda out: figures.fig_bodies(out, n=21, targets=("0", "1/4"), grid=16),
 }
 
 

@@ -5,7 +5,7 @@
 //! after n periods; the boundaries must stay put when the sampling resolution doubles.
 
 use rubber_atlas::cell::{solve_cell, CellOptions, Method};
-use rubber_atlas::trajectory::{integrate, Model, Start};
+use rubber_atlas::trajectory::Start;
 use rubber_atlas::verdict::{boundaries, verdict, BoundaryOptions, Case, Verdict, VerdictOptions};
 use rubber_atlas::EllipsoidBody;
 
@@ -61,20 +61,7 @@ fn check_counterexamples(body: &EllipsoidBody, v: &Verdict) {
             theta0: c.theta_min,
             theta_dot0: 0.0,
         };
-        let away = |periods: f64| {
-            let t = integrate(
-                body,
-                &start,
-                Model::Full,
-                periods * comp.period,
-                4,
-                1e-12,
-                &|| false,
-            )
-            .unwrap();
-            let n = t.t.len() - 1;
-            (t.x_c[n] - t.x_c[0]).hypot(t.y_c[n] - t.y_c[0])
-        };
+        let away = |periods: f64| crate::full_model_distance(body, &start, periods * comp.period);
         for periods in [5.0, 10.0] {
             let d = away(periods);
             assert!(
