@@ -10,7 +10,7 @@ use rubber_atlas::critical::DiagramType;
 use rubber_atlas::family::{Census, ComponentAxis, Family, Layout};
 use rubber_atlas::scene::{Field, Scene};
 use rubber_atlas::torus::EffectivePotential;
-use rubber_atlas::EllipsoidBody;
+use rubber_atlas::{Body, EdgedShape, EllipsoidBody, Shape};
 use std::collections::BTreeMap;
 
 /// One body of each diagram type (paper §4, Fig. `bif`), the issue's α = 0.3, β = 2, and a
@@ -49,7 +49,7 @@ struct Line {
     families: Vec<Vec<Family>>,
 }
 
-fn line(b: &EllipsoidBody, points: &[(f64, f64)]) -> Line {
+fn line<S: Shape>(b: &Body<S>, points: &[(f64, f64)]) -> Line {
     let mut by_family: BTreeMap<Family, Vec<Option<f64>>> = BTreeMap::new();
     let mut first_slot = Vec::new();
     let (mut count, mut families) = (Vec::new(), Vec::new());
@@ -112,7 +112,7 @@ fn jumps(values: &[Option<f64>], count: &[usize], factor: f64) -> Vec<(usize, f6
 }
 
 /// The energies of a body's lines: spread over U's range at κ = 0 and above its top.
-fn energies(b: &EllipsoidBody) -> Vec<f64> {
+fn energies<S: Shape>(b: &Body<S>) -> Vec<f64> {
     let potential = EffectivePotential::new(b, 0.0);
     let values: Vec<f64> = potential
         .critical_points()
@@ -130,63 +130,101 @@ fn energies(b: &EllipsoidBody) -> Vec<f64> {
         .collect()
 }
 
+/// Checks N of each family of `b` along κ- and ε-lines ([`energies`], five κ): a family is
+/// born or dies only where the number of tori changes, and its N does not jump. Returns the
+/// number of values judged and adds the families met to `seen`.
+fn check_lines<S: Shape>(
+    b: &Body<S>,
+    name: &str,
+    seen: &mut std::collections::BTreeSet<Family>,
+) -> usize {
+    const POINTS: usize = 240;
+    let mut judged = 0;
+    let mut lines: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+    for e in energies(b) {
+        let points = (0..POINTS)
+            .map(|i| (0.005 + 2.5 * i as f64 / (POINTS - 1) as f64, e))
+            .collect();
+        lines.push((format!("energy {e}"), points));
+    }
+    for kappa in [0.02, 0.2, 0.6, 1.0, 1.6] {
+        let bottom = EffectivePotential::new(b, kappa).lowest_minimum().unwrap();
+        let points = (0..POINTS)
+            .map(|i| (kappa, bottom + 1e-6 + 5.0 * i as f64 / (POINTS - 1) as f64))
+            .collect();
+        lines.push((format!("kappa {kappa}"), points));
+    }
+    for (line_name, points) in &lines {
+        let l = line(b, points);
+        // A family is born or dies only where the number of tori changes.
+        for i in 0..points.len() - 1 {
+            assert!(
+                l.families[i] == l.families[i + 1] || l.count[i] != l.count[i + 1],
+                "{name}, {line_name}: {:?} at {:?} becomes {:?} at {:?} with {} tori on both \
+                 sides",
+                l.families[i],
+                points[i],
+                l.families[i + 1],
+                points[i + 1],
+                l.count[i]
+            );
+        }
+        for (family, values) in &l.by_family {
+            seen.insert(*family);
+            judged += values.iter().flatten().count();
+            let found = jumps(values, &l.count, 6.0);
+            assert!(
+                found.is_empty(),
+                "{name}, {line_name}: N of {family} jumps at {:?}",
+                found
+                    .iter()
+                    .map(|&(i, a, c)| (points[i], a, c))
+                    .collect::<Vec<_>>()
+            );
+        }
+    }
+    judged
+}
+
 #[test]
 fn n_of_each_family_is_continuous_along_kappa_and_energy_lines() {
-    const POINTS: usize = 240;
     let mut judged = 0;
     let mut families_seen = std::collections::BTreeSet::new();
     for (alpha, beta) in BODIES {
-        let b = body(alpha, beta);
-        let mut lines: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
-        for e in energies(&b) {
-            let points = (0..POINTS)
-                .map(|i| (0.005 + 2.5 * i as f64 / (POINTS - 1) as f64, e))
-                .collect();
-            lines.push((format!("energy {e}"), points));
-        }
-        for kappa in [0.02, 0.2, 0.6, 1.0, 1.6] {
-            let bottom = EffectivePotential::new(&b, kappa).lowest_minimum().unwrap();
-            let points = (0..POINTS)
-                .map(|i| (kappa, bottom + 1e-6 + 5.0 * i as f64 / (POINTS - 1) as f64))
-                .collect();
-            lines.push((format!("kappa {kappa}"), points));
-        }
-        for (name, points) in &lines {
-            let l = line(&b, points);
-            // A family is born or dies only where the number of tori changes.
-            for i in 0..points.len() - 1 {
-                assert!(
-                    l.families[i] == l.families[i + 1] || l.count[i] != l.count[i + 1],
-                    "alpha {alpha} beta {beta}, {name}: {:?} at {:?} becomes {:?} at {:?} with \
-                     {} tori on both sides",
-                    l.families[i],
-                    points[i],
-                    l.families[i + 1],
-                    points[i + 1],
-                    l.count[i]
-                );
-            }
-            for (family, values) in &l.by_family {
-                families_seen.insert(*family);
-                judged += values.iter().flatten().count();
-                let found = jumps(values, &l.count, 6.0);
-                assert!(
-                    found.is_empty(),
-                    "alpha {alpha} beta {beta} ({:?}), {name}: N of {family} jumps at {:?}",
-                    DiagramType::of(alpha, beta),
-                    found
-                        .iter()
-                        .map(|&(i, a, c)| (points[i], a, c))
-                        .collect::<Vec<_>>()
-                );
-            }
-        }
+        let name = format!(
+            "alpha {alpha} beta {beta} ({:?})",
+            DiagramType::of(alpha, beta)
+        );
+        judged += check_lines(&body(alpha, beta), &name, &mut families_seen);
     }
     // Every family of a κ ≠ 0 level was on some line, with thousands of values judged.
     for f in [Family::Well0, Family::WellPi, Family::WellEquator] {
         assert!(families_seen.contains(&f), "{f} never seen");
     }
     assert!(judged > 12_000, "{judged}");
+}
+
+/// The same for the edged bodies (docs/bodies.md): N of a family stays continuous where a
+/// torus starts to cross a kink, and the symmetric wheel has its equator family.
+#[test]
+fn n_of_each_family_of_an_edged_body_is_continuous_along_lines() {
+    let mut judged = 0;
+    let mut families_seen = std::collections::BTreeSet::new();
+    for (shape, nu, eta) in [
+        (EdgedShape::disk(0.3).unwrap(), 2.0, 4.0),
+        (EdgedShape::truncated_ball(0.2, 0.4).unwrap(), 0.7, 1.3),
+        (EdgedShape::truncated_ball(-0.3, -0.5).unwrap(), 0.7, 1.3),
+        (EdgedShape::wheel(0.25, 0.7).unwrap(), 0.7, 1.3),
+        (EdgedShape::wheel(0.0, 0.5).unwrap(), 1.0, 2.0),
+    ] {
+        let name = format!("{shape:?}");
+        let b = Body::new(shape, nu, eta).unwrap();
+        judged += check_lines(&b, &name, &mut families_seen);
+    }
+    for f in [Family::Well0, Family::WellPi, Family::WellEquator] {
+        assert!(families_seen.contains(&f), "{f} never seen");
+    }
+    assert!(judged > 8_000, "{judged}");
 }
 
 #[test]
