@@ -183,9 +183,18 @@ pub(super) fn resonance(args: ResonanceArgs) -> Result<()> {
     );
     if curves.is_empty() {
         println!(
-            "  (no component reaches N = {target} in this window: the curve may lie beyond it; \
-             widen it with --kappa-max and --energy-max, or see where N takes this value with \
-             an atlas or `rubber-atlas verdict`)"
+            "  (no component reaches N = {target} on the seed grid of this window: the curve may \
+             lie beyond the window (widen it with --kappa-max and --energy-max), or between the \
+             grid's rows (kappa step {}, energy step {}: raise --grid); see where N takes this \
+             value with an atlas or `rubber-atlas verdict`)",
+            digits(
+                (options.kappa.1 - options.kappa.0) / (options.grid as f64 - 1.0),
+                3
+            ),
+            digits(
+                (options.energy.1 - options.energy.0) / (options.grid as f64 - 1.0),
+                3
+            )
         );
     }
     for (i, c) in curves.iter().enumerate() {
