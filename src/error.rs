@@ -144,7 +144,7 @@ pub(crate) fn check_kappa(kappa: f64) -> Result<f64> {
         return Err(AtlasError::InvalidParameter {
             name: "kappa",
             value: kappa,
-            reason: "is subnormal: give 0 or |kappa| >= 2.2e-308",
+            reason: "is subnormal: give 0 or |kappa| >= 2.2250738585072014e-308 (the least normal double)",
         });
     }
     Ok(kappa)

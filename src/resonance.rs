@@ -652,6 +652,13 @@ fn check_window(options: &ResonanceOptions) -> Result<()> {
             other => other,
         }
     };
+    if k0 < f64::MIN_POSITIVE {
+        return bad(
+            "kappa_min",
+            k0,
+            "must be at least 2.2250738585072014e-308 (the least normal double)",
+        );
+    }
     crate::error::check_kappa(k0).map_err(named("kappa_min"))?;
     crate::error::check_kappa(k1).map_err(named("kappa_max"))?;
     if !e0.is_finite() {
@@ -767,7 +774,17 @@ pub fn trace_curves_until<S: Shape>(
 /// refined by a golden-section search over ε of κ(ε), where κ(ε) solves N(κ, ε) = p/q. None
 /// if no curve is found, or if the curve of largest κ leaves the window through κ_max.
 pub fn fold<S: Shape>(body: &Body<S>, options: &ResonanceOptions) -> Result<Option<Fold>> {
-    let curves = trace_curves(body, options)?;
+    fold_until(body, options, &|| false)
+}
+
+/// [`fold`], given up when `stop` says so (asked while the curves are traced and at every
+/// step of the search): then [`AtlasError::Stopped`].
+pub fn fold_until<S: Shape>(
+    body: &Body<S>,
+    options: &ResonanceOptions,
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Result<Option<Fold>> {
+    let curves = trace_curves_until(body, options, stop)?;
     // The point of largest κ, with its neighbours on its curve.
     let Some((curve, index)) = curves
         .iter()
@@ -785,7 +802,7 @@ pub fn fold<S: Shape>(body: &Body<S>, options: &ResonanceOptions) -> Result<Opti
         body,
         options,
         scale: (window, options.energy.1 - options.energy.0),
-        stop: &|| false,
+        stop,
     };
     let tol = options.cell.tol.max(1e-13);
     // κ(ε) on the curve near the top: the root of N − p/q in κ nearest the last one (the
@@ -834,6 +851,9 @@ pub fn fold<S: Shape>(body: &Body<S>, options: &ResonanceOptions) -> Result<Opti
     let (mut c, mut d) = (b - ratio * (b - a), a + ratio * (b - a));
     let (mut fc, mut fd) = (value(c, &mut start), value(d, &mut start));
     while (b - a).abs() > 1e-9 * (1.0 + top.energy.abs()) {
+        if stop() {
+            return Err(AtlasError::Stopped);
+        }
         if fc > fd {
             b = d;
             d = c;

@@ -501,7 +501,7 @@ impl Scene {
                     "axes.lambda",
                     format!(
                         "lambda = {} at s = {} gives kappa = lambda/s = {}, below 2.2e-308 \
-                         (subnormal, or 0 by underflow): keep lambda/s at least 2.2e-308",
+                         (subnormal, or 0 by underflow): keep lambda/s at least 2.2250738585072014e-308",
                         show(lambda),
                         show(s),
                         show(lambda / s)
@@ -518,7 +518,7 @@ impl Scene {
             return Err(reader.error(
                 "axes.kappa",
                 format!(
-                    "a cell has kappa = {}, subnormal: give 0 or |kappa| >= 2.2e-308",
+                    "a cell has kappa = {}, subnormal: give 0 or |kappa| >= 2.2250738585072014e-308",
                     show(*least)
                 ),
             ));

@@ -256,6 +256,8 @@ fn write_csv(
     for (k, v) in &table.attributes {
         writeln!(w, "# {k}: {}", v.display().replace('\n', " ")).map_err(io)?;
     }
+    // The number of rows, last: a reader can tell a file cut short at a line's end.
+    writeln!(w, "# rows: {}", table.rows()).map_err(io)?;
     let mut csv = csv::Writer::from_writer(w);
     let text = |e: csv::Error| e.to_string();
     csv.write_record(table.columns.iter().map(|c| c.name))

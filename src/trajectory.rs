@@ -129,10 +129,22 @@ impl Start {
     ) -> Result<Component> {
         let energy = self.energy(potential.body);
         let comps = potential.components(energy)?;
-        let nearest = comps.into_iter().min_by(|a, b| {
-            a.distance_to(self.theta0)
-                .total_cmp(&b.distance_to(self.theta0))
-        });
+        // At κ = 0, θ is an angle on the circle: θ(0) and θ(0) − 2πk are one start (6.5 lies
+        // in the torus [−0.22, 0.22], not in the nearer [2.46, 3.83] of the lifted line).
+        let distance = |c: &Component| {
+            if self.kappa != 0.0 {
+                return c.distance_to(self.theta0);
+            }
+            let middle = 0.5 * (c.theta_min() + c.theta_max());
+            let turns = ((self.theta0 - middle) / std::f64::consts::TAU).round();
+            [turns - 1.0, turns, turns + 1.0]
+                .iter()
+                .map(|k| c.distance_to(self.theta0 - k * std::f64::consts::TAU))
+                .fold(f64::INFINITY, f64::min)
+        };
+        let nearest = comps
+            .into_iter()
+            .min_by(|a, b| distance(a).total_cmp(&distance(b)));
         nearest.ok_or(AtlasError::NotPeriodic {
             reason: "no component holds theta0",
         })

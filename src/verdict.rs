@@ -476,7 +476,12 @@ fn fold_windows(body: &EllipsoidBody, set: &CriticalSet) -> Vec<FoldWindow> {
 /// (N = 0, ∂N/∂ε = 0): M(κ) = max over ε of ±N(κ, ε) near the fold, and κ_max the root of
 /// M, by Illinois regula falsi (the final bracket and the solver's tolerance through dM/dκ
 /// bound the error).
-fn kappa_max(body: &EllipsoidBody, set: &CriticalSet, tol: f64) -> Result<Option<(f64, f64)>> {
+fn kappa_max(
+    body: &EllipsoidBody,
+    set: &CriticalSet,
+    tol: f64,
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Result<Option<(f64, f64)>> {
     let cell = CellOptions {
         tol,
         drift: false,
@@ -492,7 +497,7 @@ fn kappa_max(body: &EllipsoidBody, set: &CriticalSet, tol: f64) -> Result<Option
             max_points: 20_000,
             max_point_error: 1e-6,
         };
-        if let Some(fold) = resonance::fold(body, &options)? {
+        if let Some(fold) = resonance::fold_until(body, &options, stop)? {
             // Where the top is not a smooth fold (∂N/∂ε ≠ 0 there: the curve meets a
             // separatrix or turns at a corner) the traced top stands, with the relative
             // error CORNER_ERROR.
@@ -702,7 +707,7 @@ pub fn verdict_until(
     // The region of the hypothesis: κ > 0 (case 1) or κ > κ_max (case 2).
     let mut undecided = None;
     let lo = match case {
-        Case::Two => match kappa_max(body, &set, options.tol)? {
+        Case::Two => match kappa_max(body, &set, options.tol, stop)? {
             Some((k, err)) if k.is_finite() && err.is_finite() => {
                 verdict.kappa_max = Some(k);
                 verdict.kappa_max_error = Some(err);

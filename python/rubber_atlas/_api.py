@@ -488,7 +488,7 @@ def _to_kappa_energy(plane: tuple[str, str], flat: list[np.ndarray], shape: str 
         with np.errstate(over="ignore", divide="ignore", under="ignore"):
             kappa = a / b
             _first_bad("lambda", a, (a > 0) & (kappa < 2.2250738585072014e-308),
-                       "lambda / s is below 2.2e-308 (subnormal, or 0 by underflow): keep it at least 2.2e-308")
+                       "lambda / s is below 2.2250738585072014e-308 (subnormal, or 0 by underflow): keep it at least that")
             return flat[:4] + [kappa, 1.0 / (b * b)]
     return flat[:4] + [a, _excess_to_energy(*flat[:4], a, b, shape=shape)]
 
@@ -968,7 +968,8 @@ def open_atlas(path: str | Path, check: bool = False, **kwargs) -> xr.Dataset:
         Read every stored value once, chunk by chunk, before returning, and refuse a file
         whose values cannot all be read (a corrupted chunk) with a ValueError naming the
         variable. It reads the whole file (about as long as ``.load()``; its memory stays at
-        one chunk). It finds what HDF5 cannot decode, not every changed byte: the file has no
+        one chunk), first in a child process (some damaged headers crash HDF5 itself; the
+        check then raises instead). It finds what HDF5 cannot decode, not every changed byte: the file has no
         checksums, so a byte changed inside an uncompressed coordinate (α, β) or an
         attribute reads as another value.
     **kwargs
@@ -1032,6 +1033,8 @@ def open_atlas(path: str | Path, check: bool = False, **kwargs) -> xr.Dataset:
     if path.name.endswith(".partial.h5"):
         raise ValueError(f"{path}: an unfinished run's file; resume the run with --resume")
     check = _switch("check", check)
+    if check:
+        _survives_reading(path)
     kwargs.setdefault("engine", "h5netcdf")
     try:
         ds = xr.open_dataset(path, **kwargs)
@@ -1054,6 +1057,26 @@ def open_atlas(path: str | Path, check: bool = False, **kwargs) -> xr.Dataset:
             ds.close()
             raise
     return ds
+
+
+def _survives_reading(path: Path) -> None:
+    """Opens `path` as open_atlas does and reads every chunk, in a child process first: some
+    damaged headers crash HDF5 itself (a segmentation fault in h5py's dimension scales), which
+    would end this process. A crash is a ValueError naming the file."""
+    import subprocess
+
+    code = ("import sys, xarray as xr\n"
+            "from rubber_atlas._api import _read_every_chunk\n"
+            "from pathlib import Path\n"
+            "try:\n"
+            "    xr.open_dataset(sys.argv[1], engine='h5netcdf').close()\n"
+            "    _read_every_chunk(Path(sys.argv[1]))\n"
+            "except Exception:\n"
+            "    pass\n")
+    done = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True)
+    if done.returncode < 0:
+        raise ValueError(f"{path}: the file is damaged: reading it crashed HDF5 (signal {-done.returncode}); "
+                         "compute it again")
 
 
 def _read_every_chunk(path: Path) -> None:
@@ -1363,7 +1386,23 @@ def _read_csv(path: Path) -> xr.Dataset:
                 attrs[key] = float(value)
             except ValueError:
                 attrs[key] = value
+    # A rubber-atlas table names its program, ends with a newline and (since the row count
+    # was added) says how many rows it has: a foreign or cut-short file is refused.
+    if attrs.get("program") != "rubber-atlas":
+        raise ValueError(f"{path}: not a rubber-atlas table (its header has no '# program: rubber-atlas' line)")
+    with path.open("rb") as f:
+        f.seek(0, 2)
+        size = f.tell()
+        f.seek(max(size - 1, 0))
+        if size == 0 or f.read(1) != b"\n":
+            raise ValueError(f"{path}: the table is cut short (its last line is not complete); write it again")
+    rows = attrs.pop("rows", None)
     frame = pd.read_csv(path, comment="#")
+    if rows is not None and len(frame) != rows:
+        raise ValueError(f"{path}: the table is cut short or damaged: {len(frame)} rows where its header "
+                         f"says {rows:.0f}; write it again")
+    if len(frame) == 0:
+        frame = frame.astype(np.float64)
     dim = frame.columns[0]
     ds = xr.Dataset.from_dataframe(frame.set_index(dim))
     ds.attrs.update(attrs)

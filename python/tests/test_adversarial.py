@@ -15,6 +15,7 @@ import pytest
 import xarray as xr
 
 import rubber_atlas as ra
+from conftest import run
 
 BODY = (0.5, 3.0, 0.5, 0.5)
 ATLAS_BODY = dict(alpha=0.5, beta=3.0)
@@ -392,7 +393,32 @@ def test_fifth_round_the_lambda_s_plane_is_held_to_the_scenes_rules():
     "invalid energy = NaN"."""
     refused(ValueError, lambda: ra.cells(*BODY, lambda_=-0.5, s=0.5, progress=False), "lambda", ">= 0")
     refused(ValueError, lambda: ra.cells(*BODY, lambda_=0.5, s=9.99e-151, progress=False), "s", "1e300")
-    refused(ValueError, lambda: ra.cells(*BODY, lambda_=1e-300, s=1e150, progress=False), "lambda", "2.2e-308")
+    refused(ValueError, lambda: ra.cells(*BODY, lambda_=1e-300, s=1e150, progress=False), "lambda", "2.2250738585072014e-308")
     refused(ValueError, lambda: ra.cells(*BODY, kappa=1.0, energy=1e308, progress=False), "energy", "1e300")
     t = ra.trajectory(*BODY, kappa=1e-200, energy=2.5, periods=1, samples=10, model="full")
     assert t.sizes["t"] == 11
+
+
+def test_read_table_refuses_a_foreign_or_cut_short_csv(tmp_path):
+    """Issue 22, second pass: a CSV cut mid-row or after its header, and a foreign CSV, were
+    read as tables (NaN-filled rows, object columns)."""
+    whole = tmp_path / "r.csv"
+    run("resonance", "--alpha", "0.5", "--beta", "3", "--nu", "0.5", "--eta", "0.5", "--rotation-number", "-1/7",
+        "--grid", "12", "--out", whole)
+    table = ra.read_table(whole)
+    assert table.sizes["sample"] > 5 and "rows" not in table.attrs
+    text = whole.read_text()
+    cut_mid_row = tmp_path / "mid.csv"
+    cut_mid_row.write_text(text[: len(text) - 7])
+    refused(ValueError, lambda: ra.read_table(cut_mid_row), "cut short")
+    lines = text.splitlines(keepends=True)
+    cut_at_row = tmp_path / "row.csv"
+    cut_at_row.write_text("".join(lines[:-3]))
+    refused(ValueError, lambda: ra.read_table(cut_at_row), "rows")
+    header_only = tmp_path / "header.csv"
+    header_only.write_text("".join(line for line in lines if line.startswith("#")) + lines[
+        next(i for i, line in enumerate(lines) if not line.startswith("#"))])
+    refused(ValueError, lambda: ra.read_table(header_only), "rows")
+    foreign = tmp_path / "foreign.csv"
+    foreign.write_text("a,b\n1,2\n")
+    refused(ValueError, lambda: ra.read_table(foreign), "not a rubber-atlas table")

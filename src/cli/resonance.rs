@@ -119,7 +119,11 @@ pub(super) fn resonance(args: ResonanceArgs) -> Result<()> {
         header[key] = value;
     }
     if args.fold {
-        let fold = rubber_atlas::with_body!(&body, b => resonance::fold(b, &options))?;
+        let fold = rubber_atlas::with_body!(&body, b => resonance::fold_until(
+            b,
+            &options,
+            &crate::stop::requested
+        ))?;
         let mut value = header;
         match fold {
             Some(f) => {

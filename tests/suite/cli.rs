@@ -1004,7 +1004,21 @@ fn the_long_commands_stop_on_a_signal_in_one_line_writing_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("t.csv");
     let body = ["--alpha", "0.5", "--nu", "0.5", "--eta", "0.5"];
-    let commands: [(Vec<&str>, i32, i32); 3] = [
+    let commands: [(Vec<&str>, i32, i32); 4] = [
+        (
+            vec![
+                "resonance",
+                "--beta",
+                "3",
+                "--rotation-number",
+                "0",
+                "--fold",
+                "--grid",
+                "2000",
+            ],
+            libc::SIGINT,
+            130,
+        ),
         (
             vec![
                 "trajectory",

@@ -9,7 +9,7 @@ use proptest::test_runner::RngSeed;
 use rubber_atlas::cell::{solve_cell, CellOptions, Status};
 use rubber_atlas::limits::high_energy_rotation_number;
 use rubber_atlas::torus::MotionKind;
-use rubber_atlas::trajectory::{Duration, Model, Request, StartAt};
+use rubber_atlas::trajectory::{Duration, Model, Request, Start, StartAt};
 use rubber_atlas::verdict::{self, verdict, verdict_until, BoundaryOptions, VerdictOptions};
 use rubber_atlas::{AtlasError, EllipsoidBody};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -380,4 +380,49 @@ fn turning_points_far_out_and_the_trajectories_from_them() {
     // Asked to stop, it stops (Ctrl-C in Python).
     let stopped = request(2.5, Model::Full).run_until(&body, &|| true);
     assert_eq!(stopped.unwrap_err(), AtlasError::Stopped);
+}
+
+/// At κ = 0, θ(0) is an angle on the circle: a start at 6.5 lies in the torus about θ = 0
+/// (it took the torus about π, the nearer on the lifted line, and ran a trajectory for the
+/// wrong period), and one period of the trajectory brings θ back to 6.5.
+#[test]
+fn a_start_beyond_two_pi_at_kappa_zero_is_on_its_own_torus() {
+    let body = EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 0.5).unwrap();
+    let potential = rubber_atlas::torus::EffectivePotential::new(&body, 0.0);
+    use std::f64::consts::TAU;
+    for (theta0, equivalent) in [
+        (6.5, 6.5 - TAU),
+        (100.0, 100.0 - 16.0 * TAU),
+        (-5.566, -5.566 + TAU),
+    ] {
+        let at = |t: f64| {
+            Start {
+                kappa: 0.0,
+                theta0: t,
+                theta_dot0: 0.0,
+            }
+            .component_in(&potential)
+            .unwrap()
+        };
+        let (got, want) = (at(theta0), at(equivalent));
+        assert_eq!(got.family, want.family, "{theta0}");
+        assert!(
+            (got.theta_min() - want.theta_min()).abs() < 1e-12,
+            "{theta0}"
+        );
+    }
+    let request = Request {
+        kappa: 0.0,
+        start: StartAt::Angle {
+            theta0: 6.5,
+            theta_dot0: 0.0,
+        },
+        duration: Duration::Periods(1.0),
+        samples: 4,
+        model: Model::Reduced,
+        tol: 1e-12,
+    };
+    let (_, traj) = request.run(&body).unwrap();
+    let end = *traj.theta.last().unwrap();
+    assert!((end - 6.5).abs() < 1e-8, "theta ends at {end}");
 }
