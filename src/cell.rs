@@ -867,7 +867,7 @@ fn drift_radius(drift: f64, drift_error: f64, n: f64, n_error: f64) -> (f64, f64
 /// A maximum inside the component or at one of its ends whose computed level is ε itself.
 /// A level a few ulps off is integrated like any other: its orbit is real, and the saddle's
 /// conditioning (ulp(V_s)/(λ |ε − V_s|) per passage) says how little its values are worth.
-fn separatrix(component: &Component, energy: f64) -> Option<CriticalPoint> {
+pub(crate) fn separatrix(component: &Component, energy: f64) -> Option<CriticalPoint> {
     component
         .interior
         .iter()

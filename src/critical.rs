@@ -441,9 +441,14 @@ fn equator_branches(
 ) -> Result<Vec<Branch>> {
     let mut branches = Vec::new();
     let mut run: Vec<FixedPoint> = Vec::new();
-    let push_point = |kappa: f64, run: &mut Vec<FixedPoint>, force: Option<bool>| {
+    // The stability at κ; where V″(π/2) vanishes at κ = 0 because U″(π/2) does (the sphere,
+    // U ≡ 1), the branch's: stable for every κ > 0 (it was labelled unstable whole).
+    let stable_at = |kappa: f64| {
         let v2 = kappa * kappa + curvature;
-        let stable = force.unwrap_or(v2 > 0.0);
+        v2 > 0.0 || (v2 == 0.0 && curvature == 0.0)
+    };
+    let push_point = |kappa: f64, run: &mut Vec<FixedPoint>, force: Option<bool>| {
+        let stable = force.unwrap_or(stable_at(kappa));
         run.push(FixedPoint {
             theta0: FRAC_PI_2,
             kappa,
@@ -458,7 +463,7 @@ fn equator_branches(
     for i in 0..=samples {
         stopped(i)?;
         let kappa = kappa_max * i as f64 / samples as f64;
-        let stable = kappa * kappa + curvature > 0.0;
+        let stable = stable_at(kappa);
         let last_stable = run.last().map(|p| p.stable);
         if let (Some(kc), Some(last_stable)) = (kappa_c, last_stable) {
             if last_stable != stable {

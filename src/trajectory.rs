@@ -158,10 +158,15 @@ impl Start {
                 reason: "the start is a fixed point (a permanent rotation); give --t-end",
             });
         }
+        let energy = self.energy(body);
+        if crate::cell::separatrix(&comp, energy).is_some() {
+            return Err(AtlasError::NotPeriodic {
+                reason: "the start is on a separatrix (an unstable equilibrium or an orbit \
+                         asymptotic to one): its period is infinite; give --t-end",
+            });
+        }
         let potential = EffectivePotential::new(body, self.kappa);
-        Ok(potential
-            .integrate(self.energy(body), &comp, tol, false)?
-            .period)
+        Ok(potential.integrate(energy, &comp, tol, false)?.period)
     }
 }
 
@@ -357,13 +362,24 @@ pub fn integrate<S: Shape>(
     match model {
         Model::Reduced => {
             let sys = ReducedSystem::new(body, start.kappa);
-            let y0 = ReducedState::from([start.theta0, start.theta_dot0, 0.0, 0.0, 0.0, 0.0]);
+            // At κ = 0, θ is an angle on the circle: integrated from θ(0) taken within π of
+            // 0 (a start at θ(0) = 1e10 kept no digit of the motion) and shifted back.
+            // (atan2 of its sine and cosine is that angle to the last bit: their argument
+            // reduction is exact, θ(0) − 2πk in doubles is not.)
+            let theta0 = if start.kappa == 0.0 && start.theta0.abs() > std::f64::consts::PI {
+                let (s, c) = start.theta0.sin_cos();
+                s.atan2(c)
+            } else {
+                start.theta0
+            };
+            let shift = start.theta0 - theta0;
+            let y0 = ReducedState::from([theta0, start.theta_dot0, 0.0, 0.0, 0.0, 0.0]);
             let sol = integrate_sampled(&sys, y0, t_end, samples, tol, stop)?;
             for (t, y) in sol.times.iter().zip(&sol.states) {
                 energies.push(sys.energy(y[0], y[1]));
                 let (dx, dy) = sys.contact_offset(y[0], y[3]);
                 out.t.push(*t);
-                out.theta.push(y[0]);
+                out.theta.push(y[0] + shift);
                 out.theta_dot.push(y[1]);
                 out.phi.push(y[2]);
                 out.psi.push(y[3]);

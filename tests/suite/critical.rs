@@ -334,3 +334,19 @@ fn a_negative_alpha_diagram_is_the_mirror_image_and_holds_on_its_own_body() {
         }
     }
 }
+
+/// The homogeneous ball (α = 0, β = 1: U ≡ 1) has V″(π/2) = κ² > 0: its equator branch is
+/// stable at every κ > 0 (it was labelled unstable, as V″ vanishes at κ = 0 alone).
+#[test]
+fn the_spheres_equator_is_stable_at_every_kappa() {
+    let b = EllipsoidBody::ellipsoid(0.0, 1.0, 0.5, 0.5).unwrap();
+    let set = CriticalSet::of(&b, 200, 3.0).unwrap();
+    let equator: Vec<_> = set
+        .branches
+        .iter()
+        .filter(|branch| branch.name == "sigma_pi2")
+        .collect();
+    assert_eq!(equator.len(), 1, "{equator:?}");
+    assert!(equator[0].stable);
+    assert!(equator[0].points.iter().all(|p| p.stable));
+}

@@ -425,4 +425,60 @@ fn a_start_beyond_two_pi_at_kappa_zero_is_on_its_own_torus() {
     let (_, traj) = request.run(&body).unwrap();
     let end = *traj.theta.last().unwrap();
     assert!((end - 6.5).abs() < 1e-8, "theta ends at {end}");
+    // The reduced model integrates the angle within π of 0 and shifts it back: a start at
+    // 1e10 failed or ran on with no digit of the motion left.
+    for theta0 in [1e10, -1e17] {
+        let far = Request {
+            start: StartAt::Angle {
+                theta0,
+                theta_dot0: 0.0,
+            },
+            ..request
+        };
+        let (_, traj) = far.run(&body).unwrap();
+        assert!(
+            traj.energy_drift < 1e-10,
+            "{theta0:e}: {}",
+            traj.energy_drift
+        );
+        assert_eq!(*traj.theta.last().unwrap(), theta0);
+    }
+}
+
+/// A start at an unstable equilibrium (θ* of type (c) at κ = 0) has an infinite period:
+/// `--periods` is refused saying so (it said "a quadrature node fell outside the allowed
+/// set"), and `--t-end` runs it.
+#[test]
+fn a_start_on_a_separatrix_has_no_period_and_says_so() {
+    use rubber_atlas::torus::{CriticalKind, EffectivePotential};
+    let body = EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 0.5).unwrap();
+    let potential = EffectivePotential::new(&body, 0.0);
+    let top = potential
+        .critical_points()
+        .iter()
+        .find(|p| p.kind != CriticalKind::Minimum && p.site.theta > 0.1 && p.site.theta < 3.0)
+        .expect("theta* of type (c)");
+    let start = Start {
+        kappa: 0.0,
+        theta0: top.site.theta,
+        theta_dot0: 0.0,
+    };
+    match start.period(&body, 1e-10) {
+        Err(AtlasError::NotPeriodic { reason }) => {
+            assert!(reason.contains("separatrix"), "{reason}")
+        }
+        other => panic!("{other:?}"),
+    }
+    let request = Request {
+        kappa: 0.0,
+        start: StartAt::Angle {
+            theta0: top.site.theta,
+            theta_dot0: 0.0,
+        },
+        duration: Duration::Until(1.0),
+        samples: 4,
+        model: Model::Reduced,
+        tol: 1e-12,
+    };
+    assert!(request.run(&body).is_ok());
 }
