@@ -811,7 +811,7 @@ fn unresolved(component: &Component) -> ComponentResult {
         rotation_number: f64::INFINITY,
         drift: f64::INFINITY,
         drift_radius: f64::INFINITY,
-        drift_vector: f64::NAN,
+        drift_vector: f64::INFINITY,
     };
     ComponentResult {
         theta_min: component.theta_min(),

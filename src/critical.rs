@@ -799,19 +799,13 @@ fn asked_to_stop(i: usize, stop: &dyn Fn() -> bool) -> Result<()> {
 
 /// κ_max must be a finite number > 0.
 fn check_kappa_max(kappa_max: f64) -> Result<()> {
-    if !(kappa_max.is_finite() && kappa_max > 0.0) {
-        return Err(AtlasError::InvalidParameter {
-            name: "kappa-max",
-            value: kappa_max,
-            reason: "must be a finite number > 0",
-        });
-    }
-    // κ's range of every surface.
-    crate::error::check_kappa(kappa_max)
-        .map(|_| ())
-        .map_err(|_| AtlasError::InvalidParameter {
-            name: "kappa-max",
-            value: kappa_max,
-            reason: "must be at most 1e150 and at least 2.2e-308 (kappa's range)",
-        })
+    // κ's range of every surface, without 0.
+    crate::error::check_range(
+        "kappa-max",
+        kappa_max,
+        Some((f64::MIN_POSITIVE, true)),
+        Some((crate::error::MAX_KAPPA, true)),
+        "must be at most 1e150 and at least 2.2250738585072014e-308 (kappa's range)",
+    )
+    .map(|_| ())
 }

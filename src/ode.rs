@@ -58,21 +58,20 @@ pub fn run_dop853<const N: usize, F: System<f64, SVector<f64, N>>>(
         1000,
         OutputType::Sparse,
     );
-    let steps = match solver.integrate() {
-        Ok(stats) => stats.accepted_steps as usize,
-        Err(ode_solvers::dop_shared::IntegrationError::MaxNumStepReached { n_step, .. })
-            if max_steps != u32::MAX =>
-        {
-            n_step as usize
-        }
-        Err(e) => {
-            use ode_solvers::dop_shared::IntegrationError as Stop;
-            let (time, reason) = match e {
+    let steps =
+        match solver.integrate() {
+            Ok(stats) => stats.accepted_steps as usize,
+            Err(ode_solvers::dop_shared::IntegrationError::MaxNumStepReached {
+                n_step, ..
+            }) if max_steps != u32::MAX => n_step as usize,
+            Err(e) => {
+                use ode_solvers::dop_shared::IntegrationError as Stop;
+                let (time, reason) = match e {
                     Stop::StepSizeUnderflow { x } => (
                         x,
-                        "the step fell below the rounding of t: the motion is too fast there for \
-                         this tolerance (near a pole at high energy or tiny kappa; the full model may still \
-                         resolve it)"
+                        "the step fell below the rounding of t: the motion is too fast there \
+                         for this tolerance (near a pole at high energy or tiny kappa; the \
+                         full model may still resolve it)"
                             .to_string(),
                     ),
                     Stop::StiffnessDetected { x } => (x, "the equations became stiff".to_string()),
@@ -80,9 +79,9 @@ pub fn run_dop853<const N: usize, F: System<f64, SVector<f64, N>>>(
                         (x, format!("more than {n_step} steps were needed"))
                     }
                 };
-            return Err(AtlasError::Integration { time, reason });
-        }
-    };
+                return Err(AtlasError::Integration { time, reason });
+            }
+        };
     let (ts, ys) = (solver.x_out(), solver.y_out());
     let (Some(&t_last), Some(y_last)) = (ts.last(), ys.last()) else {
         return Err(AtlasError::Integration {

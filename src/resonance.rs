@@ -6,7 +6,7 @@
 
 use crate::body::Shape;
 use crate::cell::{solve_component, within_rounding_of_separatrix, CellOptions, Status};
-use crate::error::{AtlasError, Result};
+use crate::error::{check_range, AtlasError, Result, MAX_ENERGY, MAX_KAPPA};
 use crate::torus::{CriticalKind, EffectivePotential, MotionKind};
 use crate::Body;
 use serde::Serialize;
@@ -642,16 +642,6 @@ fn check_window(options: &ResonanceOptions) -> Result<()> {
         return bad("kappa_max", k1, "must be finite and above kappa_min");
     }
     // κ's and ε's ranges of every surface: the window's corners are cells.
-    let named = |name: &'static str| {
-        move |e: AtlasError| match e {
-            AtlasError::InvalidParameter { value, reason, .. } => AtlasError::InvalidParameter {
-                name,
-                value,
-                reason,
-            },
-            other => other,
-        }
-    };
     if k0 < f64::MIN_POSITIVE {
         return bad(
             "kappa_min",
@@ -659,16 +649,22 @@ fn check_window(options: &ResonanceOptions) -> Result<()> {
             "must be at least 2.2250738585072014e-308 (the least normal double)",
         );
     }
-    crate::error::check_kappa(k0).map_err(named("kappa_min"))?;
-    crate::error::check_kappa(k1).map_err(named("kappa_max"))?;
-    if !e0.is_finite() {
-        return bad("energy_min", e0, "must be finite");
+    if k1 > MAX_KAPPA {
+        return bad(
+            "kappa_max",
+            k1,
+            "must be at most 1e150 (kappa^2 would overflow)",
+        );
     }
-    if !e1.is_finite() {
-        return bad("energy_max", e1, "must be finite and above energy_min");
+    for (name, e) in [("energy_min", e0), ("energy_max", e1)] {
+        check_range(
+            name,
+            e,
+            Some((-MAX_ENERGY, true)),
+            Some((MAX_ENERGY, true)),
+            "must be finite and at most 1e300 in size",
+        )?;
     }
-    crate::error::check_energy(e0).map_err(named("energy_min"))?;
-    crate::error::check_energy(e1).map_err(named("energy_max"))?;
     if e1 <= e0 {
         // Name both: energy_min may be the window's bottom of V, not a value the user gave.
         return Err(AtlasError::Atlas {

@@ -231,12 +231,14 @@ pub fn write_table_until(path: &Path, table: &Table, stop: &dyn Fn() -> bool) ->
         #[cfg(not(feature = "hdf5"))]
         TableFormat::Hdf5 => Err("built without the hdf5 feature: write .csv".to_string()),
     };
-    if written.is_err() || stop() {
+    let failed = match (written, stop()) {
+        (_, true) => Some(AtlasError::Stopped),
+        (Err(e), false) => Some(output_error(path, e)),
+        (Ok(()), false) => None,
+    };
+    if let Some(e) = failed {
         let _ = std::fs::remove_file(&tmp);
-        return Err(match written {
-            Err(e) if !stop() => output_error(path, e),
-            _ => AtlasError::Stopped,
-        });
+        return Err(e);
     }
     std::fs::rename(&tmp, path).map_err(|e| {
         let _ = std::fs::remove_file(&tmp);

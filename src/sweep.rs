@@ -208,6 +208,7 @@ pub struct Footprint {
 /// The [`Footprint`] of running `shard` of `scene` on `threads` threads.
 pub fn footprint(scene: &Scene, shard: Shard, threads: usize) -> Footprint {
     let shape = scene.shape();
+    // In floating point: the grid may be too large for its unit count to fit a usize.
     let [na, nb, nk, ne] = shape.map(|n| n as f64);
     let rows = atlas::rows_per_unit(shape) as f64;
     let betas = atlas::betas_per_unit(shape) as f64;

@@ -130,16 +130,16 @@ impl Start {
         let energy = self.energy(potential.body);
         let comps = potential.components(energy)?;
         // At κ = 0, θ is an angle on the circle: θ(0) and θ(0) − 2πk are one start (6.5 lies
-        // in the torus [−0.22, 0.22], not in the nearer [2.46, 3.83] of the lifted line).
+        // in the torus [−0.22, 0.22], not in the nearer [2.46, 3.83] of the lifted line). The
+        // components of the lifted circle lie within [−2π, 3π].
+        let theta0 = self.circle_angle();
         let distance = |c: &Component| {
             if self.kappa != 0.0 {
-                return c.distance_to(self.theta0);
+                return c.distance_to(theta0);
             }
-            let middle = 0.5 * (c.theta_min() + c.theta_max());
-            let turns = ((self.theta0 - middle) / std::f64::consts::TAU).round();
-            [turns - 1.0, turns, turns + 1.0]
+            [-1.0, 0.0, 1.0]
                 .iter()
-                .map(|k| c.distance_to(self.theta0 - k * std::f64::consts::TAU))
+                .map(|k| c.distance_to(theta0 + k * std::f64::consts::TAU))
                 .fold(f64::INFINITY, f64::min)
         };
         let nearest = comps
@@ -148,6 +148,18 @@ impl Start {
         nearest.ok_or(AtlasError::NotPeriodic {
             reason: "no component holds theta0",
         })
+    }
+
+    /// θ(0), at κ = 0 (θ an angle on the circle) taken within π of 0 when it lies beyond:
+    /// atan2 of its sine and cosine is that angle to the last bit (their argument reduction
+    /// is exact; θ(0) − 2πk in doubles is not, and at θ(0) = 1e10 kept no digit).
+    fn circle_angle(&self) -> f64 {
+        if self.kappa == 0.0 && self.theta0.abs() > std::f64::consts::PI {
+            let (s, c) = self.theta0.sin_cos();
+            s.atan2(c)
+        } else {
+            self.theta0
+        }
     }
 
     /// The θ-period of the component that holds θ(0), from the quadrature of [`crate::torus`].
@@ -362,16 +374,8 @@ pub fn integrate<S: Shape>(
     match model {
         Model::Reduced => {
             let sys = ReducedSystem::new(body, start.kappa);
-            // At κ = 0, θ is an angle on the circle: integrated from θ(0) taken within π of
-            // 0 (a start at θ(0) = 1e10 kept no digit of the motion) and shifted back.
-            // (atan2 of its sine and cosine is that angle to the last bit: their argument
-            // reduction is exact, θ(0) − 2πk in doubles is not.)
-            let theta0 = if start.kappa == 0.0 && start.theta0.abs() > std::f64::consts::PI {
-                let (s, c) = start.theta0.sin_cos();
-                s.atan2(c)
-            } else {
-                start.theta0
-            };
+            // Integrated from θ(0) on the circle ([`Start::circle_angle`]), shifted back.
+            let theta0 = start.circle_angle();
             let shift = start.theta0 - theta0;
             let y0 = ReducedState::from([theta0, start.theta_dot0, 0.0, 0.0, 0.0, 0.0]);
             let sol = integrate_sampled(&sys, y0, t_end, samples, tol, stop)?;

@@ -458,16 +458,19 @@ def _shape_inputs(shape: str, beta, cut) -> dict:
     return {"cut": cut}
 
 
-def _one_body(shape, alpha, beta, nu, eta, cut) -> tuple[dict, str, dict, list]:
-    """The checked numbers of one body, the shape's name, and the keywords the core takes: the
-    ellipsoid's (alpha, beta, nu, eta), or an edged body's with its cut in beta's place."""
+def _one_body(shape, alpha, beta, nu, eta, cut) -> tuple[dict, str, dict, list, dict]:
+    """The checked numbers of one body, the shape's name, the keywords the core takes, the
+    core's positional numbers (the ellipsoid's alpha, beta, nu, eta, or an edged body's with
+    its cut in beta's place), and the call's own keywords for the body beside alpha (beta, or
+    shape and cut) as the caller gave them."""
     shape = _text("shape", shape, '"ellipsoid", "disk", "truncated_ball" or "wheel"')
     second = _shape_inputs(shape, beta, cut)
     body = _reals(alpha=alpha, **second, nu=nu, eta=eta)
     values = list(body.values())
     if shape == "disk":
         values.insert(1, 0.0)
-    return body, shape, ({"shape": shape} if shape != "ellipsoid" else {}), values
+    extra = {"shape": shape} if shape != "ellipsoid" else {}
+    return body, shape, extra, values, {**extra, **second}
 
 
 def _to_kappa_energy(plane: tuple[str, str], flat: list[np.ndarray], shape: str = "ellipsoid") -> list[np.ndarray]:
@@ -1462,11 +1465,10 @@ def diagram(alpha: float, beta: float | None, nu: float = 0.5, eta: float = 0.5,
     >>> summary["diagram_type"], round(summary["energy_min"], 5)
     ('c', 3.04651)
     """
-    body, shape, extra, values = _one_body(shape, alpha, beta, nu, eta, cut)
+    body, shape, extra, values, named = _one_body(shape, alpha, beta, nu, eta, cut)
     table, summary = _core.diagram(*values, _count("samples", samples), _real("kappa_max", kappa_max),
                                    _switch("allow_large", allow_large), **extra)
-    arguments = dict(alpha=alpha, **({} if extra else dict(beta=beta)), nu=nu, eta=eta, samples=samples,
-                     kappa_max=kappa_max, **extra, **({"cut": cut} if cut is not None else {}))
+    arguments = dict(alpha=alpha, **named, nu=nu, eta=eta, samples=samples, kappa_max=kappa_max)
     attrs = _root_attrs("diagram", arguments, **extra, **body, critical_set_json=summary)
     return _table(table, attrs)
 
@@ -1543,7 +1545,7 @@ def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, e
     >>> round(float(t.theta[0]), 4) == round(float(t.attrs["theta0"]), 4)
     True
     """
-    body, shape, extra, values = _one_body(shape, alpha, beta, nu, eta, cut)
+    body, shape, extra, values, named = _one_body(shape, alpha, beta, nu, eta, cut)
     tol = _real("tol", tol)
     # As the command: each start option goes with its start (it used to be ignored silently).
     if energy is not None and theta_dot0 is not None:
@@ -1557,9 +1559,9 @@ def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, e
         _optional_real("theta0", theta0), _real("theta_dot0", theta_dot0), _optional_real("periods", periods),
         _optional_real("t_end", t_end), _count("samples", samples), _text("model", model, '"reduced" or "full"'), tol,
         _switch("allow_large", allow_large), **extra)
-    arguments = dict(alpha=alpha, **({} if extra else dict(beta=beta)), nu=nu, eta=eta, kappa=kappa, energy=energy,
-                     component=component, theta0=theta0, theta_dot0=theta_dot0, periods=periods, t_end=t_end,
-                     samples=samples, model=model, tol=tol, **extra, **({"cut": cut} if cut is not None else {}))
+    arguments = dict(alpha=alpha, **named, nu=nu, eta=eta, kappa=kappa, energy=energy, component=component,
+                     theta0=theta0, theta_dot0=theta_dot0, periods=periods, t_end=t_end, samples=samples,
+                     model=model, tol=tol)
     attrs = _root_attrs("trajectory", arguments, model=str(model), **extra, **body,
                         kappa=k, energy=e, theta0=t0, theta_dot0=td0, tolerance=tol, energy_drift=drift)
     return _table(table, attrs)
@@ -1637,16 +1639,15 @@ def resonance(alpha: float, beta: float, nu: float, eta: float, rotation_number,
     ('truncated_ball', True)
     """
     target = _rotation_number(rotation_number)
-    body, shape, extra, values = _one_body(shape, alpha, beta, nu, eta, cut)
+    body, shape, extra, values, named = _one_body(shape, alpha, beta, nu, eta, cut)
     window = _reals(kappa_min=kappa_min, kappa_max=kappa_max, energy_max=energy_max)
     tol = _real("tol", tol)
     table, e_min = _core.resonance(*values, target, window["kappa_min"], window["kappa_max"],
                                    _optional_real("energy_min", energy_min), window["energy_max"],
                                    _count("grid", grid), tol, **extra)
-    arguments = dict(alpha=alpha, **({} if extra else dict(beta=beta)), nu=nu, eta=eta,
-                     rotation_number=rotation_number, kappa_min=kappa_min, kappa_max=kappa_max,
-                     energy_min=energy_min, energy_max=energy_max, grid=grid, tol=tol, **extra,
-                     **({"cut": cut} if cut is not None else {}))
+    arguments = dict(alpha=alpha, **named, nu=nu, eta=eta, rotation_number=rotation_number,
+                     kappa_min=kappa_min, kappa_max=kappa_max, energy_min=energy_min, energy_max=energy_max,
+                     grid=grid, tol=tol)
     attrs = _root_attrs("resonance", arguments, **extra, **body, rotation_number=target, tolerance=tol,
                         kappa_window=np.array([window["kappa_min"], window["kappa_max"]], dtype=float),
                         energy_window=np.array([e_min, window["energy_max"]], dtype=float))
