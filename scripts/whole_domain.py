@@ -147,6 +147,9 @@ class Outcome:
     worst_ratio: float = 0.0
     # Whether ε lies within rounding of a critical level (component count not checked).
     ambiguous: bool = False
+    # (status, estimate / true error, whether the true error meets the tolerance) for every
+    # T and N compared (T relative), for the sharpness of the estimates.
+    sharpness: list = field(default_factory=list)
 
 
 def _loguniform(rng: random.Random, lo: float, hi: float) -> float:
@@ -251,10 +254,10 @@ def reproductions() -> list[Case]:
     return issue + [Case(*r, origin=label) for label, r in FOUND]
 
 
-def run_cell(case: Case, method: str = "quadrature") -> dict:
+def run_cell(case: Case, method: str = "quadrature", tol: float = 1e-10) -> dict:
     args = [BIN, "cell", f"--alpha={case.alpha!r}", f"--beta={case.beta!r}", f"--nu={case.nu!r}",
             f"--eta={case.eta!r}", f"--kappa={case.kappa!r}", f"--energy={case.energy!r}", "--method", method,
-            "--json"]
+            f"--tol={tol!r}", "--json"]
     out = subprocess.run(args, capture_output=True, text=True)
     if out.returncode != 0:
         return {"error": out.stderr.strip()}
@@ -270,7 +273,7 @@ def _overlap(a, b, circle: bool) -> float:
     return best
 
 
-def check(case: Case, method: str = "quadrature") -> Outcome:
+def check(case: Case, method: str = "quadrature", tol: float = 1e-10) -> Outcome:
     """Compares one cell with the reference."""
     case = resolve(case)
     outcome = Outcome(case)
@@ -282,7 +285,7 @@ def check(case: Case, method: str = "quadrature") -> Outcome:
         if abs(case.energy - value) <= 64 * EPS * size:
             outcome.ambiguous = True
     truth = reference(case.alpha, case.beta, case.nu, case.eta, case.kappa, case.energy)
-    result = run_cell(case, method)
+    result = run_cell(case, method, tol)
     if "error" in result:
         outcome.problems.append(f"refused: {result['error']}")
         return outcome
@@ -315,6 +318,10 @@ def check(case: Case, method: str = "quadrature") -> Outcome:
                     continue
                 error = abs(value - truth_value)
                 allowed = estimate + 4 * truth_error
+                size = abs(truth_value) if name == "T" else 1.0
+                # Only where the reference resolves the error (its own error far below).
+                if status in ("ok", "tolerance_not_reached") and error > 0 and 16 * truth_error < error:
+                    outcome.sharpness.append((status, estimate / error, error <= tol * size))
                 if status == "ok":
                     ratio = error / allowed if allowed > 0 else (math.inf if error > 0 else 0.0)
                     outcome.worst_ratio = max(outcome.worst_ratio, ratio)
@@ -322,7 +329,7 @@ def check(case: Case, method: str = "quadrature") -> Outcome:
                     outcome.problems.append(
                         f"{status}: {name} = {value!r}, reference {truth_value!r}: error {error:.3g} > estimate {estimate:.3g}"
                     )
-                if status == "ok" and estimate > 1e-10 * (abs(truth_value) if name == "T" else 1.0) * 1.0000001:
+                if status == "ok" and estimate > tol * size * 1.0000001:
                     outcome.problems.append(f"ok but {name}'s estimate {estimate:.3g} is above the tolerance")
         elif status == "separatrix":
             if not outcome.ambiguous:
@@ -332,10 +339,11 @@ def check(case: Case, method: str = "quadrature") -> Outcome:
     return outcome
 
 
-def check_all(cases: list[Case], method: str = "quadrature", processes: int | None = None) -> list[Outcome]:
+def check_all(cases: list[Case], method: str = "quadrature", processes: int | None = None,
+              tol: float = 1e-10) -> list[Outcome]:
     processes = processes or os.cpu_count() or 1
     with multiprocessing.Pool(processes) as pool:
-        return pool.starmap(check, [(c, method) for c in cases], chunksize=1)
+        return pool.starmap(check, [(c, method, tol) for c in cases], chunksize=1)
 
 
 def summary(outcomes: list[Outcome]) -> str:
@@ -344,6 +352,14 @@ def summary(outcomes: list[Outcome]) -> str:
     worst = max((o.worst_ratio for o in outcomes), default=0.0)
     lines = [f"{len(outcomes)} cells, {sum(o.components for o in outcomes)} components, {oks} with status ok; "
              f"worst error/estimate among ok values {worst:.3g}; {len(bad)} cells with problems"]
+    ratios = sorted(r for o in outcomes for s, r, _ in o.sharpness if s == "ok")
+    missed = [meets for o in outcomes for s, _, meets in o.sharpness if s == "tolerance_not_reached"]
+    if ratios:
+        lines.append(f"estimate / true error among ok values (T, N; {len(ratios)} resolved by the reference): "
+                     f"median {ratios[len(ratios) // 2]:.3g}, 90th percentile {ratios[len(ratios) * 9 // 10]:.3g}")
+    if missed:
+        lines.append(f"tolerance_not_reached values (T, N) whose true error meets the tolerance: "
+                     f"{sum(missed)} of {len(missed)}")
     for o in bad:
         lines.append(f"  {o.case.origin}: {asdict(o.case)}")
         lines.extend(f"    {p}" for p in o.problems)
@@ -355,6 +371,7 @@ def main():
     parser.add_argument("--cells", type=int, default=300)
     parser.add_argument("--seed", type=int, default=12)
     parser.add_argument("--method", default="quadrature")
+    parser.add_argument("--tol", type=float, default=1e-10, help="the cells' tolerance (default 1e-10)")
     parser.add_argument("--out", type=Path)
     parser.add_argument("--write-references", action="store_true", help=f"compute the references afresh into {REFERENCES.name}")
     args = parser.parse_args()
@@ -366,7 +383,7 @@ def main():
         write_references(cases)
         print(f"wrote {REFERENCES}")
         return 0
-    outcomes = check_all(cases, args.method)
+    outcomes = check_all(cases, args.method, tol=args.tol)
     print(summary(outcomes))
     if args.out:
         with args.out.open("w", newline="") as f:

@@ -7,6 +7,7 @@
 //! `hier2002`). A new body (a torus, a truncated sphere, a disk with a rounded rim) is one new
 //! implementation of [`Shape`]; every derived quantity has a generic default built from χ1, χ2.
 
+use crate::dd::DoubleDouble;
 use crate::error::{check_range, AtlasError, Result};
 use nalgebra::Vector3;
 
@@ -189,6 +190,18 @@ pub trait Shape: Send + Sync {
     #[inline]
     fn potential_and_contact_distance_sq_at(&self, a: Angle) -> (f64, f64) {
         (self.potential_at(a), self.contact_distance_sq_at(a))
+    }
+
+    /// U at the angle whose sine and cosine are `sin` and `cos`, in double-double, with a
+    /// bound on its error (about 1e-30 of U's terms), for shapes that provide it: the cell
+    /// solver then knows how far the level of a turning point is from ε far below an ulp of V
+    /// (docs/accuracy.md, "The level of the turning points").
+    fn potential_double_double(
+        &self,
+        _sin: DoubleDouble,
+        _cos: DoubleDouble,
+    ) -> Option<(DoubleDouble, f64)> {
+        None
     }
 }
 
@@ -433,6 +446,20 @@ impl Shape for Ellipsoid {
         }
         let offset = self.alpha * (x.sin + y.sin) / (1.0 + cos_diff);
         (shape - offset, shape.abs() + offset.abs())
+    }
+
+    /// U = Z + α cosθ with Z = √(β² sin²θ + cos²θ), to a few units of 2⁻¹⁰⁶ of Z + |α cosθ|
+    /// (a relative error of U that grows as the two terms cancel).
+    fn potential_double_double(
+        &self,
+        sin: DoubleDouble,
+        cos: DoubleDouble,
+    ) -> Option<(DoubleDouble, f64)> {
+        let bs = sin.mul_f64(self.beta);
+        let z = bs.mul(bs).add(cos.mul(cos)).sqrt();
+        let offset = cos.mul_f64(self.alpha);
+        let error = crate::dd::RELATIVE_ERROR * (z.hi + offset.hi.abs());
+        Some((z.add(offset), error))
     }
 
     #[inline]

@@ -4,6 +4,7 @@
 //! independent check, by integrating one period of the reduced system ([`crate::period_ode`]).
 
 use crate::body::{Body, Shape};
+use crate::dd::DoubleDouble;
 use crate::error::{AtlasError, Result};
 use crate::family::Family;
 use crate::limits::Estimate;
@@ -473,11 +474,17 @@ impl EnergyErrors {
     }
 }
 
-/// The error of a libration's integrals from the level of its turning points: they are the
-/// roots of V − ε measured from a critical point c inside, ε − V(c) − (V(θ) − V(c)), whose
-/// constant term carries the rounding of V(c) (a few ulps of its L1 size, whatever the gap)
-/// and whose roots are rounded to a double; the integrals are then exact for an energy
-/// within δε of ε. The error is |dX/dε| δε for X = T, Δψ, Δζ. The crude bound
+/// The error of a libration's integrals from the level of its turning points. The integrand
+/// near an end e measures ε − V from V(e) (by the divided difference of V), so the integrals
+/// are exact for a level that runs from V(e_min) to V(e_max), off ε by s = ε − V(e) at each
+/// end: the common part shifts the energy, the difference tilts the level across the
+/// libration. Bounds on |s|: a priori, the rounding of ε − V(c) (the turning points are the
+/// roots of ε − V(c) − (V(θ) − V(c)) for a critical point c inside, whose constant carries
+/// V(c)'s rounding, a few ulps of its L1 size, whatever the gap) plus the rounding of each
+/// root to a double; or, where that would weigh in the tolerance and the shape gives U in
+/// double-double, s itself at each end computed in double-double, plus V′ times the
+/// uncertainty of the end's angle (its sine and cosine are rounded: an ulp of θ in its chart).
+/// The error is |dX/dε| δε for X = T, Δψ, Δζ: the crude bound
 /// |dX/dε| ≤ 2 ‖X‖ / (ε − V_min) (T ∝ (ε − V_min)^p with |p| ≤ ½ at a flat bottom, 0 at a
 /// harmonic one; saddles are bounded separately) is used when it is far below the
 /// tolerance; otherwise, and near a pole at small κ, where the turning point is where ε and
@@ -509,33 +516,13 @@ fn level_offset_error<S: Shape>(
         .iter()
         .map(|s| (chart(s), potential.slope_and_psi_rates(s.angle())))
         .collect();
-    // The rounding of ε − V(c) and of each turning point (an ulp of θ in its chart).
-    let delta = 4.0 * eps * (scale + energy.abs())
-        + sites[..2]
-            .iter()
-            .zip(&rates)
-            .map(|(end, (_, (slope, _, _)))| 2.0 * eps * end.ulp_scale() * slope.abs())
-            .sum::<f64>();
-    let depth = (energy - bottom.value).max(delta);
-    // The two ends' levels V(e) differ from ε by their own rounding, so the integrals are
-    // taken against a level tilted across the libration by m ≤ δε / L. Their response,
-    // dX/dm = −d(X ⟨θ − θ_mid⟩)/dε (⟨⟩ the time average), is at most (L/2)|dX/dε| (in the
-    // level term) plus ‖X‖ |d⟨θ⟩/dε|, and the average moves no faster than the faster end,
-    // |dθ_end/dε| = 1/|V′|: an error δε ‖X‖ max(1/|V′|) / L. (Against 30-digit quadrature
-    // of a tilted cubic well the two terms were 1.03–27× the true dT/dm, tightest next to
-    // the saddle, where the level term carries it; the level term below is 4× that.)
+    // A priori: the rounding of ε − V(c) and of each turning point (an ulp of θ in its
+    // chart), as the common shift and as the spread of the two ends.
+    let root = |i: usize| 2.0 * eps * sites[i].ulp_scale() * rates[i].1 .0.abs();
+    let a_priori = 4.0 * eps * (scale + energy.abs()) + root(0) + root(1);
     let length = potential
         .separation(&component.lower, &component.upper)
         .abs();
-    let tilt = if length > 0.0 {
-        delta / length
-            * rates[..2]
-                .iter()
-                .map(|(_, r)| 1.0 / r.0.abs())
-                .fold(0.0, f64::max)
-    } else {
-        0.0
-    };
     // Away from the poles (at an end near a pole ψ̇ peaks in a sliver of time whose share
     // the relative bounds cover): ∫|ψ̇| dt ≤ T max|ψ̇|, and the shift of the orbit by the
     // rounding of each turning point to a double (an ulp in its chart) moves Δψ by
@@ -562,15 +549,35 @@ fn level_offset_error<S: Shape>(
             .map(|((_, r), s)| s.ulp_scale() * r.2.abs())
             .fold(0.0, f64::max);
     let drift_scale = raw.drift.map_or(0.0, |d| d.scale);
-    let tilted = EnergyErrors {
-        period: tilt * raw.period,
-        psi_advance: tilt * psi_scale + passage_rounding,
-        drift: tilt * drift_scale,
-    };
-    let crude = EnergyErrors {
-        period: 2.0 * delta / depth * raw.period,
-        psi_advance: 2.0 * delta / depth * psi_scale + psi_shift,
-        drift: 2.0 * delta / depth * drift_scale,
+    // The crude bound of the common shift δε and the tilt's: the two ends' offsets differ by
+    // at most `spread`, a level tilted across the libration by m ≤ spread / L. The response,
+    // dX/dm = −d(X ⟨θ − θ_mid⟩)/dε (⟨⟩ the time average), is at most (L/2)|dX/dε| (in the
+    // level term) plus ‖X‖ |d⟨θ⟩/dε|, and the average moves no faster than the faster end,
+    // |dθ_end/dε| = 1/|V′|: an error spread ‖X‖ max(1/|V′|) / L. (Against 30-digit quadrature
+    // of a tilted cubic well the two terms were 1.03–27× the true dT/dm, tightest next to
+    // the saddle, where the level term carries it; the level term below is 4× that.)
+    let bounds = |delta: f64, spread: f64| {
+        let depth = (energy - bottom.value).max(delta);
+        let tilt = if length > 0.0 {
+            spread / length
+                * rates[..2]
+                    .iter()
+                    .map(|(_, r)| 1.0 / r.0.abs())
+                    .fold(0.0, f64::max)
+        } else {
+            0.0
+        };
+        let tilted = EnergyErrors {
+            period: tilt * raw.period,
+            psi_advance: tilt * psi_scale + passage_rounding,
+            drift: tilt * drift_scale,
+        };
+        let crude = EnergyErrors {
+            period: 2.0 * delta / depth * raw.period,
+            psi_advance: 2.0 * delta / depth * psi_scale + psi_shift,
+            drift: 2.0 * delta / depth * drift_scale,
+        };
+        (crude, tilted, depth)
     };
     // The wall κ²/(2 sin²θ) a small part of V at an end near a pole: ε and U nearly cancel.
     let near_pole = potential.kappa != 0.0
@@ -579,12 +586,58 @@ fn level_offset_error<S: Shape>(
             let w = potential.kappa / a.sin;
             chart(e) < 0.1 && 0.5 * w * w < 1e-3 * potential.value_scale(a)
         });
-    let small = |error: f64, allowed: f64| error <= 0.05 * options.tol * allowed;
-    if !near_pole
-        && small(crude.period, raw.period)
-        && small(crude.psi_advance, TAU)
-        && small(crude.drift, drift_scale)
-    {
+    // Sharper, where the shape gives V in double-double: each end's offset s = ε − V(e) at
+    // the angle of the (sine, cosine) pair the integrand measures from, and the step where
+    // the two ends' halves meet: the rise V(e_max) − V(e_min) the level is tilted by (see
+    // `Piece::tilt_rate`) against its double-double value, plus the rise's response to the
+    // rounding of the length between the ends (an ulp of each end in its chart).
+    let sharp = || -> Option<(f64, f64)> {
+        let (lower, lower_error) = potential.value_double_double(sites[0].angle())?;
+        let (upper, upper_error) = potential.value_double_double(sites[1].angle())?;
+        let level = DoubleDouble::from_f64(energy);
+        let (s_lower, s_upper) = (level.sub(lower).to_f64(), level.sub(upper).to_f64());
+        let rise = upper.sub(lower).to_f64();
+        // (The double-double errors, and one ulp of each difference rounded to a double.)
+        let rounding = 2.0 * (lower_error + upper_error) + eps * (s_lower.abs() + s_upper.abs());
+        let step = (potential.rise(&sites[0], &sites[1]) - rise).abs()
+            + (rise / length).abs() * eps * (sites[0].ulp_scale() + sites[1].ulp_scale())
+            + eps * rise.abs()
+            + rounding;
+        Some((
+            s_lower.abs().max(s_upper.abs()) + step,
+            (s_lower - s_upper).abs() + step,
+        ))
+    };
+    // The crude bound is kept (away from a pole) where it is far below the tolerance, or
+    // where measuring the slope cannot change the status: the values miss the tolerance
+    // without it.
+    let tol = options.tol;
+    let drift_error = raw.drift.map_or(0.0, |d| d.error);
+    let enough = |crude: &EnergyErrors, tilted: &EnergyErrors, last: bool| {
+        let terms = [
+            (raw.period_error, crude.period, tilted.period, raw.period),
+            (
+                raw.psi_advance_error,
+                crude.psi_advance,
+                tilted.psi_advance,
+                TAU,
+            ),
+            (drift_error, crude.drift, tilted.drift, drift_scale),
+        ];
+        let small = terms.iter().all(|&(_, c, _, x)| c <= 0.05 * tol * x);
+        let misses = terms.iter().any(|&(r, _, t, x)| r + t > tol * x);
+        !near_pole && (small || (last && misses))
+    };
+    let (mut crude, mut tilted, mut depth) = bounds(a_priori, a_priori);
+    if enough(&crude, &tilted, false) {
+        return crude.plus(tilted);
+    }
+    let mut delta = a_priori;
+    if let Some((common, spread)) = sharp() {
+        delta = common;
+        (crude, tilted, depth) = bounds(common, spread);
+    }
+    if enough(&crude, &tilted, true) {
         return crude.plus(tilted);
     }
     // The step stays well inside the family: below a quarter of the depth and of the

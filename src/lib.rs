@@ -44,6 +44,7 @@ pub mod body;
 pub mod cell;
 pub mod cf;
 pub mod critical;
+pub mod dd;
 pub mod error;
 pub mod family;
 pub mod full;

@@ -13,6 +13,7 @@
 //! full relative precision right up to the turning points (docs/accuracy.md).
 
 use crate::body::{Angle, Body, Reduction, Shape};
+use crate::dd::DoubleDouble;
 use crate::error::{AtlasError, Result};
 use crate::family::{self, Family, Side};
 use crate::quadrature::{spectral_antiderivative, IntervalNode, TanhSinhLevel, FINEST_LEVEL};
@@ -276,6 +277,36 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         } else {
             let w = self.kappa / a.sin;
             0.5 * w * w + u
+        }
+    }
+
+    /// V in double-double with a bound on its error (about 1e-30 of its terms) at the angle
+    /// atan2(sin, cos) of the pair `a` (normalised onto the circle first: the cell solver's
+    /// integrands measure V from an end's pair of rounded sine and cosine), where the shape
+    /// gives U so ([`Shape::potential_double_double`]).
+    pub fn value_double_double(&self, a: Angle) -> Option<(DoubleDouble, f64)> {
+        let (sin, cos) = (DoubleDouble::from_f64(a.sin), DoubleDouble::from_f64(a.cos));
+        let radius = sin.mul(sin).add(cos.mul(cos)).sqrt();
+        let (sin, cos) = (sin.div(radius), cos.div(radius));
+        let (u, error) = self.body.shape.potential_double_double(sin, cos)?;
+        if self.kappa == 0.0 {
+            return Some((u, error));
+        }
+        let w = DoubleDouble::from_f64(self.kappa).div(sin);
+        let wall = w.mul(w).mul_f64(0.5);
+        Some((wall.add(u), error + crate::dd::RELATIVE_ERROR * wall.hi))
+    }
+
+    /// V(b) − V(a) between two sites to full relative precision where they are close:
+    /// sin(θ_b − θ_a) times the divided difference of V (its plain difference beyond 1.98
+    /// apart, where the divided difference would lose to cos(θ_b − θ_a) → −1).
+    pub(crate) fn rise(&self, a: &Site, b: &Site) -> f64 {
+        let (sl, cl) = self.separation(a, b).sin_cos();
+        let (angle_a, angle_b) = (a.angle(), b.angle());
+        if cl > -0.4 {
+            sl * divided_difference(self, angle_b, angle_a, sl, cl).0
+        } else {
+            self.value(angle_b) - self.value(angle_a)
         }
     }
 
@@ -1091,12 +1122,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 // is only a root to the last bit); the gap is measured from the nearer end, so
                 // without a correction it would jump at the middle by that difference, which
                 // near a minimum is not small against ε − V.
-                let (sl, cl) = length.sin_cos();
-                let rise = if cl > -0.4 {
-                    sl * divided_difference(self, r.angle, l.angle, sl, cl).0
-                } else {
-                    self.value(r.angle) - self.value(l.angle)
-                };
+                let rise = self.rise(&l.site, &r.site);
                 Piece {
                     left: l,
                     right: r,
