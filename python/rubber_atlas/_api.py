@@ -1738,7 +1738,7 @@ def verdict(alpha, beta, nu, eta, *, tol: float = 1e-10, resolution: int = 64,
     >>> v.counterexamples.values.tolist(), dict(v.kappa.sizes)
     ([2, 0], {'cell': 2, 'counterexample': 2})
     >>> [round(float(k), 3) for k in v.kappa[0]], bool(v.kappa[1].isnull().all())
-    ([1.0, 1.5], True)
+    ([1.0, 10000.0], True)
     """
     given = {"alpha": alpha, "beta": beta, "nu": nu, "eta": eta}
     tol, resolution, threads = _real("tol", tol), _count("resolution", resolution), _optional_count("threads", threads)
