@@ -557,7 +557,8 @@ fn level_offset_error<S: Shape>(
     // of a tilted cubic well the two terms were 1.03–27× the true dT/dm, tightest next to
     // the saddle, where the level term carries it; the level term below is 4× that.)
     let bounds = |delta: f64, spread: f64| {
-        let depth = (energy - bottom.value).max(delta);
+        // (Less V_min's rounding: a depth within it would shrink the bound.)
+        let depth = (energy - bottom.value - 4.0 * eps * bottom.scale).max(delta);
         let tilt = if length > 0.0 {
             spread / length
                 * rates[..2]
@@ -649,8 +650,10 @@ fn level_offset_error<S: Shape>(
         .filter(|p| p.kind != CriticalKind::Minimum)
         .map(|p| (energy - p.value).abs())
         .fold(f64::INFINITY, f64::min);
-    let h = (256.0 * delta).min(0.25 * depth).min(0.25 * saddles);
-    if h < 16.0 * delta {
+    // The step from the a-priori bound: the sharp one may be far below an ulp of ε, where
+    // ε ± h would round back to ε.
+    let h = (256.0 * a_priori).min(0.25 * depth).min(0.25 * saddles);
+    if h < 16.0 * a_priori {
         return crude.plus(tilted);
     }
     let at = |e: f64| -> Option<PeriodIntegrals> {
