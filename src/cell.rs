@@ -482,8 +482,8 @@ impl EnergyErrors {
 /// roots of ε − V(c) − (V(θ) − V(c)) for a critical point c inside, whose constant carries
 /// V(c)'s rounding, a few ulps of its L1 size, whatever the gap) plus the rounding of each
 /// root to a double; or, where that would weigh in the tolerance and the shape gives U in
-/// double-double, s itself at each end computed in double-double, plus V′ times the
-/// uncertainty of the end's angle (its sine and cosine are rounded: an ulp of θ in its chart).
+/// double-double, s itself at each end computed in double-double at the angle of the end's
+/// (sine, cosine) pair, plus the step where the libration's two halves meet (see below).
 /// The error is |dX/dε| δε for X = T, Δψ, Δζ: the crude bound
 /// |dX/dε| ≤ 2 ‖X‖ / (ε − V_min) (T ∝ (ε − V_min)^p with |p| ≤ ½ at a flat bottom, 0 at a
 /// harmonic one; saddles are bounded separately) is used when it is far below the
@@ -600,7 +600,7 @@ fn level_offset_error<S: Shape>(
         let rise = upper.sub(lower).to_f64();
         // (The double-double errors, and one ulp of each difference rounded to a double.)
         let rounding = 2.0 * (lower_error + upper_error) + eps * (s_lower.abs() + s_upper.abs());
-        let step = (potential.rise(&sites[0], &sites[1]) - rise).abs()
+        let step = (potential.rise(sites[0].angle(), sites[1].angle(), length) - rise).abs()
             + (rise / length).abs() * eps * (sites[0].ulp_scale() + sites[1].ulp_scale())
             + eps * rise.abs()
             + rounding;

@@ -12,9 +12,9 @@ pub struct DoubleDouble {
     pub lo: f64,
 }
 
-/// Relative error of the operations below: a few units of 2⁻¹⁰⁶ each (Joldes, Muller and
-/// Popescu 2017 give ≤ 3u² for the product and ≤ 3u² + 4u³ for the sum, u = 2⁻⁵³); a chain of
-/// a few dozen of them stays far below this.
+/// Relative error of the operations below: a few u² each, u = 2⁻⁵³ (Joldes, Muller and
+/// Popescu 2017 bound the sum by 3u² + 4u³ and this product by about 5–7u²); 1e-30 is about
+/// 80u², so a chain of a dozen of them stays below it.
 pub const RELATIVE_ERROR: f64 = 1e-30;
 
 /// a + b = s + e exactly (Knuth's TwoSum).
@@ -98,7 +98,8 @@ impl DoubleDouble {
         Self { hi, lo }
     }
 
-    /// Quotient: a first quotient and one correction from the exact remainder.
+    /// Quotient: a first quotient and two corrections from its remainder (itself computed to
+    /// about u²).
     #[allow(clippy::should_implement_trait)]
     pub fn div(self, other: Self) -> Self {
         let q1 = self.hi / other.hi;

@@ -297,16 +297,16 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         Some((wall.add(u), error + crate::dd::RELATIVE_ERROR * wall.hi))
     }
 
-    /// V(b) − V(a) between two sites to full relative precision where they are close:
+    /// V(b) − V(a) between two angles `length` = θ_b − θ_a apart (from
+    /// [`EffectivePotential::separation`]), to full relative precision where they are close:
     /// sin(θ_b − θ_a) times the divided difference of V (its plain difference beyond 1.98
     /// apart, where the divided difference would lose to cos(θ_b − θ_a) → −1).
-    pub(crate) fn rise(&self, a: &Site, b: &Site) -> f64 {
-        let (sl, cl) = self.separation(a, b).sin_cos();
-        let (angle_a, angle_b) = (a.angle(), b.angle());
+    pub(crate) fn rise(&self, a: Angle, b: Angle, length: f64) -> f64 {
+        let (sl, cl) = length.sin_cos();
         if cl > -0.4 {
-            sl * divided_difference(self, angle_b, angle_a, sl, cl).0
+            sl * divided_difference(self, b, a, sl, cl).0
         } else {
-            self.value(angle_b) - self.value(angle_a)
+            self.value(b) - self.value(a)
         }
     }
 
@@ -1122,7 +1122,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 // is only a root to the last bit); the gap is measured from the nearer end, so
                 // without a correction it would jump at the middle by that difference, which
                 // near a minimum is not small against ε − V.
-                let rise = self.rise(&l.site, &r.site);
+                let rise = self.rise(l.angle, r.angle, length);
                 Piece {
                     left: l,
                     right: r,
