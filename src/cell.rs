@@ -354,7 +354,7 @@ pub fn solve_component<S: Shape>(
         }
         Err(e) => return Err(e),
     };
-    let offset = level_offset_error(potential, energy, component, &raw, options);
+    let offset = level_offset_error(potential, energy, component, &mut raw, options);
     raw.period_error += offset.period;
     raw.psi_advance_error += offset.psi_advance;
     if let Some(d) = raw.drift.as_mut() {
@@ -456,6 +456,33 @@ fn integrate<S: Shape>(
     }
 }
 
+/// Replaces the saddle terms a libration's integrals carry at the a-priori error of the
+/// energy ([`PeriodIntegrals::saddle`]) by the same terms at `delta`, its level offset
+/// computed sharply (`level_offset_error`): near a saddle that offset is the energy error
+/// the log-divergent dT/dε multiplies (the rounding of the gap at the nodes has its own
+/// term). Only ever lowers them.
+fn sharpen_saddle_terms<S: Shape>(
+    potential: &EffectivePotential<'_, S>,
+    energy: f64,
+    component: &Component,
+    raw: &mut PeriodIntegrals,
+    delta: f64,
+) {
+    let [t, psi] = raw.saddle;
+    if t == 0.0 && psi == 0.0 {
+        return;
+    }
+    let (sharp_t, sharp_psi) =
+        potential.saddle_conditioning_within(energy, component, raw.period, 2.0, delta);
+    let (less_t, less_psi) = ((t - sharp_t).max(0.0), (psi - sharp_psi).max(0.0));
+    raw.period_error -= less_t;
+    raw.psi_advance_error -= less_psi;
+    if let Some(d) = raw.drift.as_mut() {
+        d.error -= less_psi * d.scale;
+    }
+    raw.saddle = [t - less_t, psi - less_psi];
+}
+
 /// Errors of T, Δψ and |Δζ| caused by an offset of the energy the integrals are taken at.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 struct EnergyErrors {
@@ -485,16 +512,17 @@ impl EnergyErrors {
 /// double-double, s itself at each end computed in double-double at the angle of the end's
 /// (sine, cosine) pair, plus the step where the libration's two halves meet (see below).
 /// The error is |dX/dε| δε for X = T, Δψ, Δζ: the crude bound
-/// |dX/dε| ≤ 2 ‖X‖ / (ε − V_min) (T ∝ (ε − V_min)^p with |p| ≤ ½ at a flat bottom, 0 at a
-/// harmonic one; saddles are bounded separately) is used when it is far below the
-/// tolerance; otherwise, and near a pole at small κ, where the turning point is where ε and
+/// |dX/dε| ≤ 2 ‖X‖ / min(ε − V_min, |V′(e)| |e − θ_b|) (T ∝ (ε − V_min)^p with |p| ≤ ½ where
+/// the ends rise at least as steeply as on average; saddles are bounded separately, and
+/// where the offset is computed sharply their terms are taken at it) is used when it is far
+/// below the tolerance; otherwise, and near a pole at small κ, where the turning point is where ε and
 /// U nearly cancel and X varies on the scale of κ, the slope is measured by differences at
 /// ε ± h, h = 256 δε.
 fn level_offset_error<S: Shape>(
     potential: &EffectivePotential<'_, S>,
     energy: f64,
     component: &Component,
-    raw: &PeriodIntegrals,
+    raw: &mut PeriodIntegrals,
     options: &CellOptions,
 ) -> EnergyErrors {
     if component.kind != MotionKind::Libration {
@@ -503,6 +531,8 @@ fn level_offset_error<S: Shape>(
     let Some(bottom) = component.minimum().copied() else {
         return EnergyErrors::default();
     };
+    // (The integrals as they come: the closures below read their values and scales.)
+    let values = *raw;
     let eps = f64::EPSILON;
     let scale = component
         .interior
@@ -539,16 +569,30 @@ fn level_offset_error<S: Shape>(
     } else {
         rates[..2].iter().filter(|(x, _)| *x <= 0.1).count() as f64
     };
-    let psi_scale = raw.psi_advance.abs()
-        + 2.0 * raw.period * far.clone().map(|((_, r), _)| r.1.abs()).fold(0.0, f64::max);
+    // ‖Δψ‖ in the crude slope: |Δψ| + 2T max|ψ̇| (ends and bottom, away from the poles), or,
+    // where the quadrature gives it and it is smaller (ψ̇ changing sign along the orbit),
+    // ∫|ψ̇| dt + 2T max|ψ̇| at the ends (each sign of ψ̇ bounded like T, and the ends moving
+    // out into larger |ψ̇|: ∫|ψ̇| dt alone was 3.8× short at a needle). Both checked against
+    // slopes measured by differences (tests/suite/cell.rs).
+    let end_rate = rates[..2]
+        .iter()
+        .map(|(_, r)| r.1.abs())
+        .fold(0.0, f64::max);
+    let psi_scale = (values.psi_advance.abs()
+        + 2.0 * values.period * far.clone().map(|((_, r), _)| r.1.abs()).fold(0.0, f64::max))
+    .min(
+        values
+            .psi_variation
+            .map_or(f64::INFINITY, |v| v + 2.0 * values.period * end_rate),
+    );
     let passage_rounding = 64.0 * eps * PI * passages;
     let psi_shift = 2.0
         * eps
-        * raw.period
+        * values.period
         * far
             .map(|((_, r), s)| s.ulp_scale() * r.2.abs())
             .fold(0.0, f64::max);
-    let drift_scale = raw.drift.map_or(0.0, |d| d.scale);
+    let drift_scale = values.drift.map_or(0.0, |d| d.scale);
     // The crude bound of the common shift δε and the tilt's: the two ends' offsets differ by
     // at most `spread`, a level tilted across the libration by m ≤ spread / L. The response,
     // dX/dm = −d(X ⟨θ − θ_mid⟩)/dε (⟨⟩ the time average), is at most (L/2)|dX/dε| (in the
@@ -556,9 +600,20 @@ fn level_offset_error<S: Shape>(
     // |dθ_end/dε| = 1/|V′|: an error spread ‖X‖ max(1/|V′|) / L. (Against 30-digit quadrature
     // of a tilted cubic well the two terms were 1.03–27× the true dT/dm, tightest next to
     // the saddle, where the level term carries it; the level term below is 4× that.)
+    // The crude slope assumes the well rises at least as steeply at its ends as on average
+    // from its bottom, |V′(e)| |e − θ_b| ≥ ε − V_min (a convex or steeper well; a ν-shaped
+    // one is at p = ½). Where a wall flattens before its end (the needle's U ≈ |cos θ| near
+    // a pole: p up to 1.5 measured), the end moves out at 1/|V′(e)| and the dwell there
+    // grows with it: the bound takes the end's distance over its slope in place of the
+    // depth, 2 ‖X‖ / min(ε − V_min, |V′(e)| |e − θ_b|).
+    let reach = [0, 1]
+        .iter()
+        .map(|&i| rates[i].1 .0.abs() * potential.separation(&sites[i], &bottom.site).abs())
+        .fold(f64::INFINITY, f64::min);
     let bounds = |delta: f64, spread: f64| {
         // (Less V_min's rounding: a depth within it would shrink the bound.)
         let depth = (energy - bottom.value - 4.0 * eps * bottom.scale).max(delta);
+        let steep = depth.min(reach).max(delta);
         let tilt = if length > 0.0 {
             spread / length
                 * rates[..2]
@@ -569,14 +624,14 @@ fn level_offset_error<S: Shape>(
             0.0
         };
         let tilted = EnergyErrors {
-            period: tilt * raw.period,
+            period: tilt * values.period,
             psi_advance: tilt * psi_scale + passage_rounding,
             drift: tilt * drift_scale,
         };
         let crude = EnergyErrors {
-            period: 2.0 * delta / depth * raw.period,
-            psi_advance: 2.0 * delta / depth * psi_scale + psi_shift,
-            drift: 2.0 * delta / depth * drift_scale,
+            period: 2.0 * delta / steep * values.period,
+            psi_advance: 2.0 * delta / steep * psi_scale + psi_shift,
+            drift: 2.0 * delta / steep * drift_scale,
         };
         (crude, tilted, depth)
     };
@@ -613,32 +668,38 @@ fn level_offset_error<S: Shape>(
     // where measuring the slope cannot change the status: the values miss the tolerance
     // without it.
     let tol = options.tol;
-    let drift_error = raw.drift.map_or(0.0, |d| d.error);
-    let enough = |crude: &EnergyErrors, tilted: &EnergyErrors, last: bool| {
-        let terms = [
-            (raw.period_error, crude.period, tilted.period, raw.period),
-            (
-                raw.psi_advance_error,
-                crude.psi_advance,
-                tilted.psi_advance,
-                TAU,
-            ),
-            (drift_error, crude.drift, tilted.drift, drift_scale),
-        ];
-        let small = terms.iter().all(|&(_, c, _, x)| c <= 0.05 * tol * x);
-        let misses = terms.iter().any(|&(r, _, t, x)| r + t > tol * x);
-        !near_pole && (small || (last && misses))
-    };
+    let enough =
+        |crude: &EnergyErrors, tilted: &EnergyErrors, last: bool, raw: &PeriodIntegrals| {
+            let drift_error = raw.drift.map_or(0.0, |d| d.error);
+            let terms = [
+                (raw.period_error, crude.period, tilted.period, values.period),
+                (
+                    raw.psi_advance_error,
+                    crude.psi_advance,
+                    tilted.psi_advance,
+                    TAU,
+                ),
+                (drift_error, crude.drift, tilted.drift, drift_scale),
+            ];
+            let small = terms.iter().all(|&(_, c, _, x)| c <= 0.05 * tol * x);
+            let misses = terms.iter().any(|&(r, _, t, x)| r + t > tol * x);
+            !near_pole && (small || (last && misses))
+        };
+    // The integrator's saddle terms are at the a-priori energy error: the sharp offset is
+    // computed where they weigh in too.
+    let saddle_small =
+        values.saddle[0] <= 0.05 * tol * values.period && values.saddle[1] <= 0.05 * tol;
     let (mut crude, mut tilted, mut depth) = bounds(a_priori, a_priori);
-    if enough(&crude, &tilted, false) {
+    if enough(&crude, &tilted, false, raw) && saddle_small {
         return crude.plus(tilted);
     }
     let mut delta = a_priori;
     if let Some((common, spread)) = sharp() {
         delta = common;
         (crude, tilted, depth) = bounds(common, spread);
+        sharpen_saddle_terms(potential, energy, component, raw, common);
     }
-    if enough(&crude, &tilted, true) {
+    if enough(&crude, &tilted, true, raw) {
         return crude.plus(tilted);
     }
     // The step stays well inside the family: below a quarter of the depth and of the
@@ -673,7 +734,7 @@ fn level_offset_error<S: Shape>(
     let slope = |x: f64, x_up: f64, x_down: f64, errors: f64| {
         2.0 * (x_up - x).abs().max((x - x_down).abs()) / h * delta + errors * delta / h
     };
-    let drift = match (raw.drift, up.drift, down.drift) {
+    let drift = match (values.drift, up.drift, down.drift) {
         (Some(d), Some(u), Some(w)) => {
             let dist = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
             2.0 * dist(u.value, d.value).max(dist(d.value, w.value)) / h * delta
@@ -683,13 +744,13 @@ fn level_offset_error<S: Shape>(
     };
     EnergyErrors {
         period: slope(
-            raw.period,
+            values.period,
             up.period,
             down.period,
             up.period_error + raw.period_error + down.period_error,
         ),
         psi_advance: slope(
-            raw.psi_advance,
+            values.psi_advance,
             up.psi_advance,
             down.psi_advance,
             up.psi_advance_error + raw.psi_advance_error + down.psi_advance_error,

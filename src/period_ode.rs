@@ -290,6 +290,9 @@ pub fn integrate<S: Shape>(
         period_error,
         psi_advance_error,
         drift,
+        psi_variation: None,
+        // (The runs' own energy drift, not a level offset: kept.)
+        saddle: [0.0, 0.0],
         work: n1 + n2,
         converged: period_error <= tol * tight.period && psi_advance_error / TAU <= tol,
     })

@@ -950,6 +950,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         let mut psi_advance_error = double * sum(&|s| s.error(|n| n.dpsi));
         let period_rounding = double * sum(&|s| s.rounding(|n| n.dt));
         let psi_rounding = double * sum(&|s| s.rounding(|n| n.dpsi));
+        let psi_variation = double * sum(&|s| s.sum(0, |n| n.dpsi.abs()));
         let (saddle_t, saddle_psi) =
             self.saddle_conditioning(energy, component, period, double, 0.0);
         period_error += period_rounding + saddle_t;
@@ -1005,6 +1006,8 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             period_error,
             psi_advance_error,
             drift,
+            psi_variation: Some(psi_variation),
+            saddle: [saddle_t, saddle_psi],
             work: samples.iter().map(|s| s.evaluations).sum(),
             converged,
         })
@@ -1021,6 +1024,33 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         period: f64,
         double: f64,
         energy_error: f64,
+    ) -> (f64, f64) {
+        self.saddle_terms(energy, component, period, double, |p| {
+            energy_error.max(4.0 * EPS * (p.scale + energy.abs()))
+        })
+    }
+
+    /// [`Self::saddle_conditioning`] for an energy known to within `delta` (a libration's
+    /// level offset computed sharply: see `cell::level_offset_error`).
+    pub(crate) fn saddle_conditioning_within(
+        &self,
+        energy: f64,
+        component: &Component,
+        period: f64,
+        double: f64,
+        delta: f64,
+    ) -> (f64, f64) {
+        self.saddle_terms(energy, component, period, double, |_| delta)
+    }
+
+    /// The saddle terms with the energy error `delta` at each saddle.
+    fn saddle_terms(
+        &self,
+        energy: f64,
+        component: &Component,
+        period: f64,
+        double: f64,
+        delta: impl Fn(&CriticalPoint) -> f64,
     ) -> (f64, f64) {
         let (mut saddle_t, mut saddle_psi) = (0.0, 0.0);
         for (p, passes) in component
@@ -1039,8 +1069,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             let lambda = (p.curvature.abs() / b).sqrt();
             let gap = (energy - p.value).abs().max(EPS * p.scale);
             let sensitivity = (1.0 / lambda).min(period) / gap;
-            let delta = energy_error.max(4.0 * EPS * (p.scale + energy.abs()));
-            let dt = passes * delta * sensitivity;
+            let dt = passes * delta(p) * sensitivity;
             saddle_t += dt;
             saddle_psi += dt * self.psi_rate(a).abs();
         }
@@ -1250,6 +1279,14 @@ pub struct PeriodIntegrals {
     pub psi_advance_error: f64,
     /// Δζ, when asked for.
     pub drift: Option<DriftEstimate>,
+    /// ∫ |ψ̇| dt over one period (the L1 size of Δψ's integrand), where the method gives it
+    /// (the quadratures; not the ODE runs).
+    pub psi_variation: Option<f64>,
+    /// The parts of `period_error` and `psi_advance_error` (and, times the path scale, of
+    /// the drift's error) that bound the conditioning near a saddle at the a-priori error of
+    /// the energy (see [`EffectivePotential::saddle_conditioning`]): a libration whose level
+    /// offset is known more sharply replaces them.
+    pub saddle: [f64; 2],
     /// Integrand evaluations (quadrature) or accepted steps (ODE) spent.
     pub work: usize,
     /// Whether every estimate is within the tolerance.

@@ -119,6 +119,8 @@ fn integrate_on<S: Shape>(
                 period_error,
                 psi_advance_error,
                 drift,
+                psi_variation: Some(2.0 * sums.psi_variation),
+                saddle: [saddle_t, saddle_psi],
                 work: samples.nodes.len(),
                 converged: period_error <= tol * period && psi_advance_error / TAU <= tol,
             }));
@@ -141,6 +143,8 @@ struct LevelSums {
     psi: [f64; 3],
     t_rounding: f64,
     psi_rounding: f64,
+    /// The sum of |ψ̇ dt/dφ| on n steps: ∫ |ψ̇| dt over half a period.
+    psi_variation: f64,
 }
 
 /// The samples at φ_j = jπ/n, j = 0 … n, with n = `intervals`; the levels below are every
@@ -192,6 +196,7 @@ impl Samples {
             let r = 0.5 * w * node.rounding;
             sums.t_rounding += r * node.dt.abs();
             sums.psi_rounding += r * node.dpsi.abs();
+            sums.psi_variation += w * node.dpsi.abs();
         }
         let h = PI / self.intervals as f64;
         for (level, stride) in [1.0, 2.0, 4.0].into_iter().enumerate() {
@@ -200,6 +205,7 @@ impl Samples {
         }
         sums.t_rounding *= h;
         sums.psi_rounding *= h;
+        sums.psi_variation *= h;
         sums
     }
 
