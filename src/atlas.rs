@@ -2,7 +2,7 @@
 //! slice), computes them with rayon one κ-row at a time, and lays the results out as the
 //! dense per-cell and per-component arrays of the atlas file (docs/files.md).
 
-use crate::body::{Body, Ellipsoid, Shape};
+use crate::body::{Body, Shape};
 use crate::cell::{
     high_energy_families, solve_high_energy_limit, solve_level, CellResult, ComponentResult, Status,
 };
@@ -11,7 +11,6 @@ use crate::error::{AtlasError, Result};
 use crate::family::{Census, ComponentAxis, Family};
 use crate::scene::{Field, Plane, Scene};
 use crate::torus::{EffectivePotential, MotionKind};
-use crate::EllipsoidBody;
 use rayon::prelude::*;
 use std::f64::consts::{PI, TAU};
 use std::ops::Range;
@@ -786,19 +785,19 @@ impl std::fmt::Display for Shard {
 
 /// How one cell of a scene's grid is solved: at its level of V, or (s = 0 of the compact
 /// plane) in the high-energy limit at its λ.
-enum CellLevel<'p, 'b> {
-    Level(&'p EffectivePotential<'b, Ellipsoid>, f64),
+enum CellLevel<'p, 'b, S: Shape> {
+    Level(&'p EffectivePotential<'b, S>, f64),
     HighEnergy(f64),
 }
 
 /// Visits the cells of κ-row `row` of a scene's slice with body `body`, column by column:
 /// `visit(column, (κ, ε), level)`. Every cell's κ and ε are formed here alone, for the
 /// census and the computation alike.
-fn visit_row(
+fn visit_row<S: Shape>(
     scene: &Scene,
-    body: &EllipsoidBody,
+    body: &Body<S>,
     row: usize,
-    mut visit: impl FnMut(usize, (f64, f64), CellLevel<'_, '_>),
+    mut visit: impl FnMut(usize, (f64, f64), CellLevel<'_, '_, S>),
 ) {
     let row_value = scene.kappa.values[row];
     let columns = &scene.energy.values;
@@ -850,8 +849,12 @@ pub fn census(scene: &Scene, stop: &(dyn Fn() -> bool + Sync)) -> Census {
     let kappa_zero = scene.kappa.values.contains(&0.0);
     let mut possible = [false; 4];
     for &alpha in &scene.alpha.values {
-        for &beta in &scene.beta.values {
-            let body = crate::family::possible_for_ellipsoid(alpha, beta, kappa_zero);
+        for &second in &scene.second.values {
+            // An edged body's families are not told in advance: the census is whole.
+            let body = match scene.shape {
+                None => crate::family::possible_for_ellipsoid(alpha, second, kappa_zero),
+                Some(_) => [true; 4],
+            };
             for (p, b) in possible.iter_mut().zip(body) {
                 *p |= b;
             }
@@ -870,14 +873,14 @@ pub fn census(scene: &Scene, stop: &(dyn Fn() -> bool + Sync)) -> Census {
             let (slice, row) = (i / nk, i % nk);
             let body = scene.body(slice / nb, slice % nb);
             let mut census = Census::default();
-            visit_row(scene, &body, row, |_, _, level| {
+            crate::with_body!(&body, body => visit_row(scene, body, row, |_, _, level| {
                 census.add(&match level {
                     CellLevel::Level(potential, energy) => {
                         potential.families(energy).unwrap_or_default()
                     }
-                    CellLevel::HighEnergy(lambda) => high_energy_families(&body, lambda),
+                    CellLevel::HighEnergy(lambda) => high_energy_families(body, lambda),
                 });
-            });
+            }));
             let mut all = found.lock().expect("no census panics");
             *all = all.merge(census);
             if early && all.covers(&possible) {
@@ -893,8 +896,8 @@ pub fn component_axis(scene: &Scene, stop: &(dyn Fn() -> bool + Sync)) -> Compon
     ComponentAxis::of(scene.layout, &census(scene, stop))
 }
 
-/// Computes the κ-rows `rows` (in that order) of the slices (ia, ib), ib in `betas` (β
-/// slowest), rows shared out by rayon one at a time (rows differ several-fold in cost), into
+/// Computes the κ-rows `rows` (in that order) of the slices (ia, ib), ib in `betas` (the
+/// second shape parameter, slowest), rows shared out by rayon one at a time (rows differ several-fold in cost), into
 /// the slots of `axis`; `progress` is called with the number of cells after each row. Every
 /// cell is computed on its own, so the values do not depend on the number of threads or on
 /// which rows are computed together.
@@ -917,14 +920,13 @@ pub fn compute_rows(
         .par_iter()
         .with_max_len(1)
         .map(|&(b, row)| {
-            let body = &bodies[b];
             let mut block = Block::empty(variables, columns, axis.len());
-            visit_row(scene, body, row, |j, point, level| {
+            crate::with_body!(&bodies[b], body => visit_row(scene, body, row, |j, point, level| {
                 fill_cell(&mut block, variables, axis, j, point, || match level {
                     CellLevel::Level(potential, energy) => solve_level(potential, energy, options),
                     CellLevel::HighEnergy(lambda) => solve_high_energy_limit(body, lambda, options),
                 });
-            });
+            }));
             progress(columns);
             block
         })

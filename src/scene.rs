@@ -1,11 +1,12 @@
-//! Scenes: the TOML files (docs/files.md) that describe an atlas run — the body (ν, η), the grid
-//! axes α, β, κ, ε, the solver settings and the outputs wanted. Parsing checks every key and
+//! Scenes: the TOML files (docs/files.md) that describe an atlas run — the body (its shape, ν,
+//! η), the grid axes (the shape's parameters, κ, ε), the solver settings and the outputs
+//! wanted. Parsing checks every key and
 //! value and names the file, the key and the reason of the first problem it finds.
 
 use crate::cell::{CellOptions, Method};
 use crate::error::{show, AtlasError, Result, MAX_ENERGY, MAX_KAPPA};
 use crate::family::Layout;
-use crate::EllipsoidBody;
+use crate::{AnyBody, EdgedKind};
 use std::path::Path;
 use toml::{Table, Value};
 
@@ -162,12 +163,19 @@ impl Plane {
 pub struct Scene {
     /// The scene's name (default output `atlas/<name>.h5`).
     pub name: String,
+    /// The body's shape (`[body] shape`): None for the ellipsoid (the default), or an edged
+    /// body (docs/bodies.md).
+    pub shape: Option<EdgedKind>,
     /// ν = i3 / i1.
     pub nu: f64,
-    /// η = m b3² / i1.
+    /// η = m b3² / i1 (b3 the shape's unit of length).
     pub eta: f64,
+    /// The centre-of-mass offset α of every shape.
     pub alpha: Axis,
-    pub beta: Axis,
+    /// The shape's second parameter ([`Scene::second_name`]): β of the ellipsoid, the cut h of
+    /// the truncated ball and the wheel; the disk has none, and this axis is the one value 0
+    /// (the grid keeps four dimensions; its file drops this one).
+    pub second: Axis,
     /// The row axis of each slice: κ, or λ for the compactified plane.
     pub kappa: Axis,
     /// The column axis: ε, the excess energy ε − V_min(κ), or s.
@@ -437,26 +445,56 @@ impl Scene {
         }
 
         let body = reader.table(&root, "", "body")?;
-        reader.only_keys(body, "body", &["nu", "eta"])?;
+        reader.only_keys(body, "body", &["shape", "nu", "eta"])?;
+        let shape = match body.get("shape") {
+            None => None,
+            Some(Value::String(name)) if name == "ellipsoid" => None,
+            Some(Value::String(name)) => Some(EdgedKind::from_name(name).ok_or_else(|| {
+                reader.error(
+                    "body.shape",
+                    format!("unknown shape {name:?} (use {})", SHAPE_NAMES.join(", ")),
+                )
+            })?),
+            Some(v) => {
+                return Err(reader.error(
+                    "body.shape",
+                    format!("expected a string, found {}", v.type_str()),
+                ))
+            }
+        };
         let nu = reader.required_number(body, "body", "nu")?;
         let eta = reader.required_number(body, "body", "eta")?;
 
         let axes = reader.table(&root, "", "axes")?;
-        reader.only_keys(
-            axes,
-            "axes",
-            &[
-                "alpha",
-                "beta",
-                "kappa",
-                "energy",
-                "excess_energy",
-                "lambda",
-                "s",
-            ],
-        )?;
+        let second_name = second_parameter(shape);
+        let plane_keys = ["kappa", "energy", "excess_energy", "lambda", "s"];
+        let known: Vec<&str> = ["alpha"]
+            .into_iter()
+            .chain(second_name)
+            .chain(plane_keys)
+            .collect();
+        if let Some(other) = ["beta", "cut"]
+            .into_iter()
+            .find(|k| axes.contains_key(*k) && Some(*k) != second_name)
+        {
+            let takes = match second_name {
+                Some(name) => format!("alpha and {name}"),
+                None => "alpha only".into(),
+            };
+            return Err(reader.error(
+                &join("axes", other),
+                format!(
+                    "the shape {} has no parameter {other} (its axes are {takes})",
+                    shape_name(shape)
+                ),
+            ));
+        }
+        reader.only_keys(axes, "axes", &known)?;
         let alpha = reader.axis(axes, "alpha")?;
-        let beta = reader.axis(axes, "beta")?;
+        let second = match second_name {
+            Some(name) => reader.axis(axes, name)?,
+            None => Axis { values: vec![0.0] },
+        };
         let has = |k: &str| axes.contains_key(k);
         let plane = match (
             has("kappa"),
@@ -576,13 +614,14 @@ impl Scene {
                 ));
             }
         }
-        // Every body of the grid must be valid: check the extremes of each axis.
+        // Every body of the grid must be valid: each shape's parameters lie in intervals, so
+        // checking the extremes of each axis is enough.
         for &a in &[alpha.values[0], *alpha.values.last().unwrap()] {
-            for &b in &[beta.values[0], *beta.values.last().unwrap()] {
-                if let Err(e) = EllipsoidBody::ellipsoid(a, b, nu, eta) {
+            for &b in &[second.values[0], *second.values.last().unwrap()] {
+                if let Err(e) = AnyBody::new(shape, a, b, nu, eta) {
                     let key = match &e {
                         AtlasError::InvalidParameter { name, .. } => match *name {
-                            "alpha" | "beta" => format!("axes.{name}"),
+                            "alpha" | "beta" | "cut" => format!("axes.{name}"),
                             other => format!("body.{other}"),
                         },
                         _ => "body".into(),
@@ -590,6 +629,18 @@ impl Scene {
                     return Err(parameter_error(&reader, &key, e));
                 }
             }
+        }
+        // The high-energy limit N∞(λ) (s = 0) is derived for a U smooth on [−1, 1] in cosθ:
+        // the ellipsoid's only.
+        if plane == Plane::Compact && shape.is_some() && energy.values.contains(&0.0) {
+            return Err(reader.error(
+                "axes.s",
+                format!(
+                    "s = 0 (energy = infinity) is the high-energy limit, derived for the \
+                     ellipsoid only; the {} has sharp edges: start s above 0",
+                    shape_name(shape)
+                ),
+            ));
         }
 
         let mut options = CellOptions::default();
@@ -696,13 +747,18 @@ impl Scene {
             }
         }
         options.drift = fields.iter().any(|f| f.needs_drift());
+        // The options against the body (the ODE method needs a body without edges).
+        let body = AnyBody::new(shape, alpha.values[0], second.values[0], nu, eta)?;
+        crate::with_body!(&body, b => options.check_for(b))
+            .map_err(|e| reader.error("solver.method", format!("{e} ({})", shape_name(shape))))?;
 
         Ok(Scene {
             name,
+            shape,
             nu,
             eta,
             alpha,
-            beta,
+            second,
             kappa,
             energy,
             plane,
@@ -713,11 +769,11 @@ impl Scene {
         })
     }
 
-    /// The shape of the grid: (n_α, n_β, n_κ, n_ε).
+    /// The shape of the grid: (n_α, n of the second parameter, n_κ, n_ε).
     pub fn shape(&self) -> [usize; 4] {
         [
             self.alpha.len(),
-            self.beta.len(),
+            self.second.len(),
             self.kappa.len(),
             self.energy.len(),
         ]
@@ -728,15 +784,27 @@ impl Scene {
         self.shape().iter().product()
     }
 
-    /// The body at grid point (i_α, i_β).
-    pub fn body(&self, ia: usize, ib: usize) -> EllipsoidBody {
-        EllipsoidBody::ellipsoid(
+    /// The body at grid point (i_α, i of the second parameter).
+    pub fn body(&self, ia: usize, ib: usize) -> AnyBody {
+        AnyBody::new(
+            self.shape,
             self.alpha.values[ia],
-            self.beta.values[ib],
+            self.second.values[ib],
             self.nu,
             self.eta,
         )
         .expect("the scene's bodies were checked when it was parsed")
+    }
+
+    /// The shape's name: `ellipsoid`, `disk`, `truncated_ball` or `wheel`.
+    pub fn shape_name(&self) -> &'static str {
+        shape_name(self.shape)
+    }
+
+    /// The name of the second grid axis and file dimension ([`Scene::second`]): `beta`,
+    /// `cut`, or None for the disk (its file has no such dimension).
+    pub fn second_name(&self) -> Option<&'static str> {
+        second_parameter(self.shape)
     }
 
     /// A 64-bit fingerprint of the scene's text and of the program (version and git commit):
@@ -746,6 +814,23 @@ impl Scene {
         let mut hash = fnv1a(0xcbf2_9ce4_8422_2325, self.text.as_bytes());
         hash = fnv1a(hash, env!("CARGO_PKG_VERSION").as_bytes());
         fnv1a(hash, env!("RUBBER_ATLAS_GIT_COMMIT").as_bytes())
+    }
+}
+
+/// The shapes a scene may name.
+const SHAPE_NAMES: [&str; 4] = ["ellipsoid", "disk", "truncated_ball", "wheel"];
+
+fn shape_name(shape: Option<EdgedKind>) -> &'static str {
+    shape.map_or("ellipsoid", |k| k.name())
+}
+
+/// The shape's parameter beside α: β of the ellipsoid, the cut of the cut balls, none for the
+/// disk.
+fn second_parameter(shape: Option<EdgedKind>) -> Option<&'static str> {
+    match shape {
+        None => Some("beta"),
+        Some(EdgedKind::Disk) => None,
+        Some(_) => Some("cut"),
     }
 }
 

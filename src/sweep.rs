@@ -4,8 +4,7 @@
 //! Memory stays at one slice's worth whatever the grid.
 
 use crate::atlas::{
-    self, compute_rows, status_flag, Block, Region, Shard, Unit, Variable, COMPONENT_SLOTS,
-    FLAG_FILL,
+    self, compute_rows, Block, Region, Shard, Unit, Variable, COMPONENT_SLOTS, FLAG_FILL,
 };
 use crate::error::{AtlasError, Result};
 use crate::family::ComponentAxis;
@@ -52,8 +51,8 @@ pub struct Summary {
     /// Cells by `cell_status`: ok, no_motion, failed.
     pub cells_by_status: [u64; 3],
     /// Components by `status`: ok, tolerance_not_reached, fixed_point, separatrix,
-    /// high_energy_limit.
-    pub components_by_status: [u64; 5],
+    /// high_energy_limit, reaches_face.
+    pub components_by_status: [u64; 6],
     /// Work units of this run, and how many of them an interrupted run had finished.
     pub units: usize,
     pub units_resumed: usize,
@@ -67,13 +66,13 @@ pub struct Summary {
 
 impl Summary {
     /// Words of a unit's counts in the journal.
-    const WORDS: usize = 10;
+    const WORDS: usize = 11;
 
     /// The counts of a unit, for the journal.
     fn words(&self) -> [u64; Self::WORDS] {
         let [a, b, c] = self.cells_by_status;
-        let [d, e, f, g, h] = self.components_by_status;
-        [self.cells, self.components, a, b, c, d, e, f, g, h]
+        let [d, e, f, g, h, i] = self.components_by_status;
+        [self.cells, self.components, a, b, c, d, e, f, g, h, i]
     }
 
     fn from_words(w: &[u64]) -> Summary {
@@ -81,7 +80,7 @@ impl Summary {
             cells: w[0],
             components: w[1],
             cells_by_status: [w[2], w[3], w[4]],
-            components_by_status: [w[5], w[6], w[7], w[8], w[9]],
+            components_by_status: [w[5], w[6], w[7], w[8], w[9], w[10]],
             ..Summary::default()
         }
     }
@@ -116,9 +115,8 @@ impl Summary {
         }
         if let Some(status) = block.flags(variables, "status") {
             for &s in status {
-                // (reaches_face: no scene body has a face yet.)
-                if s <= status_flag::HIGH_ENERGY_LIMIT {
-                    self.components_by_status[usize::from(s)] += 1;
+                if let Some(count) = self.components_by_status.get_mut(usize::from(s)) {
+                    *count += 1;
                 }
             }
         }
@@ -162,6 +160,12 @@ fn scene_attributes(scene: &Scene, shard: Shard, units: usize) -> Vec<(String, A
             "scene_fingerprint".into(),
             text(&format!("{:016x}", scene.fingerprint())),
         ),
+    ]);
+    // The ellipsoid's files are as they always were; another shape names itself.
+    if scene.shape.is_some() {
+        attributes.push(("shape".into(), text(scene.shape_name())));
+    }
+    attributes.extend([
         ("nu".into(), AttrValue::Number(scene.nu)),
         ("eta".into(), AttrValue::Number(scene.eta)),
         ("tolerance".into(), AttrValue::Number(scene.options.tol)),
@@ -245,7 +249,8 @@ pub fn footprint(scene: &Scene, shard: Shard, threads: usize) -> Footprint {
 /// for this shard, and whole ([`AtlasFile::is_whole`]).
 fn output_is_current(out: &Path, scene: &Scene, shard: Shard, axis: &ComponentAxis) -> bool {
     let region = shard.region(scene.shape());
-    let Ok(file) = AtlasFile::open(out, &region, &atlas::scene_variables(scene), axis) else {
+    let Ok(file) = AtlasFile::open(out, scene, &region, &atlas::scene_variables(scene), axis)
+    else {
         return false;
     };
     file.text_attribute("scene_fingerprint").as_deref()
@@ -540,7 +545,7 @@ pub fn merge(
                 ),
             ));
         }
-        let file = AtlasFile::open(path, &shard.region(shape), &variables, &axis)?;
+        let file = AtlasFile::open(path, &scene, &shard.region(shape), &variables, &axis)?;
         if file.text_attribute("scene_fingerprint").as_deref() != Some(fingerprint.as_str()) {
             return Err(AtlasError::atlas(
                 path,

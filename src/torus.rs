@@ -1097,8 +1097,56 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         inside.into_iter().map(Site::at).collect()
     }
 
+    /// A kink `plain` inside a libration as a piece end, its gap measured from the nearer
+    /// turning point: ε − V(k) taken as V(b) − V(k) = −sin(k − b) D(k, b) (D the divided
+    /// difference of V, free of cancellation on the part both lie on) rather than ε − V(k),
+    /// whose rounding, a few ulps of V, is not small against ε − V(k) when the kink lies
+    /// near the turning point: the two pieces' gaps there would carry a relative error
+    /// ulps(V)/(ε − V(k)), and T an error growing like its inverse square root (measured:
+    /// 3e-9 in N at 1e-13 from the kink on a truncated ball, and a wrong N within an ulp).
+    /// The turning point's level is the one its pieces are measured against already. None
+    /// where the kink is too close to the turning point to tell on which side it lies (the
+    /// computed gap not above twice its rounding): it is not cut there, and the piece's
+    /// integrand differs from an analytic one only that close to its end.
+    fn kink_end_from_turning_point(
+        &self,
+        plain: PieceEnd,
+        lower: &PieceEnd,
+        upper: &PieceEnd,
+    ) -> Option<PieceEnd> {
+        let from_lower = self.separation(&lower.site, &plain.site);
+        let from_upper = self.separation(&plain.site, &upper.site);
+        // The signed step k − b from the nearer turning point b.
+        let (turning, step) = if from_lower <= from_upper {
+            (lower, from_lower)
+        } else {
+            (upper, -from_upper)
+        };
+        let (sin_step, cos_step) = libm::sincos(step);
+        if cos_step <= -0.4 {
+            return Some(plain);
+        }
+        let (d, scale) = divided_difference(self, plain.angle, turning.angle, sin_step, cos_step);
+        let excess = -sin_step * d;
+        let error = 4.0 * EPS * (excess.abs() + sin_step.abs() * scale);
+        if excess <= 2.0 * error {
+            return None;
+        }
+        Some(if error < plain.excess_error {
+            PieceEnd {
+                excess,
+                level: turning.level,
+                excess_error: error,
+                ..plain
+            }
+        } else {
+            plain
+        })
+    }
+
     /// The pieces of a component: cut at the ends and, if `cut`, at every interior maximum or
-    /// tangency and at every kink of U.
+    /// tangency and at every kink of U (kinks within a libration measured from its turning
+    /// points, [`EffectivePotential::kink_end_from_turning_point`]).
     fn pieces(&self, energy: f64, component: &Component, cut: bool) -> Vec<Piece> {
         let end = |site: Site, turning: bool| {
             let angle = site.angle();
@@ -1130,17 +1178,26 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 .filter(|p| cut && (p.kind != CriticalKind::Minimum || sharp))
                 .map(|p| end(p.site, false)),
         );
+        let upper = end(component.upper, turning);
         if cut {
             // U″ jumps at a kink: each piece must be analytic for the rule's fast convergence.
+            let lower = ends[0];
             ends.extend(
                 self.kinks_inside(component.lower.theta, component.upper.theta)
                     .into_iter()
-                    .map(|site| end(site, false)),
+                    .filter_map(|site| {
+                        let plain = end(site, false);
+                        if turning {
+                            self.kink_end_from_turning_point(plain, &lower, &upper)
+                        } else {
+                            Some(plain)
+                        }
+                    }),
             );
             ends[1..].sort_by(|a, b| a.site.theta.total_cmp(&b.site.theta));
             ends.dedup_by(|a, b| a.site.theta == b.site.theta);
         }
-        ends.push(end(component.upper, turning));
+        ends.push(upper);
         ends.windows(2)
             .map(|w| {
                 let (l, r) = (w[0], w[1]);

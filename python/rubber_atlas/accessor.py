@@ -13,7 +13,7 @@ from . import _api
 
 # Short axis labels of the planes' dimensions.
 _LABELS = {"kappa": "κ", "energy": "ε", "excess_energy": "ε − V_min", "lambda": "λ = κ/√ε",
-           "s": "s = 1/√ε", "alpha": "α", "beta": "β", "nu": "ν", "eta": "η"}
+           "s": "s = 1/√ε", "alpha": "α", "beta": "β", "cut": "h", "nu": "ν", "eta": "η"}
 # At most this many resonance contours per panel: fewer denominators beyond.
 _MAX_LEVELS = 60
 # A trajectory's plane is drawn with equal scales only while the path's extents differ by at
@@ -332,12 +332,12 @@ class RubberAccessor:
         ax_t.set_title("theta(t)", fontsize=9)
         attrs = ds.attrs
         title = ", ".join(f"{k} = {float(attrs[k]):.7g}"
-                          for k in ("alpha", "beta", "nu", "eta", "kappa", "energy") if k in attrs)
+                          for k in ("alpha", "beta", "cut", "nu", "eta", "kappa", "energy") if k in attrs)
         fig.suptitle(f"{attrs.get('model', '')} model: {title}", fontsize=9)
         return fig
 
     @_reads
-    def plot_slice(self, alpha_index: int = 0, beta_index: int = 0, max_q: int = 7):
+    def plot_slice(self, alpha_index: int = 0, beta_index: int = 0, max_q: int = 7, *, cut_index: int = 0):
         """A matplotlib Figure of the rotation number of each torus family over a plane.
 
         One panel per family present: its rotation number N over the plane on a diverging
@@ -357,6 +357,9 @@ class RubberAccessor:
         max_q : int, default 7
             The largest denominator q of the contours N = p/q, ≥ 1; lowered where a panel
             would have more than 60 contours.
+        cut_index : int, default 0
+            The cut of a truncated ball or wheel atlas (index along ``cut``; the disk's
+            atlas has no second dimension).
 
         Returns
         -------
@@ -369,7 +372,7 @@ class RubberAccessor:
         ------
         ValueError
             The dataset is not an atlas or a `cells` result over two dimensions (besides
-            α and β); an index beyond ``alpha`` or ``beta`` (a dataset without that
+            α and β, or α and the cut); an index beyond ``alpha``, ``beta`` or ``cut`` (a dataset without that
             dimension has index 0 only); `max_q` < 1; a slice that is empty or whose axes
             are not finite; nothing to draw: neither rotation_number nor drift_radius (the
             fields left them out), or no finite value of them (the message counts the
@@ -398,7 +401,7 @@ class RubberAccessor:
         if max_q < 1:
             raise ValueError(f"invalid max_q = {max_q}: must be >= 1")
         cut = ds
-        for name, index in (("alpha", alpha_index), ("beta", beta_index)):
+        for name, index in (("alpha", alpha_index), ("beta", beta_index), ("cut", cut_index)):
             index = _api._count(f"{name}_index", index)
             size = ds.sizes[name] if name in ds.cell_status.dims else 1
             if not -size <= index < size:
@@ -498,8 +501,10 @@ class RubberAccessor:
         for ax in axes[0]:
             ax.set_xlabel(_LABELS.get(plane[0], plane[0]))
             ax.set_ylabel(_LABELS.get(plane[1], plane[1]))
-        body = ", ".join(f"{_LABELS[k]} = {float(cut[k]):g}" for k in ("alpha", "beta", "nu", "eta")
-                         if k in cut.coords and cut[k].ndim == 0)
+        shape = ds.attrs.get("shape", "")
+        body = ", ".join([shape] * bool(shape) + [f"{_LABELS[k]} = {float(cut[k]):g}"
+                                                  for k in ("alpha", "beta", "cut", "nu", "eta")
+                                                  if k in cut.coords and cut[k].ndim == 0])
         name = ds.attrs.get("scene_name", "")
         contours = f"; contours N = p/q, q ≤ {max_q} (integers black)" if denominators else ""
         fig.suptitle(f"{name}: {body}{contours}" if name else f"{body}{contours}", fontsize=10)

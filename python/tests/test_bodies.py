@@ -128,3 +128,38 @@ def test_resonance_of_an_edged_body_equals_the_command(tmp_path):
         ra.resonance(0.1, 3.0, 1.0, 2.0, 0, shape="disk")
     with pytest.raises(TypeError, match="needs cut"):
         ra.resonance(0.1, None, 1.0, 2.0, 0, shape="truncated_ball")
+
+
+@pytest.mark.parametrize("shape", ["disk", "wheel"])
+def test_an_atlas_of_an_edged_body_opens_with_its_own_dimensions_and_equals_cells(shape, tmp_path):
+    """`rubber-atlas run` on a scene with `[body] shape`: dimensions named after the shape's
+    parameters, values equal to `cells(shape=…)` bit for bit, and the accessor takes them."""
+    import matplotlib
+    matplotlib.use("Agg")
+    second = "cut = [0.3, 0.6]\n" if shape == "wheel" else ""
+    scene = tmp_path / "s.toml"
+    scene.write_text(f'name = "s"\n[body]\nshape = "{shape}"\nnu = 0.5\neta = 2.0\n[axes]\nalpha = [-0.3, 0.1]\n'
+                     f"{second}kappa = {{ start = 0.0, stop = 1.5, num = 7 }}\n"
+                     "energy = { start = 0.5, stop = 3.0, num = 9 }\n")
+    run("run", scene, "--out", tmp_path / "s.h5", "--quiet")
+    with ra.open_atlas(tmp_path / "s.h5", check=True) as atlas:
+        body_dims = ["alpha", "cut"] if shape == "wheel" else ["alpha"]
+        assert list(atlas.cell_status.dims) == [*body_dims, "kappa", "energy"]
+        assert atlas.attrs["shape"] == shape
+        cut = atlas.cut if shape == "wheel" else None
+        grid = ra.cells(atlas.alpha, None, 0.5, 2.0, atlas.kappa, atlas.energy, shape=shape, cut=cut)
+        for name in ("rotation_number", "period", "drift_radius", "theta_min"):
+            a = atlas[name].transpose(*grid[name].dims).values
+            b = grid[name].values
+            assert a.shape == b.shape
+            assert np.array_equal(a, b, equal_nan=True), name
+        body = {"alpha": 0.1, **({"cut": 0.6} if shape == "wheel" else {})}
+        found = atlas.rubber.components(**body, kappa=float(atlas.kappa[3]), energy=float(atlas.energy[8]))
+        assert found and all(np.isfinite(c["rotation_number"]) for c in found)
+        with pytest.raises(KeyError, match="give the cell by"):
+            atlas.rubber.components(alpha=0.1, beta=3.0, kappa=float(atlas.kappa[3]), energy=float(atlas.energy[8]))
+        top = 1 if shape == "wheel" else 0
+        fig = atlas.rubber.plot_slice(alpha_index=1, cut_index=top)
+        assert shape in fig._suptitle.get_text()
+        with pytest.raises(ValueError, match=f"cut_index = {top + 1}"):
+            atlas.rubber.plot_slice(cut_index=top + 1)

@@ -129,3 +129,46 @@ def test_resonance_curves_of_edged_bodies_are_on_resonance_at_50_digits(case):
             assert abs(ref[0].rotation_number - p / q) <= tol + point["error_estimate"], where
             checked += 1
     assert checked >= 3
+
+
+# (shape, α, cut, ν, η, κ, which kink, δ): the level ε = V(θ_t) with the turning point θ_t a
+# distance |δ| from a kink, on its far side for δ > 0 (the kink inside the torus, the hard case:
+# θ_k − δ for the truncated ball's well above its kink, θ_k + δ for the wheel's well below its
+# upper kink), on the torus's own side for δ < 0.
+NEAR_KINK = [
+    ("truncated_ball", 0.2, 0.4, 0.7, 1.3, 1.26, 0, 1e-3),
+    ("truncated_ball", 0.2, 0.4, 0.7, 1.3, 1.26, 0, 1e-7),
+    ("truncated_ball", 0.2, 0.4, 0.7, 1.3, 1.26, 0, 1e-11),
+    ("truncated_ball", 0.2, 0.4, 0.7, 1.3, 1.26, 0, 3e-16),
+    ("truncated_ball", 0.2, 0.4, 0.7, 1.3, 1.26, 0, -1e-13),
+    ("wheel", 0.25, 0.7, 0.7, 1.3, 0.5, 1, 1e-9),
+    ("wheel", 0.25, 0.7, 0.7, 1.3, 0.5, 1, 4e-16),
+    ("wheel", 0.25, 0.7, 0.7, 1.3, 0.5, 1, -1e-12),
+]
+
+
+@pytest.mark.parametrize("case", NEAR_KINK, ids=[f"{c[0]}-{c[6]}-{c[7]:g}" for c in NEAR_KINK])
+def test_a_turning_point_next_to_a_kink_keeps_the_full_accuracy(case):
+    """A kink within a few ulps to 1e-3 of a turning point: the pieces' gaps are measured from
+    the turning point, so N and T meet 1e-12 with estimates near 1e-14 (they were 3e-9 at
+    1e-13 from the kink, and N was wrong, 0.35 instead of -0.09, within an ulp of it)."""
+    shape, alpha, cut, nu, eta, kappa, which, delta = case
+    cell = EdgedCell(shape, alpha, cut, nu, eta, kappa)
+    with mpmath.workdps(50):
+        kink = cell.kinks()[which]
+        theta_k = kink.theta
+        theta = theta_k - delta if which == 0 else theta_k + delta
+        energy = float(cell.potential(at(theta)))
+    reference = cell.components(energy)
+    out = run_cell(shape, alpha, cut, nu, eta, kappa, energy, 1e-12)
+    comps = out["components"]
+    assert len(comps) == len(reference), (out, reference)
+    near = 0
+    for got, ref in zip(comps, reference):
+        where = f"{case}: {got} vs {ref}"
+        assert got["status"] == "ok", where
+        assert abs(got["period"] - ref.period) <= got["errors"]["period"], where
+        assert abs(got["rotation_number"] - ref.rotation_number) <= got["errors"]["rotation_number"], where
+        assert got["errors"]["rotation_number"] <= 1e-13 and got["errors"]["period"] <= 1e-13 * ref.period, where
+        near += min(abs(got["theta_min"] - float(theta_k)), abs(got["theta_max"] - float(theta_k))) < 2e-3
+    assert near, f"{case}: no turning point next to the kink {float(theta_k)}"

@@ -213,6 +213,18 @@ impl EdgedShape {
         }
     }
 
+    /// Whether the angle `a` lies at a kink (to a few ulps of its cosine ±h) that bounds
+    /// `part`: U and U′ of either part agree there (U″ jumps).
+    fn bounds(&self, a: Angle, part: Part) -> bool {
+        const NEAR: f64 = 8.0 * f64::EPSILON;
+        const STEP: f64 = 1e-6;
+        // cosθ at the kinks: h, and −h (the wheel's upper edge).
+        [self.cut, -self.cut][..self.kink_count].iter().any(|&c| {
+            (a.cos - c).abs() <= NEAR
+                && (self.part_at_cos(c + STEP) == part || self.part_at_cos(c - STEP) == part)
+        })
+    }
+
     /// The part in contact when the axis is tilted so that γ3 = cosθ = `cos`.
     #[inline]
     fn part_at_cos(&self, cos: f64) -> Part {
@@ -349,8 +361,9 @@ impl Shape for EdgedShape {
 
     /// (U(x) − U(y)) / sin(x − y) on one part, without cancellation: with d = x − y,
     /// (sin x − sin y)/sin d = cos y − sin y sin d/(1 + cos d) and
-    /// (cos x − cos y)/sin d = −sin y − cos y sin d/(1 + cos d). Across a kink, or where
-    /// sinθ changes sign, U is differenced directly (the default's rounding scale).
+    /// (cos x − cos y)/sin d = −sin y − cos y sin d/(1 + cos d). An angle at a kink belongs
+    /// to both parts it joins. Across a kink, or where sinθ changes sign, U is differenced
+    /// directly (the default's rounding scale).
     #[inline]
     fn potential_divided_difference(
         &self,
@@ -359,11 +372,19 @@ impl Shape for EdgedShape {
         sin_diff: f64,
         cos_diff: f64,
     ) -> (f64, f64) {
-        let part = self.part(y);
-        if part != self.part(x) || x.sin * y.sin <= 0.0 || cos_diff <= -0.5 {
+        let part = match (self.part(x), self.part(y)) {
+            (px, py) if px == py => Some(py),
+            // U is continuous at a kink: an angle at one takes the other angle's part, so
+            // that a divided difference from a kink (a piece's end) stays free of
+            // cancellation.
+            (px, _) if self.bounds(y, px) => Some(px),
+            (_, py) if self.bounds(x, py) => Some(py),
+            _ => None,
+        };
+        let Some(part) = part.filter(|_| x.sin * y.sin > 0.0 && cos_diff > -0.5) else {
             let (ux, uy) = (self.potential_at(x), self.potential_at(y));
             return ((ux - uy) / sin_diff, (ux.abs() + uy.abs()) / sin_diff.abs());
-        }
+        };
         let t = sin_diff / (1.0 + cos_diff);
         let sin_dd = y.cos - y.sin * t;
         let cos_dd = -y.sin - y.cos * t;

@@ -17,25 +17,26 @@ pub const SCENE_FORMAT: &str = "\
 Scene files (TOML):
   name = \"paper-c\"                 # the default output: paper-c.h5 beside the scene
   [body]
+  shape = \"ellipsoid\"              # the default; or \"disk\", \"truncated_ball\", \"wheel\"
   nu = 0.5                         # i3 / i1, 0 < nu <= 2
   eta = 0.5                        # m b3^2 / i1 > 0
   [axes]                           # each axis: a list, or { start, stop, num [, spacing = \"log\"] }
-  alpha = [0.5]                    # -1 < alpha < 1
-  beta = [3.0]                     # beta > 0
+  alpha = [0.5]                    # -1 < alpha < 1 (the disk: -100 <= alpha <= 100)
+  beta = [3.0]                     # beta > 0; the cut balls take cut instead, the disk neither
   kappa = { start = 0.0, stop = 2.0, num = 201 }
   energy = { start = 0.5, stop = 4.5, num = 201 }
   [solver]
   tolerance = 1e-10                # 1e-15 ... 0.1
-  method = \"quadrature\"           # or \"ode\"
+  method = \"quadrature\"            # or \"ode\"
   resonance_tol = 1e-9             # |N - round(N)| counted as an integer resonance
   [outputs]
   fields = [\"rotation_number\", \"drift_radius\", \"bounded\"]   # default: all
-  layout = \"family\"               # component axis: one torus family per slot, or \"theta_min\"
+  layout = \"family\"                # component axis: one torus family per slot, or \"theta_min\"
 
 The plane is one of: kappa with energy; kappa with excess_energy (energy measured from the
 bottom of V at each kappa); lambda with s (kappa = lambda / s, energy = 1 / s^2; s = 0 is
-the high-energy limit). Fields: theta_min, theta_max, period, omega_theta, omega_psi,
-rotation_number, drift, drift_radius, bounded, motion, status, error_estimate. Examples:
+the high-energy limit, for the ellipsoid only). Shapes and their parameters: docs/bodies.md.
+Fields: theta_min, theta_max, period, omega_theta, omega_psi, rotation_number, drift, drift_radius, bounded, motion, status, error_estimate. Examples:
 atlas/*.toml in the repository; every key: docs/scenes.md.";
 
 #[derive(Debug, Args)]
@@ -240,7 +241,7 @@ pub(super) fn shards_to_fit(scene: &Scene, threads: usize) -> String {
 
 pub(super) fn print_summary(summary: &sweep::Summary, out: &std::path::Path, threads: usize) {
     let [ok, no_motion, failed] = summary.cells_by_status;
-    let [c_ok, c_tol, c_fixed, c_sep, c_limit] = summary.components_by_status;
+    let [c_ok, c_tol, c_fixed, c_sep, c_limit, c_face] = summary.components_by_status;
     let rate = summary.cells_computed as f64 / summary.seconds.max(1e-9);
     println!("wrote {}", out.display());
     println!(
@@ -249,7 +250,7 @@ pub(super) fn print_summary(summary: &sweep::Summary, out: &std::path::Path, thr
     );
     println!(
         "components by status: ok {c_ok}, tolerance_not_reached {c_tol}, fixed_point {c_fixed}, \
-         separatrix {c_sep}, high_energy_limit {c_limit}"
+         separatrix {c_sep}, high_energy_limit {c_limit}, reaches_face {c_face}"
     );
     println!(
         "units: {} ({} resumed from an interrupted run, {} computed now)",

@@ -1,8 +1,9 @@
-//! The atlas file (docs/files.md): one HDF5 file per scene with the coordinates `alpha, beta,
-//! kappa, energy, component` as HDF5 dimension scales attached to every variable (so that
-//! xarray's h5netcdf engine shows named dimensions), CF attributes, and variables chunked
-//! one work unit (whole κ-rows of one (α, β) slice) per chunk and compressed. A file holds
-//! a region of the scene's grid: all of it, or a shard's box.
+//! The atlas file (docs/files.md): one HDF5 file per scene with the coordinates (the shape's
+//! parameters: `alpha, beta` of the ellipsoid, `alpha, cut` of the cut balls, `alpha` of the
+//! disk; the plane's two; `component`) as HDF5 dimension scales attached to every variable (so
+//! that xarray's h5netcdf engine shows named dimensions), CF attributes, and variables chunked
+//! one work unit (whole κ-rows of one body's slice) per chunk and compressed. A file holds a
+//! region of the scene's grid: all of it, or a shard's box.
 
 use super::h5::{attach_scale, describe, set_scale, text_attr, write_attr};
 use crate::atlas::{Block, Column, Kind, Region, Unit, Variable, FLAG_FILL};
@@ -11,14 +12,13 @@ use crate::error::{AtlasError, Result};
 use crate::family::ComponentAxis;
 use crate::scene::{Plane, Scene};
 use hdf5::types::VarLenUnicode;
-use ndarray::s;
 use std::path::{Path, PathBuf};
 
 /// The deflate level of the variables (1: a third of level 4's time for 10–20 % more bytes
 /// on these arrays after the shuffle filter).
 const DEFLATE_LEVEL: u8 = 1;
 
-/// The names of the dimensions, slowest first.
+/// The names of an ellipsoid atlas's dimensions on the (κ, ε) plane, slowest first.
 pub const DIMENSIONS: [&str; 5] = ["alpha", "beta", "kappa", "energy", "component"];
 
 pub use crate::cf::AttrValue;
@@ -31,6 +31,8 @@ pub struct AtlasFile {
     variables: Vec<Variable>,
     region: Region,
     axis: ComponentAxis,
+    /// Whether the file has the grid's second dimension (every shape but the disk).
+    second: bool,
 }
 
 impl AtlasFile {
@@ -85,20 +87,21 @@ impl AtlasFile {
                 ),
             ),
         };
-        let coords: [(&str, &[f64], (&str, cf::Units)); 4] = [
-            (
-                "alpha",
-                &scene.alpha.values[region.alpha.clone()],
-                known("alpha"),
-            ),
-            (
-                "beta",
-                &scene.beta.values[region.beta.clone()],
-                known("beta"),
-            ),
+        let second = scene
+            .second_name()
+            .map(|name| (name, &scene.second.values[region.beta.clone()], known(name)));
+        let coords: Vec<(&str, &[f64], (&str, cf::Units))> = [(
+            "alpha",
+            &scene.alpha.values[region.alpha.clone()],
+            known("alpha"),
+        )]
+        .into_iter()
+        .chain(second)
+        .chain([
             (row_name, &scene.kappa.values[region.rows.clone()], row),
-            (column_name, &scene.energy.values, column),
-        ];
+            (column_name, &scene.energy.values[..], column),
+        ])
+        .collect();
         let mut scales = Vec::new();
         for (name, values, (long_name, units)) in coords {
             let d = file.new_dataset_builder().with_data(values).create(name)?;
@@ -142,19 +145,30 @@ impl AtlasFile {
         scales.push(d);
         let slots = axis.len();
 
-        let shape = scene.shape();
+        let has_second = scene.second_name().is_some();
         let [na, nb, nk, ne] = region.shape();
-        let [betas, rows] = region.chunk(shape);
+        let [betas, rows] = region.chunk(scene.shape());
+        // The dimensions of a variable per cell, and of one per cell and component.
+        let (cell_shape, cell_chunk) = if has_second {
+            (vec![na, nb, nk, ne], vec![1, betas, rows, ne])
+        } else {
+            (vec![na, nk, ne], vec![1, rows, ne])
+        };
+        let with_slots = |dims: &[usize], n: usize| [dims, &[n]].concat();
+        let (slot_shape, slot_chunk) = (
+            with_slots(&cell_shape, slots),
+            with_slots(&cell_chunk, slots),
+        );
         let mut datasets = Vec::with_capacity(variables.len());
         for v in variables {
             let per_cell = v.kind.per_cell();
             let d = if v.kind == Kind::CellValue {
                 file.new_dataset::<f64>()
-                    .chunk([1, betas, rows, ne])
+                    .chunk(cell_chunk.clone())
                     .shuffle()
                     .deflate(DEFLATE_LEVEL)
                     .fill_value(f64::NAN)
-                    .shape([na, nb, nk, ne])
+                    .shape(cell_shape.clone())
                     .create(v.name)?
             } else if per_cell {
                 // Where no unit was written yet, `cell_status` reads `not_computed`, never
@@ -165,27 +179,27 @@ impl AtlasFile {
                     0u8
                 };
                 file.new_dataset::<u8>()
-                    .chunk([1, betas, rows, ne])
+                    .chunk(cell_chunk.clone())
                     .shuffle()
                     .deflate(DEFLATE_LEVEL)
                     .fill_value(fill)
-                    .shape([na, nb, nk, ne])
+                    .shape(cell_shape.clone())
                     .create(v.name)?
             } else if v.kind == Kind::Value {
                 file.new_dataset::<f64>()
-                    .chunk([1, betas, rows, ne, slots])
+                    .chunk(slot_chunk.clone())
                     .shuffle()
                     .deflate(DEFLATE_LEVEL)
                     .fill_value(f64::NAN)
-                    .shape([na, nb, nk, ne, slots])
+                    .shape(slot_shape.clone())
                     .create(v.name)?
             } else {
                 file.new_dataset::<u8>()
-                    .chunk([1, betas, rows, ne, slots])
+                    .chunk(slot_chunk.clone())
                     .shuffle()
                     .deflate(DEFLATE_LEVEL)
                     .fill_value(FLAG_FILL)
-                    .shape([na, nb, nk, ne, slots])
+                    .shape(slot_shape.clone())
                     .create(v.name)?
             };
             describe(&d, v.long_name, v.units)?;
@@ -207,8 +221,14 @@ impl AtlasFile {
                 coordinates.extend(scene.plane.auxiliary());
             }
             text_attr(&d, "coordinates", &coordinates.join(" "))?;
-            let dims = if per_cell { 4 } else { 5 };
-            for (i, scale) in scales.iter().take(dims).enumerate() {
+            // The grid's scales, and the component's last where the variable has it.
+            let grid = scales.len() - 1;
+            let own: Vec<&hdf5::Dataset> = if per_cell {
+                scales[..grid].iter().collect()
+            } else {
+                scales.iter().collect()
+            };
+            for (i, scale) in own.into_iter().enumerate() {
                 attach_scale(&d, scale, i)?;
             }
             datasets.push(d);
@@ -220,13 +240,15 @@ impl AtlasFile {
             variables: variables.to_vec(),
             region: region.clone(),
             axis: axis.clone(),
+            second: has_second,
         })
     }
 
-    /// Opens an existing atlas file of the part `region` of the scene's grid for reading;
+    /// Opens an existing atlas file of the part `region` of `scene`'s grid for reading;
     /// `variables` are those its scene asks for, `axis` its component axis.
     pub fn open(
         path: &Path,
+        scene: &Scene,
         region: &Region,
         variables: &[Variable],
         axis: &ComponentAxis,
@@ -244,6 +266,7 @@ impl AtlasFile {
                 variables: variables.to_vec(),
                 region: region.clone(),
                 axis: axis.clone(),
+                second: scene.second_name().is_some(),
             })
         };
         inner().map_err(|e| AtlasError::atlas(path, e))
@@ -275,6 +298,9 @@ impl AtlasFile {
     pub fn is_whole(&self) -> bool {
         self.variables.iter().zip(&self.datasets).all(|(v, d)| {
             let mut shape = self.region.shape().to_vec();
+            if !self.second {
+                shape.remove(1);
+            }
             if !v.kind.per_cell() {
                 shape.push(self.axis.len());
             }
@@ -319,12 +345,17 @@ impl AtlasFile {
         }
         let r = &self.region;
         let [row, column] = scene.plane.axis_names();
-        let expected: [(&str, &[f64]); 4] = [
-            ("alpha", &scene.alpha.values[r.alpha.clone()]),
-            ("beta", &scene.beta.values[r.beta.clone()]),
-            (row, &scene.kappa.values[r.rows.clone()]),
-            (column, &scene.energy.values),
-        ];
+        let second = scene
+            .second_name()
+            .map(|name| (name, &scene.second.values[r.beta.clone()]));
+        let expected: Vec<(&str, &[f64])> = [("alpha", &scene.alpha.values[r.alpha.clone()])]
+            .into_iter()
+            .chain(second)
+            .chain([
+                (row, &scene.kappa.values[r.rows.clone()]),
+                (column, &scene.energy.values[..]),
+            ])
+            .collect();
         expected.iter().all(|(name, want)| {
             self.file
                 .dataset(name)
@@ -347,16 +378,11 @@ impl AtlasFile {
             .zip(&self.datasets)
             .zip(&encoded.chunks)
         {
-            let r = &self.region;
-            let mut offset = vec![
-                (unit.alpha_index - r.alpha.start) as u64,
-                (unit.betas.start - r.beta.start) as u64,
-                (unit.rows.start - r.rows.start) as u64,
-                0,
-            ];
-            if !v.kind.per_cell() {
-                offset.push(0);
-            }
+            let offset: Vec<u64> = self
+                .unit_box(unit, v.kind)
+                .iter()
+                .map(|r| r.start as u64)
+                .collect();
             let status = hdf5::sync::sync(|| unsafe {
                 hdf5_sys::h5d::H5Dwrite_chunk(
                     d.id(),
@@ -377,39 +403,48 @@ impl AtlasFile {
         Ok(())
     }
 
-    /// Reads the values of `unit`.
-    pub fn read_unit(&self, unit: &Unit) -> Result<Block> {
+    /// The box of `unit` in a variable of `kind` of this file, dimension by dimension.
+    fn unit_box(&self, unit: &Unit, kind: Kind) -> Vec<std::ops::Range<usize>> {
         let g = &self.region;
         let ia = unit.alpha_index - g.alpha.start;
-        let ib = unit.betas.start - g.beta.start..unit.betas.end - g.beta.start;
-        let r = unit.rows.start - g.rows.start..unit.rows.end - g.rows.start;
+        let mut dims = Vec::with_capacity(5);
+        dims.push(ia..ia + 1);
+        if self.second {
+            dims.push(unit.betas.start - g.beta.start..unit.betas.end - g.beta.start);
+        }
+        dims.push(unit.rows.start - g.rows.start..unit.rows.end - g.rows.start);
+        dims.push(0..g.columns);
+        if !kind.per_cell() {
+            dims.push(0..self.axis.len());
+        }
+        dims
+    }
+
+    /// Reads the values of `unit`.
+    pub fn read_unit(&self, unit: &Unit) -> Result<Block> {
+        use hdf5::{Hyperslab, Selection, SliceOrIndex};
         let read = || -> hdf5::Result<Block> {
             let mut columns = Vec::with_capacity(self.variables.len());
             for (v, d) in self.variables.iter().zip(&self.datasets) {
+                let slab: Vec<SliceOrIndex> = self
+                    .unit_box(unit, v.kind)
+                    .into_iter()
+                    .map(|r| SliceOrIndex::SliceCount {
+                        start: r.start,
+                        step: 1,
+                        count: r.len(),
+                        block: 1,
+                    })
+                    .collect();
+                let selection = Selection::from(Hyperslab::from(slab));
                 columns.push(match v.kind {
-                    Kind::CellFlag => Column::U8(
-                        d.read_slice::<u8, _, ndarray::Ix3>(s![ia, ib.clone(), r.clone(), ..])?
+                    Kind::CellFlag | Kind::Flag => Column::U8(
+                        d.read_slice::<u8, _, ndarray::IxDyn>(selection)?
                             .into_raw_vec_and_offset()
                             .0,
                     ),
-                    Kind::Flag => Column::U8(
-                        d.read_slice::<u8, _, ndarray::Ix4>(s![ia, ib.clone(), r.clone(), .., ..])?
-                            .into_raw_vec_and_offset()
-                            .0,
-                    ),
-                    Kind::Value => Column::F64(
-                        d.read_slice::<f64, _, ndarray::Ix4>(s![
-                            ia,
-                            ib.clone(),
-                            r.clone(),
-                            ..,
-                            ..
-                        ])?
-                        .into_raw_vec_and_offset()
-                        .0,
-                    ),
-                    Kind::CellValue => Column::F64(
-                        d.read_slice::<f64, _, ndarray::Ix3>(s![ia, ib.clone(), r.clone(), ..])?
+                    Kind::Value | Kind::CellValue => Column::F64(
+                        d.read_slice::<f64, _, ndarray::IxDyn>(selection)?
                             .into_raw_vec_and_offset()
                             .0,
                     ),

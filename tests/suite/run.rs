@@ -85,6 +85,15 @@ fn arrays(path: &Path) -> Vec<(String, Vec<u8>)> {
     out
 }
 
+/// Value `i` of the scene axis `{ start, stop, num }` (docs/scenes.md: the last exactly `stop`).
+fn axis_value(start: f64, stop: f64, num: usize, i: usize) -> f64 {
+    if i + 1 == num {
+        stop
+    } else {
+        start + (stop - start) / (num - 1) as f64 * i as f64
+    }
+}
+
 fn assert_same_arrays(a: &Path, b: &Path) {
     let (x, y) = (arrays(a), arrays(b));
     let names = |v: &[(String, Vec<u8>)]| v.iter().map(|(n, _)| n.clone()).collect::<Vec<_>>();
@@ -213,14 +222,8 @@ fn atlas_values_equal_the_cell_command() {
     let slots = labels.len();
     let families = ["well_0", "well_pi", "well_equator", "over_the_top"];
     let (alphas, betas) = ([0.2, 0.5], [0.8, 3.0]);
-    let kappa = |i: usize| if i == 23 { 1.5 } else { 1.5 / 23.0 * i as f64 };
-    let energy = |j: usize| {
-        if j == 39 {
-            4.0
-        } else {
-            0.5 + 3.5 / 39.0 * j as f64
-        }
-    };
+    let kappa = |i: usize| axis_value(0.0, 1.5, 24, i);
+    let energy = |j: usize| axis_value(0.5, 4.0, 40, j);
     let mut checked = 0;
     for (ia, ib, ik, ie) in [
         (0, 0, 5, 20),
@@ -890,4 +893,244 @@ fn a_damaged_journal_unit_is_computed_again_and_counted_once() {
         );
     }
     assert_same_arrays(&reference, &out);
+}
+
+/// A scene of an edged body (docs/bodies.md): `shape` and its axes beside α.
+fn edged_scene(dir: &Path, shape: &str, second: &str, plane: &str) -> PathBuf {
+    let path = dir.join(format!("{shape}.toml"));
+    std::fs::write(
+        &path,
+        format!(
+            "name = \"{shape}\"\n[body]\nshape = \"{shape}\"\nnu = 0.5\neta = 2.0\n[axes]\n\
+             alpha = [-0.3, 0.1]\n{second}\n{plane}\n[solver]\ntolerance = 1e-8\n"
+        ),
+    )
+    .unwrap();
+    path
+}
+
+#[test]
+fn edged_body_atlases_equal_the_cell_command_and_their_shards_merge() {
+    let dir = tempfile::tempdir().unwrap();
+    let plane = "kappa = { start = 0.0, stop = 1.5, num = 12 }\n\
+                 energy = { start = 0.5, stop = 3.0, num = 15 }";
+    let kappa = |i: usize| axis_value(0.0, 1.5, 12, i);
+    let energy = |j: usize| axis_value(0.5, 3.0, 15, j);
+    let statuses = [
+        "ok",
+        "tolerance_not_reached",
+        "fixed_point",
+        "separatrix",
+        "high_energy_limit",
+        "reaches_face",
+    ];
+    let families = ["well_0", "well_pi", "well_equator", "over_the_top"];
+    for (shape, second, values) in [
+        ("disk", "", &[][..]),
+        ("truncated_ball", "cut = [-0.2, 0.4]", &[-0.2, 0.4][..]),
+        ("wheel", "cut = [0.3, 0.6]", &[0.3, 0.6][..]),
+    ] {
+        let scene = edged_scene(dir.path(), shape, second, plane);
+        let s = scene.to_str().unwrap();
+        let single = dir.path().join(format!("{shape}.h5"));
+        let summary = ok(&run(&["run", s, "--out", single.to_str().unwrap()]));
+        let file = hdf5::File::open(&single).unwrap();
+        // The dimensions are the shape's parameters: the disk's file has no second one.
+        let status = file.dataset("cell_status").unwrap();
+        let grid: Vec<usize> = [2].into_iter().chain(values.first().map(|_| 2)).collect();
+        assert_eq!(
+            status.shape(),
+            [grid.clone(), vec![12, 15]].concat(),
+            "{shape}"
+        );
+        assert!(file.dataset("beta").is_err(), "{shape}");
+        assert_eq!(file.dataset("cut").is_ok(), !values.is_empty(), "{shape}");
+        let attribute = file
+            .attr("shape")
+            .unwrap()
+            .read_scalar::<hdf5::types::VarLenUnicode>();
+        assert_eq!(attribute.unwrap().as_str(), shape);
+        let read = |name: &str| file.dataset(name).unwrap().read_raw::<f64>().unwrap();
+        let flags = |name: &str| file.dataset(name).unwrap().read_raw::<u8>().unwrap();
+        let (n, period, theta_min) = (read("rotation_number"), read("period"), read("theta_min"));
+        let (count, status, family) = (flags("n_components"), flags("status"), flags("family"));
+        let labels = flags("component");
+        let slots = labels.len();
+        let cuts: Vec<Option<f64>> = if values.is_empty() {
+            vec![None]
+        } else {
+            values.iter().copied().map(Some).collect()
+        };
+        let mut compared = 0;
+        let mut faces = 0;
+        for (ia, alpha) in [-0.3, 0.1].into_iter().enumerate() {
+            for (ib, cut) in cuts.iter().enumerate() {
+                for (ik, ie) in [(0, 4), (0, 12), (3, 7), (6, 14), (11, 13), (9, 2)] {
+                    let cell = ((ia * cuts.len() + ib) * 12 + ik) * 15 + ie;
+                    let (k, e) = (format!("{:?}", kappa(ik)), format!("{:?}", energy(ie)));
+                    let a = alpha.to_string();
+                    let mut args = vec![
+                        "cell", "--shape", shape, "--alpha", &a, "--nu", "0.5", "--eta", "2",
+                        "--kappa", &k, "--energy", &e, "--tol", "1e-8", "--json",
+                    ];
+                    let c = cut.map(|c| c.to_string());
+                    if let Some(c) = &c {
+                        args.extend(["--cut", c]);
+                    }
+                    let json: serde_json::Value = serde_json::from_str(&ok(&run(&args))).unwrap();
+                    let components = json["components"].as_array().unwrap();
+                    assert_eq!(
+                        components.len(),
+                        count[cell] as usize,
+                        "{shape} cell {cell}"
+                    );
+                    // Each stored component is one of `cell`'s, bit for bit (null is NaN);
+                    // at κ = 0 a family's mirror images share a slot, and one of them is kept.
+                    let same = |want: &serde_json::Value, stored: f64| {
+                        let want = want.as_f64().unwrap_or(f64::NAN);
+                        want.to_bits() == stored.to_bits() || (want.is_nan() && stored.is_nan())
+                    };
+                    for slot in (0..slots).filter(|&k| family[cell * slots + k] != 255) {
+                        let at = cell * slots + slot;
+                        let found = components.iter().find(|c| {
+                            c["family"] == families[usize::from(labels[slot])]
+                                && c["status"] == statuses[usize::from(status[at])]
+                                && same(&c["rotation_number"], n[at])
+                                && same(&c["period"], period[at])
+                                && same(&c["theta_min"], theta_min[at])
+                        });
+                        assert!(
+                            found.is_some(),
+                            "{shape} cell {cell} slot {slot}: N {} T {} theta_min {} in the \
+                             atlas is none of cell's {components:?}",
+                            n[at],
+                            period[at],
+                            theta_min[at]
+                        );
+                        faces += usize::from(status[at] == 5);
+                        compared += 1;
+                    }
+                }
+            }
+        }
+        assert!(compared >= 10, "{shape}: {compared} components compared");
+        // κ = 0 columns of the disk and the truncated ball reach a face; the summary counts them.
+        let line = summary
+            .lines()
+            .find(|l| l.starts_with("components by status: "))
+            .unwrap();
+        assert!(line.contains("reaches_face "), "{line}");
+        if shape != "wheel" {
+            assert!(faces > 0, "{shape}: no component reached a face");
+            assert!(!line.ends_with("reaches_face 0"), "{line}");
+        }
+
+        // Two shards merged are the single run, bit for bit.
+        let shards: Vec<String> = (1..=2)
+            .map(|i| {
+                let path = dir.path().join(format!("{shape}-{i}.h5"));
+                let p = path.to_str().unwrap().to_string();
+                ok(&run(&[
+                    "run",
+                    s,
+                    "--out",
+                    &p,
+                    "--shard",
+                    &format!("{i}/2"),
+                    "--quiet",
+                ]));
+                p
+            })
+            .collect();
+        let merged = dir.path().join(format!("{shape}-merged.h5"));
+        let m = merged.to_str().unwrap();
+        ok(&run(&[
+            "merge", &shards[0], &shards[1], "--out", m, "--quiet",
+        ]));
+        assert_same_arrays(&single, &merged);
+    }
+}
+
+#[test]
+fn edged_body_scenes_are_refused_where_the_shape_does_not_fit() {
+    let dir = tempfile::tempdir().unwrap();
+    let plane = "kappa = [0.5]\nenergy = [1.5]";
+    let compact = "lambda = [0.5]\ns = [0.0, 0.5]";
+    for (shape, second, plane, extra, expected) in [
+        (
+            "disk",
+            "beta = [2.0]",
+            plane,
+            "",
+            "axes.beta: the shape disk has no parameter beta",
+        ),
+        (
+            "disk",
+            "cut = [0.2]",
+            plane,
+            "",
+            "axes.cut: the shape disk has no parameter cut",
+        ),
+        (
+            "wheel",
+            "beta = [2.0]",
+            plane,
+            "",
+            "axes.beta: the shape wheel has no parameter beta",
+        ),
+        ("wheel", "", plane, "", "axes.cut: missing"),
+        (
+            "wheel",
+            "cut = [0.0, 0.5]",
+            plane,
+            "",
+            "axes.cut: 0 must satisfy 0 < cut < 1",
+        ),
+        (
+            "truncated_ball",
+            "cut = [1.0]",
+            plane,
+            "",
+            "axes.cut: 1 must satisfy -1 < cut < 1",
+        ),
+        ("disk", "", plane, "", ""),
+        (
+            "disk",
+            "",
+            compact,
+            "",
+            "axes.s: s = 0 (energy = infinity) is the high-energy limit",
+        ),
+        ("cube", "", plane, "", "body.shape: unknown shape \"cube\""),
+        (
+            "truncated_ball",
+            "cut = [0.2]",
+            plane,
+            "method = \"ode\"\n",
+            "solver.method: method ode",
+        ),
+    ] {
+        let path = dir.path().join("bad.toml");
+        let mut text = edged_scene(dir.path(), shape, second, plane);
+        std::fs::write(&path, std::fs::read_to_string(&text).unwrap() + extra).unwrap();
+        text = path;
+        let out = dir.path().join("bad.h5");
+        let output = run(&[
+            "run",
+            text.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--force",
+        ]);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        if expected.is_empty() {
+            ok(&output);
+            std::fs::remove_file(&out).unwrap();
+            continue;
+        }
+        assert_eq!(output.status.code(), Some(2), "{shape} {second}: {stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        assert!(stderr.contains(expected), "{shape} {second}: {stderr}");
+        assert!(!out.exists());
+    }
 }
