@@ -7,6 +7,11 @@ every other status is honest, and that the components are the reference's wherev
 within rounding of a critical level.
 
     python scripts/whole_domain.py --cells 300 --seed 12 [--out summary.csv]
+    python scripts/whole_domain.py --bodies --cells 120 --seed 21
+
+`--bodies` samples the edged bodies instead (docs/bodies.md): the disk (|α| ≤ 100), the
+truncated ball and the wheel (|α| < 1, every cut), κ ≠ 0, with a fifth of the energies putting
+a turning point within 1e-15 … 1e-3 of a kink; their references are computed afresh.
 
 The references take about a second of CPU each: those of the reproductions, of the first
 300 cells of seed 12 and of the tiny-κ cells of the tests are kept in `whole_domain_references.json` (the test suite checks
@@ -53,16 +58,30 @@ def stored() -> dict:
     return _stored
 
 
-def critical_levels(alpha, beta, nu, eta, kappa) -> list[tuple[float, float]]:
-    """reference.critical_levels, from the stored references when they hold this body."""
+def _edged(shape: str, alpha, cut, nu, eta, kappa) -> "_reference.EdgedCell":
+    return _reference.EdgedCell(shape, alpha, cut, nu, eta, kappa)
+
+
+def critical_levels(alpha, beta, nu, eta, kappa, shape: str = "ellipsoid", cut: float = 0.0
+                    ) -> list[tuple[float, float]]:
+    """reference.critical_levels (of an edged body: computed afresh), from the stored
+    references when they hold this ellipsoid."""
+    if shape != "ellipsoid":
+        cell = _edged(shape, alpha, cut, nu, eta, kappa)
+        with _reference.mpmath.workdps(_reference.DIGITS):
+            return [(float(p.theta), float(cell.potential(p))) for p in cell.critical_points()]
     got = stored()["levels"].get(_key(alpha, beta, nu, eta, kappa))
     if got is not None:
         return [tuple(level) for level in got]
     return _reference.critical_levels(alpha, beta, nu, eta, kappa)
 
 
-def reference(alpha, beta, nu, eta, kappa, energy) -> list[Component]:
-    """reference.reference, from the stored references when they hold this cell."""
+def reference(alpha, beta, nu, eta, kappa, energy, shape: str = "ellipsoid", cut: float = 0.0
+              ) -> list[Component]:
+    """reference.reference (of an edged body: computed afresh), from the stored references
+    when they hold this cell."""
+    if shape != "ellipsoid":
+        return _edged(shape, alpha, cut, nu, eta, kappa).components(energy)
     got = stored()["components"].get(_key(alpha, beta, nu, eta, kappa, energy))
     if got is not None:
         return [Component(**c) for c in got]
@@ -116,15 +135,33 @@ class Case:
     origin: str
     # For a sampled cell: random numbers that place ε against the critical levels of V.
     recipe: tuple | None = None
+    # The body's shape (docs/bodies.md) and, for the cut balls, its cut; β is unused then.
+    shape: str = "ellipsoid"
+    cut: float = 0.0
+
+    def levels(self) -> list[tuple[float, float]]:
+        return critical_levels(self.alpha, self.beta, self.nu, self.eta, self.kappa, self.shape, self.cut)
+
+    def reference(self) -> list[Component]:
+        return reference(self.alpha, self.beta, self.nu, self.eta, self.kappa, self.energy, self.shape, self.cut)
 
 
 def resolve(case: Case) -> Case:
     """The cell with its energy: 30 % within 1e-15 … 1e-3 (relative) of a separatrix, else
-    1e-12 … 1e6 (relative to max(|V_min|, 1)) above a minimum of V."""
+    1e-12 … 1e6 (relative to max(|V_min|, 1)) above a minimum of V; a sampled edged body's
+    recipe may instead put a turning point 1e-15 … 1e-3 from a kink ([`sample_bodies`])."""
     if case.recipe is None:
         return case
+    if len(case.recipe) == 3:
+        which, side, distance = case.recipe
+        cell = _edged(case.shape, case.alpha, case.cut, case.nu, case.eta, case.kappa)
+        with _reference.mpmath.workdps(_reference.DIGITS):
+            kinks = cell.kinks()
+            theta = kinks[int(which * len(kinks))].theta + side * _reference.mpmath.mpf(10) ** distance
+            energy = float(cell.potential(_reference.at(theta)))
+        return Case(**{**asdict(case), "energy": energy, "origin": "next to a kink", "recipe": None})
     pick, mode, sign, near, above = case.recipe
-    levels = critical_levels(case.alpha, case.beta, case.nu, case.eta, case.kappa)
+    levels = case.levels()
     values = [v for _, v in levels]
     minima = [v for i, (_, v) in enumerate(levels) if _is_minimum(levels, i, case.kappa)]
     maxima = [v for i, (_, v) in enumerate(levels) if _is_maximum(levels, i, case.kappa)]
@@ -173,6 +210,33 @@ def sample(seed: int, count: int) -> list[Case]:
         # The energy is placed against the critical levels in the worker (see `resolve`).
         recipe = (rng.random(), rng.random(), rng.choice([-1, 1]), rng.uniform(-15, -3), rng.uniform(-12, 6))
         cases.append(Case(alpha, beta, nu, eta, kappa, math.nan, "random", recipe))
+    return cases
+
+
+def sample_bodies(seed: int, count: int) -> list[Case]:
+    """`count` seeded random cells of the edged bodies (docs/bodies.md): the disk with
+    |α| ≤ 100, the truncated ball (−1 < h < 1) and the wheel (0 < h < 1) with |α| < 1 (0 and
+    ±0.999999 among them); ν ∈ (0, 2], η ∈ [1e-3, 1e3], |κ| ∈ [1e-8, 1e4] (κ = 0, where a
+    motion may reach a face, is not in the reference); the energies as for the ellipsoid, or
+    for a fifth of the cut balls' a turning point 1e-15 … 1e-3 from a kink."""
+    rng = random.Random(seed)
+    cases = []
+    while len(cases) < count:
+        shape = rng.choice(["disk", "truncated_ball", "wheel"])
+        if shape == "disk":
+            alpha = rng.choice([0.0, rng.uniform(-1, 1), rng.choice([-1, 1]) * _loguniform(rng, 1, 100)])
+            cut = 0.0
+        else:
+            alpha = rng.choice([0.0, 0.999999, -0.999999, rng.uniform(-1, 1), rng.uniform(-1, 1)])
+            cut = rng.uniform(-0.999, 0.999) if shape == "truncated_ball" else rng.uniform(0.001, 0.999)
+        nu = rng.uniform(1e-3, 2)
+        eta = _loguniform(rng, 1e-3, 1e3)
+        kappa = rng.choice([-1, 1]) * _loguniform(rng, 1e-8, 1e4)
+        if shape != "disk" and rng.random() < 0.2:
+            recipe = (rng.random(), rng.choice([-1, 1]), rng.uniform(-15, -3))
+        else:
+            recipe = (rng.random(), rng.random(), rng.choice([-1, 1]), rng.uniform(-15, -3), rng.uniform(-12, 6))
+        cases.append(Case(alpha, 1.0, nu, eta, kappa, math.nan, "random", recipe, shape, cut))
     return cases
 
 
@@ -255,7 +319,10 @@ def reproductions() -> list[Case]:
 
 
 def run_cell(case: Case, method: str = "quadrature", tol: float = 1e-10) -> dict:
-    args = [BIN, "cell", f"--alpha={case.alpha!r}", f"--beta={case.beta!r}", f"--nu={case.nu!r}",
+    body = [f"--beta={case.beta!r}"] if case.shape == "ellipsoid" else [f"--shape={case.shape}"]
+    if case.shape in ("truncated_ball", "wheel"):
+        body.append(f"--cut={case.cut!r}")
+    args = [BIN, "cell", f"--alpha={case.alpha!r}", *body, f"--nu={case.nu!r}",
             f"--eta={case.eta!r}", f"--kappa={case.kappa!r}", f"--energy={case.energy!r}", "--method", method,
             f"--tol={tol!r}", "--json"]
     out = subprocess.run(args, capture_output=True, text=True)
@@ -277,14 +344,14 @@ def check(case: Case, method: str = "quadrature", tol: float = 1e-10) -> Outcome
     """Compares one cell with the reference."""
     case = resolve(case)
     outcome = Outcome(case)
-    levels = critical_levels(case.alpha, case.beta, case.nu, case.eta, case.kappa)
+    levels = case.levels()
     # Within rounding of a critical level the component count is not defined in double
     # precision (the L1 size of V there times a few eps).
     for theta, value in levels:
         size = abs(value) + (case.kappa**2 / (2 * math.sin(theta) ** 2) if case.kappa else 0.0) + 2.0
         if abs(case.energy - value) <= 64 * EPS * size:
             outcome.ambiguous = True
-    truth = reference(case.alpha, case.beta, case.nu, case.eta, case.kappa, case.energy)
+    truth = case.reference()
     result = run_cell(case, method, tol)
     if "error" in result:
         outcome.problems.append(f"refused: {result['error']}")
@@ -371,12 +438,13 @@ def main():
     parser.add_argument("--cells", type=int, default=300)
     parser.add_argument("--seed", type=int, default=12)
     parser.add_argument("--method", default="quadrature")
+    parser.add_argument("--bodies", action="store_true", help="sample the edged bodies instead of the ellipsoid")
     parser.add_argument("--tol", type=float, default=1e-10, help="the cells' tolerance (default 1e-10)")
     parser.add_argument("--out", type=Path)
     parser.add_argument("--write-references", action="store_true", help=f"compute the references afresh into {REFERENCES.name}")
     args = parser.parse_args()
-    cases = reproductions() + sample(args.seed, args.cells)
-    if args.write_references:
+    cases = sample_bodies(args.seed, args.cells) if args.bodies else reproductions() + sample(args.seed, args.cells)
+    if args.write_references and not args.bodies:
         cases += tiny_kappa()
         global _stored
         _stored = {"levels": {}, "components": {}}

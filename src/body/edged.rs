@@ -55,9 +55,17 @@ struct Part {
 }
 
 impl Part {
-    /// U.
+    /// U. On the sphere (p = 0, r = 1) 1 + q cosθ cancels at the pole the centre of mass
+    /// leans away from as |α| = |q| → 1 (U = 1 − |α| there): it is formed as
+    /// sin²θ/(1 + |cosθ|) + (1 − |q|)|cosθ| (1 − |cosθ| without cancellation; 1 − |q| exact
+    /// for |q| ≥ ½), as the ellipsoid's U is, so that U keeps its relative precision and V's
+    /// rounding stays a few ulps of |U|.
     #[inline]
     fn height(&self, a: Angle) -> f64 {
+        if self.p == 0.0 && self.q * a.cos < 0.0 && self.q.abs() > 0.5 {
+            let lift = a.sin * a.sin / (1.0 + a.cos.abs());
+            return lift + (1.0 - self.q.abs()) * a.cos.abs();
+        }
         self.p * a.sin.abs() + self.q * a.cos + self.r
     }
 
