@@ -897,8 +897,8 @@ pub fn component_axis(scene: &Scene, stop: &(dyn Fn() -> bool + Sync)) -> Compon
 }
 
 /// Computes the κ-rows `rows` (in that order) of the slices (ia, ib), ib in `betas` (the
-/// second shape parameter, slowest), rows shared out by rayon one at a time (rows differ several-fold in cost), into
-/// the slots of `axis`; `progress` is called with the number of cells after each row. Every
+/// second shape parameter, slowest), rows shared out by rayon one at a time (rows differ
+/// several-fold in cost), into the slots of `axis`; `progress` is called with the number of cells after each row. Every
 /// cell is computed on its own, so the values do not depend on the number of threads or on
 /// which rows are computed together.
 pub fn compute_rows(

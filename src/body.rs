@@ -592,24 +592,57 @@ impl AnyBody {
         })
     }
 
+    /// The kind of edged body, None for the ellipsoid.
+    pub fn kind(&self) -> Option<EdgedKind> {
+        match self {
+            AnyBody::Ellipsoid(_) => None,
+            AnyBody::Edged(b) => Some(b.shape.kind),
+        }
+    }
+
     /// The shape's name: `ellipsoid`, `disk`, `truncated_ball` or `wheel`.
     pub fn shape_name(&self) -> &'static str {
-        match self {
-            AnyBody::Ellipsoid(_) => "ellipsoid",
-            AnyBody::Edged(b) => b.shape.kind.name(),
-        }
+        shape_name(self.kind())
     }
 
     /// The shape's parameters by name, as the command line, the JSON and the files name
     /// them: (α, β) of the ellipsoid, α of the disk, (α, cut) of the cut balls.
     pub fn shape_parameters(&self) -> Vec<(&'static str, f64)> {
-        match self {
-            AnyBody::Ellipsoid(b) => vec![("alpha", b.shape.alpha), ("beta", b.shape.beta)],
-            AnyBody::Edged(b) if b.shape.kind == EdgedKind::Disk => {
-                vec![("alpha", b.shape.alpha)]
-            }
-            AnyBody::Edged(b) => vec![("alpha", b.shape.alpha), ("cut", b.shape.cut)],
-        }
+        let (alpha, second) = match self {
+            AnyBody::Ellipsoid(b) => (b.shape.alpha, b.shape.beta),
+            AnyBody::Edged(b) => (b.shape.alpha, b.shape.cut),
+        };
+        std::iter::once(("alpha", alpha))
+            .chain(second_parameter(self.kind()).map(|name| (name, second)))
+            .collect()
+    }
+}
+
+/// Every shape's name, the ellipsoid first (scenes, the package and the command line).
+pub const SHAPE_NAMES: [&str; 4] = ["ellipsoid", "disk", "truncated_ball", "wheel"];
+
+/// The shape of that name: Some(None) for the ellipsoid, Some(kind) for an edged body, None
+/// for an unknown name.
+pub fn shape_kind(name: &str) -> Option<Option<EdgedKind>> {
+    if name == "ellipsoid" {
+        Some(None)
+    } else {
+        EdgedKind::from_name(name).map(Some)
+    }
+}
+
+/// The name of the shape `kind` (None: the ellipsoid).
+pub fn shape_name(kind: Option<EdgedKind>) -> &'static str {
+    kind.map_or("ellipsoid", |k| k.name())
+}
+
+/// The shape's parameter beside α, as files and scenes name it: β of the ellipsoid, the cut of
+/// the truncated ball and the wheel; none for the disk.
+pub fn second_parameter(kind: Option<EdgedKind>) -> Option<&'static str> {
+    match kind {
+        None => Some("beta"),
+        Some(EdgedKind::Disk) => None,
+        Some(_) => Some("cut"),
     }
 }
 

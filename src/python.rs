@@ -339,12 +339,15 @@ fn cells<'py>(
 
 /// The shape named `name`: None for the ellipsoid, else the edged kind.
 fn shape_kind(name: &str) -> PyResult<Option<crate::EdgedKind>> {
-    if name == "ellipsoid" {
-        return Ok(None);
-    }
-    crate::EdgedKind::from_name(name).map(Some).ok_or_else(|| {
+    crate::body::shape_kind(name).ok_or_else(|| {
+        let names: Vec<String> = crate::body::SHAPE_NAMES
+            .iter()
+            .map(|n| format!("{n:?}"))
+            .collect();
         bad(format!(
-            "shape {name:?}: use \"ellipsoid\", \"disk\", \"truncated_ball\" or \"wheel\""
+            "shape {name:?}: use {} or {}",
+            names[..names.len() - 1].join(", "),
+            names[names.len() - 1]
         ))
     })
 }

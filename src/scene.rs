@@ -1,8 +1,9 @@
 //! Scenes: the TOML files (docs/files.md) that describe an atlas run — the body (its shape, ν,
 //! η), the grid axes (the shape's parameters, κ, ε), the solver settings and the outputs
-//! wanted. Parsing checks every key and
-//! value and names the file, the key and the reason of the first problem it finds.
+//! wanted. Parsing checks every key and value and names the file, the key and the reason of
+//! the first problem it finds.
 
+use crate::body::{second_parameter, shape_name, SHAPE_NAMES};
 use crate::cell::{CellOptions, Method};
 use crate::error::{show, AtlasError, Result, MAX_ENERGY, MAX_KAPPA};
 use crate::family::Layout;
@@ -448,13 +449,12 @@ impl Scene {
         reader.only_keys(body, "body", &["shape", "nu", "eta"])?;
         let shape = match body.get("shape") {
             None => None,
-            Some(Value::String(name)) if name == "ellipsoid" => None,
-            Some(Value::String(name)) => Some(EdgedKind::from_name(name).ok_or_else(|| {
+            Some(Value::String(name)) => crate::body::shape_kind(name).ok_or_else(|| {
                 reader.error(
                     "body.shape",
                     format!("unknown shape {name:?} (use {})", SHAPE_NAMES.join(", ")),
                 )
-            })?),
+            })?,
             Some(v) => {
                 return Err(reader.error(
                     "body.shape",
@@ -814,23 +814,6 @@ impl Scene {
         let mut hash = fnv1a(0xcbf2_9ce4_8422_2325, self.text.as_bytes());
         hash = fnv1a(hash, env!("CARGO_PKG_VERSION").as_bytes());
         fnv1a(hash, env!("RUBBER_ATLAS_GIT_COMMIT").as_bytes())
-    }
-}
-
-/// The shapes a scene may name.
-const SHAPE_NAMES: [&str; 4] = ["ellipsoid", "disk", "truncated_ball", "wheel"];
-
-fn shape_name(shape: Option<EdgedKind>) -> &'static str {
-    shape.map_or("ellipsoid", |k| k.name())
-}
-
-/// The shape's parameter beside α: β of the ellipsoid, the cut of the cut balls, none for the
-/// disk.
-fn second_parameter(shape: Option<EdgedKind>) -> Option<&'static str> {
-    match shape {
-        None => Some("beta"),
-        Some(EdgedKind::Disk) => None,
-        Some(_) => Some("cut"),
     }
 }
 
