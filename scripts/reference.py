@@ -107,7 +107,9 @@ class Cell:
     def critical_points(self) -> list[Point]:
         """Roots of g in (0, π), sorted by θ (κ ≠ 0), or of U′ on (0, π) plus 0 and π (κ = 0)."""
         with mpmath.workdps(self.digits):
-            grid = self._scan()
+            # The kinks too: a maximum and a minimum of V may sit on either side of one, closer
+            # than the scan's step, where g dips below zero at the kink alone.
+            grid = sorted(self._scan() + self.kinks(), key=lambda p: p.theta)
             values = [self.g(p) for p in grid]
             roots = []
             if all(v == 0 for v in values):

@@ -174,6 +174,16 @@ pub trait Shape: Send + Sync {
         &[]
     }
 
+    /// U″ on either side of a kink at which the angle `a` lies (to a few ulps of its
+    /// cosine): `[before, after]` in increasing θ, the one-sided curvatures of the two parts
+    /// that meet there (U and U′ agree, U″ jumps). `None` away from a kink, and for a smooth
+    /// body. A critical point of V on a kink is a minimum, a maximum or a shoulder (V
+    /// monotone through it) by these signs, not by U″ of whichever part rounding picked.
+    fn potential_second_sides_at(&self, a: Angle) -> Option<[f64; 2]> {
+        let _ = a;
+        None
+    }
+
     /// Whether the body has a flat face that lies on the plane at θ = 0 and at θ = π: a
     /// motion that reaches it ends there (U has a corner at that pole).
     fn faces(&self) -> [bool; 2] {

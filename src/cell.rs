@@ -1067,9 +1067,29 @@ fn fixed_point<S: Shape>(
         .expect("a fixed point has its minimum");
     let a = m.site.angle();
     let red = potential.body.reduction_at(a);
-    let omega_theta = (m.curvature / red.reduced_inertia).sqrt();
+    let b = red.reduced_inertia;
+    // On a kink V″ has a corner: each half of the small oscillation swings on its own
+    // side, π/ω of each (ω = √(V″/B)).
+    let two_sided = |[before, after]: [f64; 2]| PI * ((b / before).sqrt() + (b / after).sqrt());
+    let sides = potential.curvature_sides_at(a);
+    let (omega_theta, period) = if sides[0] != sides[1] {
+        let period = two_sided(sides);
+        (TAU / period, period)
+    } else {
+        let omega_theta = (m.curvature / b).sqrt();
+        (omega_theta, TAU / omega_theta)
+    };
+    // A kink closer than the swing at the rounding of the level (a few times
+    // √(2 · 8 ulp / V″)) may be crossed by the motion at ε: its period then lies between
+    // this one and the kink's two-sided one.
+    let swing = 4.0 * (16.0 * f64::EPSILON * m.scale / m.curvature).sqrt();
+    let straddle = potential
+        .kinks_inside(m.site.theta - swing, m.site.theta + swing)
+        .iter()
+        .filter(|k| k.theta != m.site.theta)
+        .map(|k| (two_sided(potential.curvature_sides_at(k.angle())) - period).abs())
+        .fold(0.0, f64::max);
     let psi_rate = potential.psi_rate(a);
-    let period = TAU / omega_theta;
     let psi_advance = psi_rate * period;
     let n = -psi_advance / TAU;
     let (drift, radius) = if potential.kappa == 0.0 {
@@ -1112,6 +1132,23 @@ fn fixed_point<S: Shape>(
         drift_vector: [f64::NAN; 2],
         work: 0,
     };
+    if straddle > 0.0 {
+        // Twice the difference: the swing that crosses the kink also has the corner's
+        // √(ε − V) term on top (the difference alone was met to 1e-5 of it).
+        let straddle = 2.0 * straddle;
+        let e = &mut result.errors;
+        let share = straddle / period;
+        e.period += straddle;
+        e.omega_theta += share * omega_theta;
+        e.rotation_number += share * n.abs();
+        if radius.is_finite() {
+            e.drift += radius * psi_rate.abs() * straddle;
+        }
+        result.error_estimate = e.rotation_number;
+        if e.rotation_number > options.tol || e.period > options.tol * period {
+            result.status = Status::ToleranceNotReached;
+        }
+    }
     add_window_error(potential, &m, options, &mut result);
     result
 }
@@ -1161,7 +1198,15 @@ fn add_window_error<S: Shape>(
         result.status = Status::ToleranceNotReached;
         return;
     };
-    let share = window / rise;
+    // Off the kinks the values vary linearly with ε − V at the bottom; at a corner of V″
+    // (a bottom on a kink) like √(ε − V), the odd terms of V no longer cancelling between
+    // the two halves of the swing.
+    let [before, after] = potential.curvature_sides_at(bottom.site.angle());
+    let share = if before == after {
+        window / rise
+    } else {
+        (window / rise).sqrt()
+    };
     let add = |x0: f64, x1: f64, e1: f64| {
         if x0.is_finite() && x1.is_finite() {
             2.0 * share * (x1 - x0).abs() + share * e1

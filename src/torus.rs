@@ -126,7 +126,9 @@ pub enum CriticalKind {
     Minimum,
     /// A local maximum: an unstable one; its level is a separatrix.
     Maximum,
-    /// A degenerate critical point with V increasing or decreasing through it (a tangency).
+    /// A degenerate critical point with V increasing or decreasing through it: a tangency,
+    /// or a shoulder on an edged body's kink (one part's maximum meeting the other's
+    /// minimum). Its level is a separatrix: the motion there takes forever to reach it.
     Inflection,
 }
 
@@ -255,13 +257,14 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             .collect()
     }
 
-    /// The levels of the maxima of V, sorted: the separatrices. Between two of them N of one
-    /// component is continuous in ε; it diverges only at a separatrix.
+    /// The levels of the maxima of V and of its shoulders (an edged body's critical point on
+    /// a kink with V monotone through it), sorted: the separatrices. Between two of them N of
+    /// one component is continuous in ε; it diverges only at a separatrix.
     pub fn separatrix_levels(&self) -> Vec<f64> {
         let mut v: Vec<f64> = self
             .critical
             .iter()
-            .filter(|p| p.kind == CriticalKind::Maximum)
+            .filter(|p| p.kind != CriticalKind::Minimum)
             .map(|p| p.value)
             .collect();
         v.sort_by(f64::total_cmp);
@@ -362,6 +365,17 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         }
         let w = self.kappa / a.sin;
         w * w * (1.0 + 3.0 * (a.cos / a.sin) * (a.cos / a.sin)) + upp
+    }
+
+    /// V″ on either side of an angle, `[before, after]` in increasing θ: they differ on a
+    /// kink of U ([`Shape::potential_second_sides_at`]), and equal V″ elsewhere.
+    pub fn curvature_sides_at(&self, a: Angle) -> [f64; 2] {
+        let v = self.curvature_at(a);
+        let shape = &self.body.shape;
+        match shape.potential_second_sides_at(a) {
+            Some(sides) => sides.map(|u| v - shape.potential_second_at(a) + u),
+            None => [v; 2],
+        }
     }
 
     /// Where to look for critical points of V, in increasing θ over [0, π] (κ = 0: the
@@ -503,6 +517,24 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             self.sign_changes(&g, &cuts)
         };
         roots.dedup();
+        // A critical point on a kink: V′ there may round to either sign on both sides (V
+        // rising or falling through a shoulder, whose slope is zero at one point only), so
+        // the sign changes can miss it. Any kink where V′ vanishes to rounding is one.
+        if !flat {
+            for &theta in shape.kinks() {
+                let site = Site::at(theta);
+                let a = site.angle();
+                let w = self.kappa / a.sin;
+                let scale = w * w * (a.cos / a.sin).abs()
+                    + shape.potential_at(a).abs()
+                    + shape.potential_prime_at(a).abs();
+                let known = roots.iter().any(|r| (r.theta - theta).abs() <= 1e-12);
+                if !known && g(a).abs() <= 8.0 * EPS * scale {
+                    let at = roots.partition_point(|r| r.theta < theta);
+                    roots.insert(at, site);
+                }
+            }
+        }
         let sites: Vec<Site> = if self.kappa != 0.0 {
             roots
         } else {
@@ -528,14 +560,27 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 })
                 .collect()
         };
+        let mut shoulders = Vec::with_capacity(sites.len());
         let mut points: Vec<CriticalPoint> = sites
             .into_iter()
-            .map(|site| CriticalPoint {
-                site,
-                value: self.value(site.angle()),
-                scale: self.value_scale(site.angle()),
-                curvature: self.curvature_at(site.angle()),
-                kind: CriticalKind::Inflection,
+            .map(|site| {
+                let [before, after] = self.curvature_sides_at(site.angle());
+                // On a kink whose one-sided curvatures differ in sign V is monotone through
+                // the point (a shoulder: a maximum of one part and a minimum of the other
+                // merged); its concave side's curvature sets the slow passage at its level.
+                // Otherwise the flatter side's curvature (the slower passage).
+                shoulders.push(before * after < 0.0);
+                CriticalPoint {
+                    site,
+                    value: self.value(site.angle()),
+                    scale: self.value_scale(site.angle()),
+                    curvature: if before <= 0.0 && after <= 0.0 {
+                        before.max(after)
+                    } else {
+                        before.min(after)
+                    },
+                    kind: CriticalKind::Inflection,
+                }
             })
             .collect();
         // Classify by comparing with the neighbours (poles count as +∞ for κ ≠ 0; on the
@@ -543,6 +588,9 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         let n = points.len();
         let values: Vec<f64> = points.iter().map(|p| p.value).collect();
         for (i, p) in points.iter_mut().enumerate() {
+            if shoulders[i] {
+                continue;
+            }
             let (left, right) = if self.kappa != 0.0 {
                 (
                     if i == 0 { f64::INFINITY } else { values[i - 1] },
@@ -809,6 +857,10 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         b: &Option<CriticalPoint>,
         energy: f64,
     ) -> Site {
+        // A node at the level itself (a shoulder, or a maximum, met exactly) is the end.
+        if let Some(p) = [a, b].into_iter().flatten().find(|p| p.value == energy) {
+            return p.site;
+        }
         let lo = a.map_or(0.0, |p| p.site.theta);
         let hi = b.map_or(PI, |p| p.site.theta);
         // V − ε measured from the critical point inside the level set, as
@@ -1051,27 +1103,92 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         delta: impl Fn(&CriticalPoint) -> f64,
     ) -> (f64, f64) {
         let (mut saddle_t, mut saddle_psi) = (0.0, 0.0);
-        for (p, passes) in component
+        let gap = |p: &CriticalPoint| (energy - p.value).abs().max(EPS * p.scale);
+        let saddles = component
             .interior
             .iter()
-            .map(|p| (p, double))
-            .chain(component.neighbours.iter().flatten().map(|p| (p, 1.0)))
-        {
-            if p.kind == CriticalKind::Minimum {
-                continue;
-            }
+            .map(|p| (*p, double))
+            .chain(component.neighbours.iter().flatten().map(|p| (*p, 1.0)))
+            .filter(|(p, _)| p.kind != CriticalKind::Minimum)
+            .map(|(p, passes)| (p, passes, gap(&p)));
+        for (p, passes, gap) in saddles.chain(self.near_shoulders(energy, component, double)) {
             let a = p.site.angle();
             let b = self.body.reduction_at(a).reduced_inertia;
             // dT/dε ≈ 1/(λ |ε − V_s|) per passage; never more than T/|ε − V_s| (a flat or
             // degenerate point, λ = 0, has no logarithm).
             let lambda = (p.curvature.abs() / b).sqrt();
-            let gap = (energy - p.value).abs().max(EPS * p.scale);
             let sensitivity = (1.0 / lambda).min(period) / gap;
-            let dt = passes * delta(p) * sensitivity;
+            let dt = passes * delta(&p) * sensitivity;
             saddle_t += dt;
             saddle_psi += dt * self.psi_rate(a).abs();
         }
         (saddle_t, saddle_psi)
+    }
+
+    /// The kinks inside the component (passed `double` times a period) or between an end and
+    /// the critical point beyond it (passed once) where V is nearly a shoulder: concave on
+    /// one side (V″ = −a), convex on the other, with a slope s = |V′| so small that the
+    /// motion lingers there as at a saddle. Each is returned as a saddle with its passes and
+    /// the gap |ε − V_k| + s²/(2a): on the concave side ε − V ≈ δ + s x + a x²/2, whose
+    /// time grows like log(1/δ)/λ while δ is above s²/(2a) and stays at its value there
+    /// below (dT/dε ≈ 2a/(λ s²)). Kinks that are critical points are counted as such.
+    fn near_shoulders(
+        &self,
+        energy: f64,
+        component: &Component,
+        double: f64,
+    ) -> Vec<(CriticalPoint, f64, f64)> {
+        if self.body.shape.kinks().is_empty() {
+            return Vec::new();
+        }
+        let [before, after] = component.neighbours;
+        let lower = before.map_or(
+            if self.kappa != 0.0 {
+                0.0
+            } else {
+                component.lower.theta
+            },
+            |p| p.site.theta,
+        );
+        let upper = after.map_or(
+            if self.kappa != 0.0 {
+                PI
+            } else {
+                component.upper.theta
+            },
+            |p| p.site.theta,
+        );
+        let critical: Vec<f64> = component
+            .interior
+            .iter()
+            .chain(component.neighbours.iter().flatten())
+            .map(|p| p.site.theta)
+            .collect();
+        self.kinks_inside(lower, upper)
+            .into_iter()
+            .filter(|k| critical.iter().all(|t| (t - k.theta).abs() > 1e-12))
+            .filter_map(|site| {
+                let a = site.angle();
+                let [c0, c1] = self.curvature_sides_at(a);
+                if c0 * c1 >= 0.0 {
+                    return None;
+                }
+                let concave = c0.min(c1).abs();
+                let (value, scale) = (self.value(a), self.value_scale(a));
+                let slope = self.slope(a);
+                let gap = (energy - value).abs().max(EPS * scale) + slope * slope / (2.0 * concave);
+                let inside =
+                    site.theta > component.lower.theta && site.theta < component.upper.theta;
+                let point = CriticalPoint {
+                    site,
+                    value,
+                    scale,
+                    curvature: -concave,
+                    kind: CriticalKind::Inflection,
+                };
+                Some((point, if inside { double } else { 1.0 }, gap))
+            })
+            .collect()
     }
 
     /// The kinks of U ([`Shape::kinks`]) strictly between `lower` and `upper`, in order. On

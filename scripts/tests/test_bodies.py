@@ -6,6 +6,7 @@ tori that cross a kink of U and on tori that do not."""
 from __future__ import annotations
 
 import json
+import math
 import os
 import subprocess
 import sys
@@ -17,6 +18,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "scripts"))
 
+import whole_domain  # noqa: E402
 from reference import EdgedCell, at  # noqa: E402
 
 BIN = os.environ.get("RUBBER_ATLAS_BIN", str(ROOT / "target" / "release" / "rubber-atlas"))
@@ -172,3 +174,75 @@ def test_a_turning_point_next_to_a_kink_keeps_the_full_accuracy(case):
         assert got["errors"]["rotation_number"] <= 1e-13 and got["errors"]["period"] <= 1e-13 * ref.period, where
         near += min(abs(got["theta_min"] - float(theta_k)), abs(got["theta_max"] - float(theta_k))) < 2e-3
     assert near, f"{case}: no turning point next to the kink {float(theta_k)}"
+
+
+# The truncated ball whose edge part has its minimum on the kink at this κ: V rises through
+# the kink (a shoulder, the sphere part's concave side meeting the edge part's well), and
+# ε = V there. The build before this test found the torus [0.894, π/2] with N = 0.50 (true
+# 3.85), and its estimates were up to 29× short within 1e-10 … 1e-13 of that level.
+SHOULDER = ("truncated_ball", -0.2, 0.4, 0.7, 1.3, 0.5939696961967001)
+SHOULDER_LEVEL = 1.1300000000000001
+
+
+def test_the_level_of_a_shoulder_on_a_kink_is_a_separatrix():
+    out = run_cell(*SHOULDER, SHOULDER_LEVEL, 1e-10)
+    (comp,) = out["components"]
+    kink = math.acos(SHOULDER[2])
+    assert comp["status"] == "separatrix", comp
+    assert abs(comp["theta_max"] - kink) <= 4e-16, comp
+    assert comp["period"] is None and comp["omega_theta"] == 0.0, comp
+
+
+@pytest.mark.parametrize("offset", [1e-3, -1e-3, 1e-6, -1e-6, 1e-10, -1e-10, 1e-13, -1e-13])
+def test_values_next_to_a_shoulder_on_a_kink_keep_within_their_estimates(offset):
+    """Near the shoulder's level the time piles up at the kink as at a saddle (T grows like
+    the logarithm of the distance): the estimates count that and cover the true errors."""
+    cell = EdgedCell(*SHOULDER)
+    energy = SHOULDER_LEVEL * (1 + offset)
+    reference = cell.components(energy)
+    out = run_cell(*SHOULDER, energy, 1e-10)
+    comps = out["components"]
+    assert len(comps) == len(reference) == 1, (out, reference)
+    got, ref = comps[0], reference[0]
+    assert got["status"] in ("ok", "tolerance_not_reached"), got
+    assert abs(got["theta_max"] - ref.theta_max) <= 1e-9, (got, ref)
+    assert abs(got["period"] - ref.period) <= got["errors"]["period"], (got, ref)
+    assert abs(got["rotation_number"] - ref.rotation_number) <= got["errors"]["rotation_number"], (got, ref)
+
+
+# Bodies with a kink on which V′ vanishes at κ_k² = sin³θ_k U′(θ_k)/cosθ_k: a shoulder (the
+# truncated balls: one side concave, one convex) or a corner minimum (the wheels: convex on
+# both sides, with different curvatures). (shape, α, cut, ν, η, which kink)
+KINK_CRITICAL = [
+    ("truncated_ball", -0.2, 0.4, 0.7, 1.3, 0),
+    ("truncated_ball", 0.3, -0.6, 1.5, 3.0, 0),
+    ("wheel", -0.3, 0.3, 0.5, 2.0, 0),
+    ("wheel", 0.4, 0.5, 1.2, 0.8, 1),
+]
+
+
+def _kink_critical_cases():
+    cases = []
+    for shape, alpha, cut, nu, eta, which in KINK_CRITICAL:
+        with mpmath.workdps(50):
+            kink = EdgedCell(shape, alpha, cut, nu, eta, 1.0).kinks()[which]
+            s, c = mpmath.sin(kink.theta), mpmath.cos(kink.theta)
+            kappa_k = float(mpmath.sqrt(s**3 * EdgedCell(shape, alpha, cut, nu, eta, 1.0)._u_prime(s, c) / c))
+        for shift in (0.0, 1e-7, -1e-7, -1e-13):
+            for offset in (0.0, -1e-12):
+                cases.append((shape, alpha, cut, nu, eta, which, kappa_k * (1 + shift), offset))
+    return cases
+
+
+@pytest.mark.parametrize("case", _kink_critical_cases())
+def test_cells_where_v_is_flat_on_a_kink_keep_within_their_estimates(case):
+    """Near the κ where V′ vanishes on a kink and near the level there, against 50 digits:
+    every value within its estimate (the slow passage at a near-shoulder counts as a saddle's;
+    a minimum on a kink swings with each side's frequency for half a period; one beside a
+    kink may cross it). The build before this test had errors up to 5000x its estimates."""
+    shape, alpha, cut, nu, eta, which, kappa, offset = case
+    with mpmath.workdps(50):
+        cell = EdgedCell(shape, alpha, cut, nu, eta, kappa)
+        energy = float(cell.potential(cell.kinks()[which])) * (1 + offset)
+    outcome = whole_domain.check(whole_domain.Case(alpha, 1.0, nu, eta, kappa, energy, "kink", None, shape, cut))
+    assert not outcome.problems, (case, energy, outcome.problems)

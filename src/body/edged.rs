@@ -224,13 +224,20 @@ impl EdgedShape {
     /// Whether the angle `a` lies at a kink (to a few ulps of its cosine ±h) that bounds
     /// `part`: U and U′ of either part agree there (U″ jumps).
     fn bounds(&self, a: Angle, part: Part) -> bool {
+        self.parts_beside_kink(a)
+            .is_some_and(|parts| parts.contains(&part))
+    }
+
+    /// The two parts that meet at the kink the angle `a` lies at (to a few ulps of its
+    /// cosine, h or the wheel's −h), the one at smaller θ (larger cosθ) first.
+    fn parts_beside_kink(&self, a: Angle) -> Option<[Part; 2]> {
         const NEAR: f64 = 8.0 * f64::EPSILON;
         const STEP: f64 = 1e-6;
-        // cosθ at the kinks: h, and −h (the wheel's upper edge).
-        [self.cut, -self.cut][..self.kink_count].iter().any(|&c| {
-            (a.cos - c).abs() <= NEAR
-                && (self.part_at_cos(c + STEP) == part || self.part_at_cos(c - STEP) == part)
-        })
+        let c = [self.cut, -self.cut][..self.kink_count]
+            .iter()
+            .copied()
+            .find(|&c| (a.cos - c).abs() <= NEAR)?;
+        Some([self.part_at_cos(c + STEP), self.part_at_cos(c - STEP)])
     }
 
     /// The part in contact when the axis is tilted so that γ3 = cosθ = `cos`.
@@ -399,6 +406,11 @@ impl Shape for EdgedShape {
         let p = part.p * y.sin.signum() * sin_dd;
         let q = part.q * cos_dd;
         (p + q, p.abs() + q.abs())
+    }
+
+    fn potential_second_sides_at(&self, a: Angle) -> Option<[f64; 2]> {
+        self.parts_beside_kink(a)
+            .map(|parts| parts.map(|part| part.curvature(a)))
     }
 
     /// The edge parts are arcs of sinusoids: no scale below 1 (the kinks are split at).

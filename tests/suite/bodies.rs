@@ -568,6 +568,42 @@ fn the_well_by_a_face_is_found_at_the_tiniest_kappa() {
     }
 }
 
+/// At the κ where the edge part's well sits on the kink (κ² cosθ_k / sin³θ_k = U′(θ_k),
+/// with U′ = ρ cosθ − (h + α) sinθ of the edge) the sphere part's concave side meets it: V
+/// rises through the kink, a shoulder. It is neither a minimum nor a maximum, its level is
+/// a separatrix, and the torus at that level ends on the kink (it ended at π/2, N = 0.50
+/// against the true 3.85 just beside the level).
+#[test]
+fn a_critical_point_on_a_kink_with_v_rising_through_it_is_a_shoulder() {
+    use rubber_atlas::body::Angle;
+    use rubber_atlas::torus::CriticalKind;
+    let (alpha, cut) = (-0.2, 0.4);
+    let shape = EdgedShape::truncated_ball(alpha, cut).unwrap();
+    let theta_k = shape.kinks()[0];
+    let (s, c) = theta_k.sin_cos();
+    let rho = (1.0 - cut * cut).sqrt();
+    let kappa = ((rho * c - (cut + alpha) * s) * s * s * s / c).sqrt();
+    let body = Body::new(shape, 0.7, 1.3).unwrap();
+    let potential = EffectivePotential::new(&body, kappa);
+    let on_kink: Vec<_> = potential
+        .critical_points()
+        .iter()
+        .filter(|p| (p.site.theta - theta_k).abs() < 1e-12)
+        .collect();
+    assert_eq!(on_kink.len(), 1, "{:?}", potential.critical_points());
+    let shoulder = on_kink[0];
+    assert_eq!(shoulder.kind, CriticalKind::Inflection, "{shoulder:?}");
+    let v = |t: f64| potential.value(Angle::new(t));
+    for d in [1e-3, 1e-5] {
+        assert!(v(theta_k - d) < shoulder.value && shoulder.value < v(theta_k + d));
+    }
+    assert!(potential.separatrix_levels().contains(&shoulder.value));
+    let cell = solve_cell(&body, kappa, shoulder.value, &CellOptions::default()).unwrap();
+    let torus = &cell.components[0];
+    assert_eq!(torus.status, Status::Separatrix, "{torus:?}");
+    assert!((torus.theta_max - theta_k).abs() < 1e-15, "{torus:?}");
+}
+
 /// The symmetric wheel (α = 0) has three wells at small κ: one on each edge and one on the
 /// band of sphere round θ = π/2, whose family is the equator's.
 #[test]
