@@ -667,8 +667,9 @@ impl Shard {
     }
 
     /// Checks that the grid of shape `shape` splits into this many shards: boxes, one per
-    /// shard, each with work of its own.
-    pub fn check_against(&self, shape: [usize; 4]) -> Result<()> {
+    /// shard, each with work of its own. `second` names the grid's second axis (`beta`,
+    /// `cut`; None for the disk's grid, which has none) for the message.
+    pub fn check_against(&self, shape: [usize; 4], second: Option<&str>) -> Result<()> {
         if self.index == 0 || self.index > self.count {
             return Err(AtlasError::Atlas {
                 path: format!("shard {self}"),
@@ -681,12 +682,19 @@ impl Shard {
                 .rev()
                 .find(|&n| Shard { index: 1, count: n }.layout(shape).is_some())
                 .unwrap_or(1);
+            let (boxes, factors) = match second {
+                Some(name) => (
+                    format!("{a} alpha x {b} {name} x {k}"),
+                    format!("{a}, {b} and {k}"),
+                ),
+                None => (format!("{a} alpha x {k}"), format!("{a} and {k}")),
+            };
             return Err(AtlasError::Atlas {
                 path: format!("shard {self}"),
                 reason: format!(
-                    "shards are boxes of the grid, and {} shards do not tile its {a} alpha x \
-                     {b} beta x {k} blocks of kappa rows: use a count that is a product of \
-                     at most {a}, {b} and {k} (e.g. {fits})",
+                    "shards are boxes of the grid, and {} shards do not tile its {boxes} \
+                     blocks of kappa rows: use a count that is a product of at most \
+                     {factors} (e.g. {fits})",
                     self.count
                 ),
             });

@@ -265,7 +265,9 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
     let started = Instant::now();
     let out = &request.out;
     // Before anything is written: the shard must have work units of its own.
-    request.shard.check_against(scene.shape())?;
+    request
+        .shard
+        .check_against(scene.shape(), scene.second_name())?;
     // Held until the file is in place and the journal gone.
     let _claim = crate::store::OutputLock::acquire(out)?;
     // A current output (made from this scene by this build for this shard) carries the axis
@@ -528,7 +530,7 @@ pub fn merge(
         let (index, n) = shard_attributes(path)?;
         let shard = Shard { index, count: n };
         shard
-            .check_against(shape)
+            .check_against(shape, scene.second_name())
             .map_err(|e| AtlasError::atlas(path, e))?;
         let own = AtlasFile::read_axis(path)?;
         if own != axis {

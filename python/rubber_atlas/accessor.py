@@ -403,7 +403,12 @@ class RubberAccessor:
         cut = ds
         for name, index in (("alpha", alpha_index), ("beta", beta_index), ("cut", cut_index)):
             index = _api._count(f"{name}_index", index)
-            size = ds.sizes[name] if name in ds.cell_status.dims else 1
+            if name not in ds.cell_status.dims:
+                if index not in (0, -1):
+                    raise ValueError(f"invalid {name}_index = {index}: the dataset has no dimension {name} "
+                                     f"(its dimensions are {list(ds.cell_status.dims)}): leave {name}_index at 0")
+                continue
+            size = ds.sizes[name]
             if not -size <= index < size:
                 raise ValueError(f"invalid {name}_index = {index}: the dataset has {size} value{'s' * (size != 1)} "
                                  f"of {name} (index 0 … {size - 1})")

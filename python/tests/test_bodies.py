@@ -163,3 +163,6 @@ def test_an_atlas_of_an_edged_body_opens_with_its_own_dimensions_and_equals_cell
         assert shape in fig._suptitle.get_text()
         with pytest.raises(ValueError, match=f"cut_index = {top + 1}"):
             atlas.rubber.plot_slice(cut_index=top + 1)
+        # A dimension the atlas lacks is named as missing, not as having one value.
+        with pytest.raises(ValueError, match="beta_index = 1: the dataset has no dimension beta"):
+            atlas.rubber.plot_slice(beta_index=1)

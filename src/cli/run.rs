@@ -85,7 +85,7 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
     };
     // A shard count that does not tile the grid is refused at once (also by --print-out,
     // which submit.sh calls before anything is queued).
-    shard.check_against(scene.shape())?;
+    shard.check_against(scene.shape(), scene.second_name())?;
     // By default beside the scene, so that a run works from any folder.
     let out = args.out.clone().unwrap_or_else(|| {
         let folder = args.scene.parent().unwrap_or(std::path::Path::new(""));
@@ -226,7 +226,7 @@ pub(super) fn shards_to_fit(scene: &Scene, threads: usize) -> String {
     (2..=most.min(1 << 12))
         .map(|count| Shard { index: 1, count })
         .find(|s| {
-            s.check_against(shape).is_ok()
+            s.check_against(shape, scene.second_name()).is_ok()
                 && sweep::footprint(scene, *s, threads).memory_bytes <= 0.5 * free
         })
         .map_or_else(

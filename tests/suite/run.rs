@@ -1133,4 +1133,24 @@ fn edged_body_scenes_are_refused_where_the_shape_does_not_fit() {
         assert!(stderr.contains(expected), "{shape} {second}: {stderr}");
         assert!(!out.exists());
     }
+    // A shard count that does not tile the grid names the shape's own axes.
+    for (shape, second, expected) in [
+        ("disk", "", "alpha x 1 blocks of kappa rows"),
+        ("wheel", "cut = [0.2]", "alpha x 1 cut x 1 blocks"),
+    ] {
+        let scene = edged_scene(dir.path(), shape, second, plane);
+        let out = dir.path().join("shard.h5");
+        let output = run(&[
+            "run",
+            scene.to_str().unwrap(),
+            "--shard",
+            "1/3",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{shape}: {stderr}");
+        assert!(stderr.contains(expected), "{shape}: {stderr}");
+        assert!(!stderr.contains("beta"), "{shape}: {stderr}");
+    }
 }

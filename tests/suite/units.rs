@@ -69,7 +69,10 @@ mod atlas {
             let units_total = all.len();
             let mut tiled = 0;
             for count in 1..=units_total.min(24) {
-                if (Shard { index: 1, count }).check_against(shape).is_err() {
+                if (Shard { index: 1, count })
+                    .check_against(shape, Some("beta"))
+                    .is_err()
+                {
                     continue;
                 }
                 tiled += 1;
@@ -77,7 +80,7 @@ mod atlas {
                 let mut cells = 0;
                 for index in 1..=count {
                     let shard = Shard { index, count };
-                    shard.check_against(shape).unwrap();
+                    shard.check_against(shape, Some("beta")).unwrap();
                     let region = shard.region(shape);
                     let mine: Vec<Unit> = shard.units(shape).collect();
                     assert!(!mine.is_empty());
@@ -99,12 +102,14 @@ mod atlas {
                 index: 1,
                 count: units_total + 1
             })
-            .check_against(shape)
+            .check_against(shape, Some("beta"))
             .is_err());
         }
         // A count that does not factor over the axes is refused: 3 of 2 x 2 x 1.
         let small = [2, 2, 24, 40];
-        assert!((Shard { index: 1, count: 3 }).check_against(small).is_err());
+        assert!((Shard { index: 1, count: 3 })
+            .check_against(small, Some("beta"))
+            .is_err());
         assert_eq!(
             (Shard { index: 1, count: 4 }).layout(small),
             Some([2, 2, 1])
