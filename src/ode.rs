@@ -24,6 +24,8 @@ impl<const N: usize, R: Rate<N>> System<f64, SVector<f64, N>> for Adapter<'_, R>
 pub struct SampledSolution<const N: usize> {
     pub times: Vec<f64>,
     pub states: Vec<SVector<f64, N>>,
+    /// The integrator's accepted steps over the whole run.
+    pub steps: usize,
 }
 
 /// Runs DOP853 on `system` from (t0, y0) towards t1 (it may stop earlier when the system's
@@ -120,6 +122,7 @@ pub fn integrate_sampled<const N: usize, R: Rate<N>>(
     states.push(y0);
     let mut y = y0;
     let mut h_last = 0.0;
+    let mut total = 0;
     for i in 1..=samples {
         let (t0, t1) = (
             t_end * (i - 1) as f64 / samples as f64,
@@ -148,8 +151,13 @@ pub fn integrate_sampled<const N: usize, R: Rate<N>>(
             h_last = (t - t0) / steps.max(1) as f64;
         }
         h_last = (t1 - t0) / steps.max(1) as f64;
+        total += steps;
         times.push(t1);
         states.push(y);
     }
-    Ok(SampledSolution { times, states })
+    Ok(SampledSolution {
+        times,
+        states,
+        steps: total,
+    })
 }

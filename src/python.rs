@@ -33,7 +33,8 @@ fn trajectory_error(e: AtlasError) -> PyErr {
         .to_string()
         .replace("give --t-end", "give t_end=")
         .replace("t-end", "t_end")
-        .replace("theta-dot0", "theta_dot0");
+        .replace("theta-dot0", "theta_dot0")
+        .replace("--allow-large", "allow_large=True");
     PyValueError::new_err(text)
 }
 
@@ -564,6 +565,7 @@ fn trajectory<'py>(
         samples,
         model,
         tol,
+        step_budget: (!allow_large).then_some(crate::trajectory::STEP_BUDGET),
     };
     // Ctrl-C is heard between integrator runs (at most 100,000 steps each).
     let (start, traj, energy) = interruptible(py, &None, |stop| {

@@ -1508,7 +1508,8 @@ def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, e
     tol : float, default 1e-12
         Tolerance of the integrator, 1e-15 … 0.1.
     allow_large : bool, default False
-        Allow `samples` beyond 80 % of the available memory.
+        Allow `samples` beyond 80 % of the available memory, and a length that needs more
+        than 1e9 integrator steps (some 40 minutes; estimated from the first θ-period).
     shape : {"ellipsoid", "disk", "truncated_ball", "wheel"}, default "ellipsoid"
         The body (docs/bodies.md); for any but the ellipsoid `beta` is None, and the cut
         balls take `cut`. A planar start (κ = 0) whose motion reaches a face is refused.
@@ -1529,7 +1530,8 @@ def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, e
     ------
     ValueError
         A parameter out of range, no motion at `energy`, a component that does not exist,
-        not exactly one of `energy`/`theta0` or of `periods`/`t_end`.
+        not exactly one of `energy`/`theta0` or of `periods`/`t_end`, a length beyond the
+        step budget without `allow_large`.
     TypeError
         A parameter that is not one number, `component` or `samples` not a whole number,
         `allow_large` not True or False.

@@ -214,7 +214,8 @@ LONG_CALLS = {
     # About 15 s each on one core; they ran to the end under Ctrl-C.
     "trajectory": "ra.trajectory(0.5, 3.0, 0.5, 0.5, kappa=0.8, energy=2.5, t_end=1e6, model='full')",
     # A billion periods of the reduced model (issue 22: not tried before).
-    "trajectory_reduced": "ra.trajectory(0.5, 3.0, 0.5, 0.5, kappa=0.8, energy=2.5, periods=1e9, samples=100)",
+    "trajectory_reduced": "ra.trajectory(0.5, 3.0, 0.5, 0.5, kappa=0.8, energy=2.5, periods=1e9, samples=100, "
+                          "allow_large=True)",
     "resonance": "ra.resonance(0.5, 3.0, 0.5, 0.5, '-1/7', grid=400)",
     # 48 s; a SIGINT in the first call became a Rust panic.
     "diagram": "ra.diagram(0.5, 3.0, samples=50_000_000)",
@@ -242,6 +243,12 @@ def test_ctrl_c_stops_a_long_call_at_once(tmp_path, call):
     # Measured 0.02-0.2 s; the bound leaves room for a loaded machine.
     assert time.perf_counter() - sent < 1.0, time.perf_counter() - sent
     assert (err.endswith("\n") and "%" in err) if "progress" in call else "%" not in err
+
+
+def test_a_trajectory_beyond_the_step_budget_is_refused_with_its_estimate():
+    """A billion periods (some 80 hours) used to run on without a word."""
+    with pytest.raises(ValueError, match=r"periods = 1000000000 needs about \d\.\de\d+ integrator steps.*allow_large=True"):
+        ra.trajectory(0.5, 3.0, 0.5, 0.5, kappa=0.8, energy=2.5, periods=1e9)
 
 
 def test_bad_options_raise_value_errors():

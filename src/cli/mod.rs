@@ -96,7 +96,8 @@ pub enum Command {
 /// The size check of a command that may ask for more than the machine has.
 #[derive(Debug, Args)]
 pub struct Limits {
-    /// Run even where the estimated memory or disk exceeds what this machine has free.
+    /// Run even where the estimated memory or disk exceeds what this machine has free, or a
+    /// trajectory needs more than 1e9 integrator steps (some 40 minutes).
     #[arg(long)]
     pub allow_large: bool,
 }

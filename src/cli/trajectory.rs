@@ -90,6 +90,7 @@ pub(super) fn trajectory(args: TrajectoryArgs) -> Result<()> {
         samples: args.samples,
         model,
         tol: args.tol,
+        step_budget: (!args.limits.allow_large).then_some(trajectory::STEP_BUDGET),
     };
     let (start, traj, energy) = rubber_atlas::with_body!(&body, b => request
         .run_until(b, &crate::stop::requested)

@@ -641,6 +641,7 @@ fn planar_trajectories_onto_a_face_are_refused() {
         samples: 10,
         model: Model::Reduced,
         tol: 1e-10,
+        step_budget: None,
     };
     let face = Body::new(EdgedShape::truncated_ball(0.2, 0.4).unwrap(), 0.7, 1.3).unwrap();
     let refused = request(0.7).run(&face).unwrap_err().to_string();

@@ -1030,6 +1030,7 @@ fn the_long_commands_stop_on_a_signal_in_one_line_writing_nothing() {
                 "2.5",
                 "--periods",
                 "1e8",
+                "--allow-large",
                 "--samples",
                 "100",
                 "--out",
@@ -1079,4 +1080,29 @@ fn the_long_commands_stop_on_a_signal_in_one_line_writing_nothing() {
         );
         assert!(waited.as_secs_f64() < 10.0, "{args:?}: {waited:?}");
     }
+}
+
+/// A trajectory that would take hours is refused at once, in one line with the estimate of
+/// its integrator steps (from a pilot over one θ-period), unless the caller insists; it used
+/// to run on without a word (1e9 periods: some 80 hours).
+#[test]
+fn a_trajectory_beyond_the_step_budget_is_refused_at_once_with_its_estimate() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("t.csv");
+    let out = out.to_str().unwrap();
+    for length in [["--periods", "1e9"], ["--t-end", "1e12"]] {
+        let o = run(&trajectory_args(&[length[0], length[1], "--out", out]));
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(
+            err.contains("integrator steps") && err.contains("--allow-large"),
+            "{err}"
+        );
+        assert!(err.contains(&length[0][2..]), "{err}");
+        assert!(!Path::new(out).exists());
+    }
+    // Within the budget: runs as before.
+    let o = run(&trajectory_args(&["--periods", "3", "--out", out]));
+    assert!(o.status.success(), "{}", stderr(&o));
 }

@@ -348,6 +348,7 @@ fn turning_points_far_out_and_the_trajectories_from_them() {
         samples: 4,
         model,
         tol: 1e-12,
+        step_budget: Some(rubber_atlas::trajectory::STEP_BUDGET),
     };
     for model in [Model::Reduced, Model::Full] {
         for energy in [2.5, 1e20, 1e300] {
@@ -421,6 +422,7 @@ fn a_start_beyond_two_pi_at_kappa_zero_is_on_its_own_torus() {
         samples: 4,
         model: Model::Reduced,
         tol: 1e-12,
+        step_budget: Some(rubber_atlas::trajectory::STEP_BUDGET),
     };
     let (_, traj) = request.run(&body).unwrap();
     let end = *traj.theta.last().unwrap();
@@ -479,6 +481,7 @@ fn a_start_on_a_separatrix_has_no_period_and_says_so() {
         samples: 4,
         model: Model::Reduced,
         tol: 1e-12,
+        step_budget: Some(rubber_atlas::trajectory::STEP_BUDGET),
     };
     assert!(request.run(&body).is_ok());
 }
