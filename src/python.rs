@@ -16,7 +16,7 @@ use crate::trajectory::{Duration, Model, Request, StartAt};
 use crate::verdict::{self, VerdictOptions};
 use crate::{AnyBody, EllipsoidBody};
 use numpy::{PyArray1, PyReadonlyArray1};
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
@@ -29,13 +29,19 @@ fn value_error(e: AtlasError) -> PyErr {
 
 /// A trajectory error in the words of `ra.trajectory`'s keywords, not the command's flags.
 fn trajectory_error(e: AtlasError) -> PyErr {
+    // A computation that failed (the command's exit 1), not a bad input.
+    let failed = matches!(e, AtlasError::Integration { .. });
     let text = e
         .to_string()
         .replace("give --t-end", "give t_end=")
         .replace("t-end", "t_end")
         .replace("theta-dot0", "theta_dot0")
         .replace("--allow-large", "allow_large=True");
-    PyValueError::new_err(text)
+    if failed {
+        PyRuntimeError::new_err(text)
+    } else {
+        PyValueError::new_err(text)
+    }
 }
 
 fn bad(message: String) -> PyErr {

@@ -1532,6 +1532,10 @@ def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, e
         A parameter out of range, no motion at `energy`, a component that does not exist,
         not exactly one of `energy`/`theta0` or of `periods`/`t_end`, a length beyond the
         step budget without `allow_large`.
+    RuntimeError
+        The integration failed: its steps fell below the rounding of t (a motion too fast
+        for `tol`, e.g. near a pole at tiny κ in the reduced model), or the energy drifted
+        beyond what the samples allow (the command exits 1 for these).
     TypeError
         A parameter that is not one number, `component` or `samples` not a whole number,
         `allow_large` not True or False.

@@ -251,6 +251,12 @@ def test_a_trajectory_beyond_the_step_budget_is_refused_with_its_estimate():
         ra.trajectory(0.5, 3.0, 0.5, 0.5, kappa=0.8, energy=2.5, periods=1e9)
 
 
+def test_a_failed_integration_raises_a_runtime_error_not_a_value_error():
+    """The inputs are valid; the computation failed (the command exits 1, not 2)."""
+    with pytest.raises(RuntimeError, match="integration failed at t = 0"):
+        ra.trajectory(0.5, 3.0, 0.5, 0.5, kappa=1e-200, energy=2.5, periods=1)
+
+
 def test_bad_options_raise_value_errors():
     with pytest.raises(ValueError, match="omega"):
         ra.cells(0.5, 3, 0.5, 0.5, 0.5, 2.0, fields=["omega"])
