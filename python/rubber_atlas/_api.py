@@ -1255,8 +1255,14 @@ def components(ds: xr.Dataset, alpha: float | None = None, beta: float | None = 
         cell["beta"] = beta
     dims = [d for d in ds.cell_status.dims]
     if sorted(cell) != sorted(dims):
-        raise NotInDataset(f"give the cell by {', '.join(dims)} (this dataset's dimensions), not "
-                            f"{', '.join(cell) or 'nothing'}")
+        # Name what is wrong: the keys that are no dimension of it, and those left out.
+        extra = [_KEYWORDS.get(k, k) for k in cell if k not in dims]
+        missing = [_KEYWORDS.get(d, d) for d in dims if d not in cell]
+        wrong = "; ".join(part for part in (
+            extra and f"{', '.join(extra)} {'is' if len(extra) == 1 else 'are'} not among them",
+            missing and f"{', '.join(missing)} {'is' if len(missing) == 1 else 'are'} missing") if part)
+        raise NotInDataset(f"give the cell by {', '.join(_KEYWORDS.get(d, d) for d in dims)} (this dataset's "
+                           f"dimensions): {wrong}")
     index = {}
     for name, value in cell.items():
         shown = _KEYWORDS.get(name, name)

@@ -251,6 +251,17 @@ def test_a_trajectory_beyond_the_step_budget_is_refused_with_its_estimate():
         ra.trajectory(0.5, 3.0, 0.5, 0.5, kappa=0.8, energy=2.5, periods=1e9)
 
 
+def test_components_names_the_keys_that_are_not_dimensions_and_those_missing():
+    """It said "give the cell by lambda, s, not lambda, s, alpha, beta": both lists in full,
+    the wrong keys not named, and `lambda` where the keyword is `lambda_`."""
+    ds = ra.cells(0.5, 3.0, 0.5, 0.5, lambda_=np.array([[0.2], [0.4]]), s=[0.5, 1.0])
+    with pytest.raises(KeyError, match=r"by lambda_, s \(this dataset's dimensions\): alpha, beta are not among them$"):
+        ds.rubber.components(alpha=0.5, beta=3.0, lambda_=0.4, s=0.5)
+    with pytest.raises(ValueError, match=r"kappa is not among them; lambda_ is missing$"):
+        ds.rubber.components(kappa=0.4, s=0.5)
+    assert ds.rubber.components(lambda_=0.4, s=0.5)
+
+
 def test_a_failed_integration_raises_a_runtime_error_not_a_value_error():
     """The inputs are valid; the computation failed (the command exits 1, not 2)."""
     with pytest.raises(RuntimeError, match="integration failed at t = 0"):
