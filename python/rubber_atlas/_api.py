@@ -1418,7 +1418,8 @@ def _read_csv(path: Path) -> xr.Dataset:
     return ds
 
 
-def diagram(alpha: float, beta: float | None, nu: float = 0.5, eta: float = 0.5, *, samples: int = 2000,
+def diagram(alpha: float, beta: float | None, nu: float | None = None, eta: float | None = None, *,
+            samples: int = 2000,
             kappa_max: float = 3.0, allow_large: bool = False, shape: str = "ellipsoid",
             cut: float | None = None) -> xr.Dataset:
     """The critical set of one body: its fixed-point curves (the paper's bifurcation diagram).
@@ -1429,9 +1430,10 @@ def diagram(alpha: float, beta: float | None, nu: float = 0.5, eta: float = 0.5,
         α = a/b3, -1 < α < 1.
     beta : float
         β = b1/b3 > 0.
-    nu, eta : float, default 0.5
+    nu, eta : float, optional
         ν = i3/i1 (0 < ν ≤ 2) and η = m b3²/i1 > 0: they do not change the set and are
-        recorded.
+        recorded. Both or neither (then 0.5 each), so that no value you did not give is
+        recorded beside one you gave.
     samples : int, default 2000
         Number of θ0 samples along the curves, ≥ 2.
     kappa_max : float, default 3.0
@@ -1457,7 +1459,8 @@ def diagram(alpha: float, beta: float | None, nu: float = 0.5, eta: float = 0.5,
     Raises
     ------
     ValueError
-        A parameter out of range, or too many samples without `allow_large`.
+        A parameter out of range, `nu` without `eta` or the reverse, or too many samples
+        without `allow_large`.
     TypeError
         A parameter that is not one number, `samples` not a whole number, `allow_large`
         not True or False.
@@ -1471,6 +1474,12 @@ def diagram(alpha: float, beta: float | None, nu: float = 0.5, eta: float = 0.5,
     >>> summary["diagram_type"], round(summary["energy_min"], 5)
     ('c', 3.04651)
     """
+    if (nu is None) != (eta is None):
+        given, other = ("nu", "eta") if eta is None else ("eta", "nu")
+        raise ValueError(f"{given} given without {other}: give both (they do not change the critical set, "
+                         "only the record) or neither (0.5 each)")
+    if nu is None:
+        nu = eta = 0.5
     body, shape, extra, values, named = _one_body(shape, alpha, beta, nu, eta, cut)
     table, summary = _core.diagram(*values, _count("samples", samples), _real("kappa_max", kappa_max),
                                    _switch("allow_large", allow_large), **extra)

@@ -262,6 +262,16 @@ def test_components_names_the_keys_that_are_not_dimensions_and_those_missing():
     assert ds.rubber.components(lambda_=0.4, s=0.5)
 
 
+def test_diagram_takes_nu_and_eta_together_or_neither():
+    """Either alone would record the other's default beside it (they do not change the set)."""
+    with pytest.raises(ValueError, match="nu given without eta"):
+        ra.diagram(0.5, 3.0, nu=0.7)
+    with pytest.raises(ValueError, match="eta given without nu"):
+        ra.diagram(0.5, 3.0, eta=2.0)
+    assert json.loads(ra.diagram(0.5, 3.0, samples=10).attrs["critical_set_json"])["eta"] == 0.5
+    assert json.loads(ra.diagram(0.5, 3.0, 0.7, 2.0, samples=10).attrs["critical_set_json"])["eta"] == 2.0
+
+
 def test_a_failed_integration_raises_a_runtime_error_not_a_value_error():
     """The inputs are valid; the computation failed (the command exits 1, not 2)."""
     with pytest.raises(RuntimeError, match="integration failed at t = 0"):

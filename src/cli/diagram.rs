@@ -13,11 +13,24 @@ use std::path::PathBuf;
 pub struct DiagramArgs {
     #[command(flatten)]
     pub shape: BodyShapeArgs,
-    /// ν = i3/i1 (does not change the critical set; recorded in the output).
-    #[arg(value_parser = number, long, default_value_t = 0.5, allow_hyphen_values = true)]
+    /// ν = i3/i1 (does not change the critical set; recorded in the output); with --eta, or
+    /// both left at 0.5, so that no value the user did not give is recorded beside one given.
+    #[arg(
+        value_parser = number,
+        long,
+        default_value_t = 0.5,
+        allow_hyphen_values = true,
+        requires = "eta"
+    )]
     pub nu: f64,
-    /// η = m b3²/i1 (does not change the critical set; recorded in the output).
-    #[arg(value_parser = number, long, default_value_t = 0.5, allow_hyphen_values = true)]
+    /// η = m b3²/i1 (does not change the critical set; recorded in the output); with --nu.
+    #[arg(
+        value_parser = number,
+        long,
+        default_value_t = 0.5,
+        allow_hyphen_values = true,
+        requires = "nu"
+    )]
     pub eta: f64,
     /// Print the critical set as one JSON object.
     #[arg(long, conflicts_with = "out")]

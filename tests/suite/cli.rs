@@ -252,6 +252,21 @@ fn bad_input_is_refused_with_one_clear_line() {
         "beta = NaN",
         None,
     );
+    // ν without η (or the reverse) would record a default beside the value given.
+    assert_refused(
+        &[
+            "diagram", "--alpha", "0.5", "--beta", "3", "--nu", "0.7", "--out", d,
+        ],
+        "--eta",
+        Some(&d_out),
+    );
+    assert_refused(
+        &[
+            "diagram", "--alpha", "0.5", "--beta", "3", "--eta", "2", "--json",
+        ],
+        "--nu",
+        None,
+    );
     assert_refused(
         &[
             "diagram",
