@@ -211,8 +211,9 @@ def test_values_next_to_a_shoulder_on_a_kink_keep_within_their_estimates(offset)
 
 
 # Bodies with a kink on which V′ vanishes at κ_k² = sin³θ_k U′(θ_k)/cosθ_k: a shoulder (the
-# truncated balls: one side concave, one convex) or a corner minimum (the wheels: convex on
-# both sides, with different curvatures). (shape, α, cut, ν, η, which kink)
+# first: V″ = −0.26 before the kink, 0.74 after) or a corner minimum (the others: convex on
+# both sides, with different curvatures; the last on the wheel's upper kink).
+# (shape, α, cut, ν, η, which kink)
 KINK_CRITICAL = [
     ("truncated_ball", -0.2, 0.4, 0.7, 1.3, 0),
     ("truncated_ball", 0.3, -0.6, 1.5, 3.0, 0),
