@@ -520,7 +520,7 @@ impl EnergyErrors {
 /// where the offset is computed sharply their terms are taken at it) is used when it is far
 /// below the tolerance; otherwise, and near a pole at small κ, where the turning point is where ε and
 /// U nearly cancel and X varies on the scale of κ, the slope is measured by differences at
-/// ε ± h, h = 256 δε.
+/// ε ± h, h a thousandth of the scale X varies on (256 δε near a pole).
 fn level_offset_error<S: Shape>(
     potential: &EffectivePotential<'_, S>,
     energy: f64,
@@ -715,12 +715,44 @@ fn level_offset_error<S: Shape>(
         .filter(|p| p.kind != CriticalKind::Minimum)
         .map(|p| (energy - p.value).abs())
         .fold(f64::INFINITY, f64::min);
-    // The step from the a-priori bound: the sharp one may be far below an ulp of ε, where
-    // ε ± h would round back to ε.
-    let h = (256.0 * a_priori).min(0.25 * depth).min(0.25 * saddles);
+    // Away from a pole X(ε) is analytic on the scale of the depth, the end's reach and the
+    // distance to the nearest saddle or kink level (a turning point crossing a kink): a step
+    // of 1e-3 of that scale leaves the slope changed by about that fraction, which the
+    // doubled difference below covers, and it lets the integrals at ε ± h be far less
+    // accurate than the cell's, their errors entering times δ/h. Near a pole at small κ
+    // (X varies on the scale of κ there) and where that scale is below it, the step is
+    // 256 times the a-priori bound (never below: the sharp δ may be far below an ulp of ε,
+    // where ε ± h would round back to ε).
+    let kink_levels = potential
+        .body
+        .shape
+        .kinks()
+        .iter()
+        .map(|&k| (energy - potential.value(crate::torus::Site::at(k).angle())).abs())
+        .fold(f64::INFINITY, f64::min);
+    let variation = depth.min(reach).min(saddles).min(kink_levels);
+    let narrow = 256.0 * a_priori;
+    let h = if near_pole {
+        narrow
+    } else {
+        narrow.max(1e-3 * variation)
+    }
+    .min(0.25 * depth)
+    .min(0.25 * saddles);
     if h < 16.0 * a_priori {
         return crude.plus(tilted);
     }
+    // The integrals at ε ± h to what keeps their errors' share, errors δ/h, at a hundredth
+    // of the tolerance (never looser than 1e-8, never tighter than the cell's).
+    let looser = 0.01 * tol * h / delta;
+    let options = &CellOptions {
+        tol: if looser > tol {
+            looser.min(tol.max(1e-8))
+        } else {
+            tol
+        },
+        ..*options
+    };
     let at = |e: f64| -> Option<PeriodIntegrals> {
         integrate(
             potential,
