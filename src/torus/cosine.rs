@@ -6,8 +6,8 @@
 //! at small κ) it stops early and the tanh-sinh path of the parent module takes over.
 
 use super::{
-    interleave, level_error, sample, weighted, Component, Convergence, DriftEstimate,
-    EffectivePotential, NodeSample, PeriodIntegrals, Piece, EPS, HIDDEN_PEAK,
+    interleave, level_error, root_of_ratio, sample, weighted, Component, Convergence,
+    DriftEstimate, EffectivePotential, NodeSample, PeriodIntegrals, Piece, EPS, HIDDEN_PEAK,
 };
 use crate::body::{Angle, Shape};
 use crate::error::Result;
@@ -405,7 +405,7 @@ fn end_sample<S: Shape>(
     if g.is_nan() || g <= 1e3 * g_error {
         return None;
     }
-    let dt = (red.reduced_inertia * map.end_length(piece, left) / (2.0 * g)).sqrt();
+    let dt = root_of_ratio(red.reduced_inertia * map.end_length(piece, left), 2.0 * g);
     Some(weighted(v, a, &red, dt, 0.0, g_error / g))
 }
 

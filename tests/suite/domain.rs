@@ -227,6 +227,43 @@ fn the_cells_issue_22_found_answer_honestly() {
     }
 }
 
+/// The lightest bodies, η from 1e-306 down to the least accepted 5.6e-309: B = 1/η + |r|²
+/// over a gap below 1 overflowed before its root, and every value was missing. T grows like
+/// η^(−1/2) at fixed κ and ε (B ≈ 1/η, the potential's terms do not depend on η), and N,
+/// the drift and the status stay those of η = 1e-300.
+#[test]
+fn the_lightest_bodies_have_their_values() {
+    let options = CellOptions::default();
+    let solve = |eta: f64| {
+        let body = EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, eta).unwrap();
+        let cell = solve_cell(&body, 0.8, 2.5, &options).unwrap();
+        assert_eq!(cell.components.len(), 1, "{eta:e}: {cell:?}");
+        cell.components[0].clone()
+    };
+    let reference = solve(1e-300);
+    assert_eq!(reference.status, Status::Ok, "{reference:?}");
+    for eta in [1e-306, 1e-307, 1e-308, 5.6e-309] {
+        let c = solve(eta);
+        assert_eq!(c.status, Status::Ok, "{eta:e}: {c:?}");
+        let scaled = c.period * (eta / 1e-300).sqrt();
+        assert!(
+            (scaled - reference.period).abs() <= 1e-12 * reference.period,
+            "{eta:e}: T √η {scaled} against {}",
+            reference.period
+        );
+        let n_error = c.errors.rotation_number + reference.errors.rotation_number;
+        assert!(
+            (c.rotation_number - reference.rotation_number).abs() <= n_error,
+            "{eta:e}: {c:?}"
+        );
+        assert!(
+            (c.drift - reference.drift).abs() <= c.errors.drift + reference.errors.drift,
+            "{eta:e}: {c:?}"
+        );
+        assert_eq!(c.bounded, reference.bounded, "{eta:e}");
+    }
+}
+
 /// Bodies beyond the checked β and η answer at once, undecided, saying why; the edges of the
 /// checked range are decided.
 #[test]
