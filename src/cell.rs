@@ -10,7 +10,7 @@ use crate::family::Family;
 use crate::limits::Estimate;
 use crate::period_ode;
 use crate::torus::{
-    Component, CriticalKind, CriticalPoint, EffectivePotential, MotionKind, PeriodIntegrals,
+    Component, CriticalKind, CriticalPoint, EffectivePotential, MotionKind, PeriodIntegrals, Site,
 };
 use serde::Serialize;
 use std::f64::consts::{PI, TAU};
@@ -728,7 +728,7 @@ fn level_offset_error<S: Shape>(
         .shape
         .kinks()
         .iter()
-        .map(|&k| (energy - potential.value(crate::torus::Site::at(k).angle())).abs())
+        .map(|&k| (energy - potential.value(Site::at(k).angle())).abs())
         .fold(f64::INFINITY, f64::min);
     let variation = depth.min(reach).min(saddles).min(kink_levels);
     let narrow = 256.0 * a_priori;

@@ -1706,19 +1706,19 @@ fn sample<S: Shape>(
             reason: "a quadrature node fell outside the allowed set (ε ≤ V there)",
         });
     }
-    let dt = root_of_ratio(red.reduced_inertia, 2.0 * gap) * node.jacobian;
+    let dt = root_of_ratio(red.reduced_inertia, 1.0, 2.0 * gap) * node.jacobian;
     Ok(weighted(v, a, &red, dt, node.jacobian, abs_err / gap))
 }
 
-/// √(a/b) for a, b > 0, also where a/b overflows (B = 1/η + |r|² up to 1.8e308 at the
-/// smallest η, over a gap below 1: the root is still a double).
+/// √(a·b/c) for a, b, c > 0, also where the quotient overflows (B = 1/η + |r|² up to
+/// 1.8e308 at the smallest η, over a gap below 1: the root is still a double).
 #[inline]
-pub(super) fn root_of_ratio(a: f64, b: f64) -> f64 {
-    let ratio = a / b;
+pub(super) fn root_of_ratio(a: f64, b: f64, c: f64) -> f64 {
+    let ratio = a * b / c;
     if ratio.is_finite() {
         ratio.sqrt()
     } else {
-        a.sqrt() / b.sqrt()
+        a.sqrt() * (b.sqrt() / c.sqrt())
     }
 }
 

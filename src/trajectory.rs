@@ -287,29 +287,36 @@ impl Request {
                 "must be a finite number > 0",
             )
         };
-        let t_end = match self.duration {
-            Duration::Periods(k) => positive("periods", k)? * start.period(body, 1e-13)?,
-            Duration::Until(t) => positive("t-end", t)?,
+        let (t_end, period) = match self.duration {
+            Duration::Periods(k) => {
+                let k = positive("periods", k)?;
+                let period = start.period(body, 1e-13)?;
+                (k * period, Some(period))
+            }
+            Duration::Until(t) => (positive("t-end", t)?, None),
         };
         if let Some(budget) = self.step_budget {
-            self.check_work(body, &start, t_end, budget, stop)?;
+            // (A start with no period is piloted over t_end/1000.)
+            let period =
+                period.unwrap_or_else(|| start.period(body, 1e-13).unwrap_or(f64::INFINITY));
+            self.check_work(body, &start, t_end, period, budget, stop)?;
         }
         let traj = integrate(body, &start, self.model, t_end, self.samples, tol, stop)?;
         Ok((start, traj))
     }
 
     /// Refuses, in one line with the estimate, an integration to `t_end` that needs more
-    /// than `budget` steps: the steps of a pilot run over the first θ-period (or over
-    /// t_end/1000 where the start has no period) scaled to `t_end`.
+    /// than `budget` steps: the steps of a pilot run over the first θ-`period` (or over
+    /// t_end/1000 where it is shorter, or the start has none: ∞) scaled to `t_end`.
     fn check_work<S: Shape>(
         &self,
         body: &Body<S>,
         start: &Start,
         t_end: f64,
+        period: f64,
         budget: f64,
         stop: &dyn Fn() -> bool,
     ) -> Result<()> {
-        let period = start.period(body, 1e-13).unwrap_or(f64::INFINITY);
         let span = period.min(1e-3 * t_end);
         if !(span > 0.0 && span < t_end) {
             return Ok(());

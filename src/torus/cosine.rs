@@ -405,7 +405,7 @@ fn end_sample<S: Shape>(
     if g.is_nan() || g <= 1e3 * g_error {
         return None;
     }
-    let dt = root_of_ratio(red.reduced_inertia * map.end_length(piece, left), 2.0 * g);
+    let dt = root_of_ratio(red.reduced_inertia, map.end_length(piece, left), 2.0 * g);
     Some(weighted(v, a, &red, dt, 0.0, g_error / g))
 }
 
