@@ -371,6 +371,25 @@ pub fn solve_component<S: Shape>(
     Ok(finish(component, raw, limit, options))
 }
 
+/// The values of the component that holds a start (`component`, at the start's `energy`):
+/// those of [`solve_component`], except that a start at rest on an unstable equilibrium is
+/// that equilibrium, on its separatrix (T = ∞, `bounded`), even where the level's other
+/// motions land on a face (the upright disk at rest) and so have no values.
+pub fn solve_start<S: Shape>(
+    potential: &EffectivePotential<'_, S>,
+    start: &crate::trajectory::Start,
+    energy: f64,
+    component: &Component,
+    options: &CellOptions,
+) -> Result<ComponentResult> {
+    match start.rest_on_saddle(component, energy) {
+        Some(saddle) if reaches_face(potential, component) => {
+            Ok(on_separatrix(potential, component, &saddle, options))
+        }
+        _ => solve_component(potential, energy, component, options),
+    }
+}
+
 /// Whether a κ = 0 component reaches a pole at which the body has a flat face: a pole
 /// θ = 2πm (face 0) or π + 2πm (face π) of the lifted circle within [θ_min, θ_max].
 pub(crate) fn reaches_face<S: Shape>(

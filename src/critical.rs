@@ -375,16 +375,41 @@ fn sample_branches<S: Shape>(
         let mut pts: Vec<FixedPoint> = Vec::with_capacity(samples + 1);
         // Interior samples; a pole is added only where a branch ends at it (U″ > 0 there,
         // i.e. κ² ≥ 0 on its neighbourhood), never as a lone point.
-        for i in 1..samples {
+        let mut previous: Option<(f64, f64)> = None;
+        for i in 1..=samples {
             stopped(i)?;
-            let t = lo + (hi - lo) * i as f64 / samples as f64;
-            if (curve.kappa_sq)(t) < 0.0 {
+            // The last probe is the end at π/2 (on this half's side of it), where κ → ∞
+            // unless U′(π/2) = 0: it only brackets a climb to κ_max.
+            let t = match (i, lo) {
+                (i, _) if i < samples => lo + (hi - lo) * i as f64 / samples as f64,
+                (_, 0.0) => FRAC_PI_2,
+                _ => break,
+            };
+            let k2 = (curve.kappa_sq)(t);
+            if let Some(a) = previous {
+                pts.extend(climb_to_kappa_max(curve, a, (t, k2), kappa_max, samples));
+            }
+            previous = Some((t, k2));
+            if i == samples || k2 < 0.0 {
                 continue;
             }
             let p = (curve.point)(t);
             if p.kappa <= kappa_max {
                 pts.push(p);
             }
+        }
+        if lo != 0.0 {
+            // The upper half's first probe is the end at π/2 on its side.
+            let t = FRAC_PI_2.next_up();
+            let (k2, first) = ((curve.kappa_sq)(t), lo + (hi - lo) / samples as f64);
+            let k1 = (curve.kappa_sq)(first);
+            pts.extend(climb_to_kappa_max(
+                curve,
+                (t, k2),
+                (first, k1),
+                kappa_max,
+                samples,
+            ));
         }
         let pole = if lo == 0.0 { 0.0 } else { PI };
         if (curve.pole_ends)(pole) && !pts.is_empty() {
@@ -426,6 +451,53 @@ fn sample_branches<S: Shape>(
         }
     }
     Ok((branches, cusps))
+}
+
+/// The points of a branch between two probes of the curve, (θ, κ²) each, where κ climbs
+/// steeply between them or crosses κ_max: by θ0 = π/2 on a body not symmetric about its
+/// equator κ → ∞ (at α = 10⁻⁶, β = 1 the grid's last sample has κ = 0.036, and at α = 10⁻¹⁵
+/// the last double before π/2 has κ = 2.5). Points at most 4 κ_max/`samples` apart in κ, from
+/// the lower probe's κ up to the crossing κ = κ_max or short of the upper probe, so that the
+/// branch is drawn up to κ_max or as far as doubles reach. None where either probe has no
+/// permanent rotation (κ² < 0) or both lie beyond κ_max.
+fn climb_to_kappa_max<S: Shape>(
+    curve: &Curve<'_, S>,
+    a: (f64, f64),
+    b: (f64, f64),
+    kappa_max: f64,
+    samples: usize,
+) -> Vec<FixedPoint> {
+    let ((t_in, k2_in), (t_out, k2_out)) = if a.1 <= b.1 { (a, b) } else { (b, a) };
+    let step = 4.0 * kappa_max / samples as f64;
+    let (k_in, k_out) = (k2_in.sqrt(), k2_out.sqrt());
+    if !(k2_in >= 0.0 && k_in <= kappa_max && k_out - k_in > step.min(kappa_max - k_in)) {
+        return Vec::new();
+    }
+    let crosses = k_out > kappa_max;
+    let k_top = k_out.min(kappa_max);
+    let steps = ((k_top - k_in) / step).ceil().clamp(1.0, samples as f64) as usize;
+    let (lo, hi) = (t_in.min(t_out), t_in.max(t_out));
+    // Up to the crossing, or short of the upper probe (a sample already, or the end at π/2).
+    let last = if crosses { steps } else { steps - 1 };
+    (1..=last)
+        .map(|j| {
+            let k = k_in + (k_top - k_in) * j as f64 / steps as f64;
+            let k2 = if crosses && j == steps {
+                kappa_max * kappa_max
+            } else {
+                k * k
+            };
+            let f = |t: f64| (curve.kappa_sq)(t) - k2;
+            let t = bisect(&f, lo, hi, f(lo) < 0.0);
+            // The bisection ends on either side of the root: the crossing is taken inside.
+            match (curve.point)(t) {
+                p if p.kappa > kappa_max && t_in < t_out => (curve.point)(t.next_down()),
+                p if p.kappa > kappa_max => (curve.point)(t.next_up()),
+                p => p,
+            }
+        })
+        .filter(|p| p.kappa <= kappa_max && p.kappa > k_in)
+        .collect()
 }
 
 /// σ_π/2 of a body symmetric about its equator: θ0 = π/2 at every κ (`s2`), ε = κ²/2 + U(π/2)

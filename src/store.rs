@@ -258,7 +258,22 @@ fn write_csv(
     for (k, v) in &table.attributes {
         writeln!(w, "# {k}: {}", v.display().replace('\n', " ")).map_err(io)?;
     }
-    // The number of rows, last: a reader can tell a file cut short at a line's end.
+    // The columns with their types (a reader can tell an edited header, and give the index
+    // and flag columns back their integer types), then the number of rows, last: a reader
+    // can tell a file cut short at a line's end.
+    let columns: Vec<String> = table
+        .columns
+        .iter()
+        .map(|c| {
+            let kind = match c.values {
+                Values::F64(_) => "float64",
+                Values::I32(_) => "int32",
+                Values::U8(_) => "uint8",
+            };
+            format!("{}:{kind}", c.name)
+        })
+        .collect();
+    writeln!(w, "# columns: {}", columns.join(" ")).map_err(io)?;
     writeln!(w, "# rows: {}", table.rows()).map_err(io)?;
     let mut csv = csv::Writer::from_writer(w);
     let text = |e: csv::Error| e.to_string();

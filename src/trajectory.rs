@@ -7,7 +7,7 @@ use crate::error::{AtlasError, Result};
 use crate::full::{FullState, FullSystem, FULL_STATE_LEN};
 use crate::ode::{integrate_sampled, Rate};
 use crate::reduced::ReducedSystem;
-use crate::torus::{Component, EffectivePotential, MotionKind};
+use crate::torus::{Component, CriticalPoint, EffectivePotential, MotionKind};
 use nalgebra::SVector;
 
 /// Which equations are integrated.
@@ -150,6 +150,28 @@ impl Start {
         })
     }
 
+    /// The unstable equilibrium this start rests on, if it does: θ̇(0) = 0 at κ = 0 on the
+    /// level of a maximum (or inflection) of V within 1e-7 of θ(0) on the circle. The body
+    /// then stays there, even where the level's other motions land on a face (the upright
+    /// disk at rest): it is the separatrix's equilibrium, not a motion onto the face.
+    pub fn rest_on_saddle(&self, component: &Component, energy: f64) -> Option<CriticalPoint> {
+        if self.kappa != 0.0 || self.theta_dot0 != 0.0 {
+            return None;
+        }
+        let tau = std::f64::consts::TAU;
+        let near = |p: &&CriticalPoint| {
+            let apart = (self.circle_angle() - p.site.theta).rem_euclid(tau);
+            apart.min(tau - apart) <= 1e-7
+        };
+        component
+            .interior
+            .iter()
+            .chain(component.neighbours.iter().flatten())
+            .filter(|p| p.kind != crate::torus::CriticalKind::Minimum && energy == p.value)
+            .find(near)
+            .copied()
+    }
+
     /// θ(0), at κ = 0 (θ an angle on the circle) taken within π of 0 when it lies beyond:
     /// atan2 of its sine and cosine is that angle to the last bit (their argument reduction
     /// is exact; θ(0) − 2πk in doubles is not, and at θ(0) = 1e10 kept no digit).
@@ -266,16 +288,25 @@ impl Request {
         crate::error::check_samples(self.samples)?;
         let start = self.start(body)?;
         // A planar motion onto a face ends there (docs/bodies.md): no trajectory to follow.
+        // A body at rest on an unstable equilibrium of such a level stays there, until
+        // rounding moves it off (checked below).
+        let mut at_rest_by_a_face = false;
         if start.kappa == 0.0 && body.shape.faces() != [false, false] {
             let potential = crate::torus::EffectivePotential::new(body, 0.0);
             let component = start.component_in(&potential)?;
             if crate::cell::reaches_face(&potential, &component) {
-                return Err(AtlasError::Unsupported {
-                    what: "trajectory",
-                    reason: "kappa = 0 and this motion reaches a flat face of the body, where \
-                             it ends (the body lands on the face); start away from it or with \
-                             kappa != 0",
-                });
+                if start
+                    .rest_on_saddle(&component, start.energy(body))
+                    .is_none()
+                {
+                    return Err(AtlasError::Unsupported {
+                        what: "trajectory",
+                        reason: "kappa = 0 and this motion reaches a flat face of the body, \
+                                 where it ends (the body lands on the face); start away from \
+                                 it or with kappa != 0",
+                    });
+                }
+                at_rest_by_a_face = true;
             }
         }
         let positive = |name, value| {
@@ -302,6 +333,9 @@ impl Request {
             self.check_work(body, &start, t_end, period, budget, stop)?;
         }
         let traj = integrate(body, &start, self.model, t_end, self.samples, tol, stop)?;
+        if at_rest_by_a_face {
+            check_still_at_rest(&start, &traj)?;
+        }
         Ok((start, traj))
     }
 
@@ -340,6 +374,33 @@ impl Request {
         }
         Ok(())
     }
+}
+
+/// A start at rest on an unstable equilibrium whose level reaches a face stays at rest; the
+/// integrator's rounding grows like e^(λt) and, once θ is 1e-3 off, the body follows the
+/// separatrix onto the face within a few 1/λ, where the motion ends: refused from there.
+/// (θ on the circle, and up to its sign: the full model's θ is the axis's angle in [0, π].)
+fn check_still_at_rest(start: &Start, traj: &Trajectory) -> Result<()> {
+    let tau = std::f64::consts::TAU;
+    let apart = |a: f64, b: f64| {
+        let d = (a - b).rem_euclid(tau);
+        d.min(tau - d)
+    };
+    let Some(i) = traj.theta.iter().position(|&t| {
+        let off = apart(t, start.theta0).min(apart(t, -start.theta0));
+        off.is_nan() || off > 1e-3
+    }) else {
+        return Ok(());
+    };
+    Err(AtlasError::Integration {
+        time: traj.t[i],
+        reason: format!(
+            "the start is an unstable equilibrium (the body stays at rest there), but \
+             rounding moved it off by t = {} and it then lands on a flat face, where the \
+             motion ends: ask for a t-end below that",
+            crate::error::show(traj.t[i])
+        ),
+    })
 }
 
 /// Samples of a trajectory, one entry per time.

@@ -777,11 +777,7 @@ pub fn verdict_until(
     stopped()?;
     let candidates = brackets(&lines, options.tol, symmetric);
     let all: Vec<&Sample> = lines.iter().flatten().collect();
-    let (n_lo, n_hi) = all
-        .iter()
-        .fold((high_energy.n_min, high_energy.n_max), |(lo, hi), s| {
-            (lo.min(s.n), hi.max(s.n))
-        });
+    let (n_lo, n_hi) = rotation_number_range(&sampler, &lines, &high_energy);
     let (mut found, mut refinement_failures) = if options.counterexamples {
         counterexamples(&sampler, &candidates)
     } else {
@@ -857,7 +853,7 @@ pub fn verdict_until(
         Some(true)
     };
     stopped()?;
-    let margins = fail_margin(&sampler, &lines, &high_energy, n_lo, n_hi);
+    let margins = fail_margin(&sampler, &lines, &high_energy, (n_lo, n_hi));
     stopped()?;
     verdict.fail_margin = margins.value();
     verdict.margins = Some(margins);
@@ -884,91 +880,165 @@ pub fn verdict_until(
     Ok(verdict)
 }
 
-/// ñ = N √ε / κ: N's sign, finite where N → 0 at ε → ∞ (slope), κ → 0 (lim N/κ) and κ → ∞.
-fn normalized(s: &Sample) -> f64 {
-    s.n * s.energy.sqrt() / s.kappa
+/// The largest `sign` · `value` over the samples that pass `eligible`, refined by golden
+/// section round the best of them: along ε between the neighbouring samples of its family,
+/// then along κ between the neighbouring lines, then along ε again, so that it follows the
+/// lobe's true peak rather than the grid. `value(N, κ, ε)`; None without an eligible sample.
+fn refined_extreme(
+    sampler: &Sampler<'_>,
+    lines: &[Vec<Sample>],
+    sign: f64,
+    eligible: &dyn Fn(&Sample) -> bool,
+    value: &dyn Fn(f64, f64, f64) -> f64,
+) -> Option<f64> {
+    let tol = sampler.cell.tol;
+    let of = |s: &Sample| sign * value(s.n, s.kappa, s.energy);
+    let (j, i, s) = lines
+        .iter()
+        .enumerate()
+        .flat_map(|(j, l)| l.iter().enumerate().map(move |(i, s)| (j, i, s)))
+        .filter(|(_, _, s)| eligible(s))
+        .max_by(|a, b| of(a.2).total_cmp(&of(b.2)))?;
+    let mut best = of(s);
+    let same = |t: &Sample| t.gap == s.gap && t.well == s.well;
+    let line = &lines[j];
+    let prev = line[..i]
+        .iter()
+        .rev()
+        .find(|t| same(t))
+        .map_or(s.energy, |t| t.energy);
+    let next = line[i + 1..]
+        .iter()
+        .find(|t| same(t))
+        .map_or(s.energy, |t| t.energy);
+    let at = |kappa: f64, energy: f64| -> f64 {
+        sampler
+            .solve(kappa, energy, s, false)
+            .map(|(_, r)| r)
+            .filter(|r| (r.rotation_number).abs() > r.error_estimate.max(tol).max(SIGN_FLOOR))
+            .map_or(f64::NEG_INFINITY, |r| {
+                sign * value(r.rotation_number, kappa, energy)
+            })
+    };
+    let log_golden = |f: &dyn Fn(f64) -> f64, a: f64, b: f64| -> (f64, f64) {
+        if a == b {
+            return (a, f(a));
+        }
+        let (x, v) = golden_max(|u| f(u.exp()), a.ln(), b.ln(), 1e-7);
+        (x.exp(), v)
+    };
+    // The neighbouring lines (a line within rounding of this one, or with no samples, is
+    // passed over: the linear and the log-spaced lines can nearly coincide).
+    let kappa_of = |l: &Vec<Sample>| l.first().map(|t| t.kappa);
+    let kprev = lines[..j]
+        .iter()
+        .rev()
+        .filter_map(kappa_of)
+        .find(|&k| k < s.kappa * (1.0 - 1e-9))
+        .unwrap_or(s.kappa);
+    let knext = lines[j + 1..]
+        .iter()
+        .filter_map(kappa_of)
+        .find(|&k| k > s.kappa * (1.0 + 1e-9))
+        .unwrap_or(s.kappa);
+    let (mut k_lo, mut k_hi) = (kprev.min(knext).min(s.kappa), kprev.max(knext).max(s.kappa));
+    // The next line beyond a κ, downwards or upwards, if any.
+    let line_beyond = |k: f64, up: bool| -> Option<f64> {
+        let mut ks = lines.iter().filter_map(kappa_of);
+        if up {
+            ks.find(|&q| q > k * (1.0 + 1e-9))
+        } else {
+            ks.rev().find(|&q| q < k * (1.0 - 1e-9))
+        }
+    };
+    let (mut e_lo, mut e_hi) = (prev.min(next).min(s.energy), prev.max(next).max(s.energy));
+    // The family's next sample on the best line beyond an ε, downwards or upwards, if any.
+    let energy_beyond = |e: f64, up: bool| -> Option<f64> {
+        let es = line.iter().filter(|t| same(t)).map(|t| t.energy);
+        if up {
+            es.filter(|&q| q > e * (1.0 + 1e-9)).reduce(f64::min)
+        } else {
+            es.filter(|&q| q < e * (1.0 - 1e-9)).reduce(f64::max)
+        }
+    };
+    // Coordinate search to convergence inside the box of the neighbouring samples and lines:
+    // along log ε at fixed λ = κ/√ε, along log κ at fixed ε, along log ε at fixed κ. Far out N is chiefly a
+    // function of λ, so the two directions are nearly independent; three line searches in κ
+    // and ε alone stopped short in the valley along λ (at α = 0.9 the N = −1 boundary still
+    // moved by 1.3e-3 in β from resolution 64 to 128).
+    let (mut kappa, mut energy) = (s.kappa, s.energy);
+    for _ in 0..64 {
+        let before = best;
+        let lambda = kappa / energy.sqrt();
+        let (lo, hi) = (
+            e_lo.max((k_lo / lambda).powi(2)),
+            e_hi.min((k_hi / lambda).powi(2)),
+        );
+        if lo < hi {
+            let (e, v) = log_golden(&|e| at(lambda * e.sqrt(), e), lo, hi);
+            if v > best {
+                (kappa, energy, best) = (lambda * e.sqrt(), e, v);
+            }
+        }
+        let (k, v) = log_golden(&|k| at(k, energy), k_lo, k_hi);
+        if v > best {
+            (kappa, best) = (k, v);
+        }
+        // And along ε at fixed κ: the way along the region's edge, where λ cannot be kept.
+        let (e, v) = log_golden(&|e| at(kappa, e), e_lo, e_hi);
+        if v > best {
+            (energy, best) = (e, v);
+        }
+        if best - before <= 1e-13 * best.abs() {
+            // An extreme on the box's κ edge lies beyond it, or on the region's edge (the
+            // first line, κ_max in case 2): the box grows by a line and the search goes on.
+            // Likewise on the box's ε edge, by the family's next sample on the best line.
+            let grown_kappa = if kappa <= k_lo * (1.0 + 1e-6) {
+                line_beyond(k_lo, false).map(|k| k_lo = k)
+            } else if kappa >= k_hi * (1.0 - 1e-6) {
+                line_beyond(k_hi, true).map(|k| k_hi = k)
+            } else {
+                None
+            };
+            let grown_energy = if energy <= e_lo * (1.0 + 1e-6) {
+                energy_beyond(e_lo, false).map(|e| e_lo = e)
+            } else if energy >= e_hi * (1.0 - 1e-6) {
+                energy_beyond(e_hi, true).map(|e| e_hi = e)
+            } else {
+                None
+            };
+            if grown_kappa.is_none() && grown_energy.is_none() {
+                break;
+            }
+        }
+    }
+    Some(best)
 }
 
-/// The fail margin of the verdict (see [`Verdict::fail_margin`]). The extreme ñ of the
-/// samples are refined by golden section, along ε between the neighbouring samples of the
-/// family, then along κ, then along ε again, so that the margin follows the lobe's true peak
-/// rather than the grid. The edge κ → ∞ contributes N∞(λ)/λ.
+/// The fail margin of the verdict (see [`Verdict::fail_margin`]). The extreme ñ and N of the
+/// samples are refined ([`refined_extreme`]): a margin that follows the grid would move its
+/// root, the boundary, with the resolution (N_min by 9.8e-4 in β from resolution 16 to 64 at
+/// α = 0.5). The edge κ → ∞ contributes N∞(λ)/λ and N∞'s extrema.
 fn fail_margin(
     sampler: &Sampler<'_>,
     lines: &[Vec<Sample>],
     high_energy: &HighEnergyLimit,
-    n_lo: f64,
-    n_hi: f64,
+    (n_lo, n_hi): (f64, f64),
 ) -> Margins {
     let tol = sampler.cell.tol;
     // The edge κ → ∞: Ñ = N∞/(λ x₀²), N's sign there, with its exact extrema.
     let edge = [high_energy.normalized_max, high_energy.normalized_min];
-    let reliable = |s: &&Sample| (s.n).abs() > ambiguity(s, tol);
+    let reliable = |s: &Sample| (s.n).abs() > ambiguity(s, tol);
+    // ñ = N √ε / κ: N's sign, finite where N → 0 at ε → ∞ (slope), κ → 0 (lim N/κ), κ → ∞.
+    let normalized = |n: f64, kappa: f64, energy: f64| n * energy.sqrt() / kappa;
     // (sign · extreme, whether it is the edge's).
     let extreme = |sign: f64| -> (f64, bool) {
         let edge_best = edge
             .iter()
             .map(|v| sign * v)
             .fold(f64::NEG_INFINITY, f64::max);
-        let best = lines
-            .iter()
-            .enumerate()
-            .flat_map(|(j, l)| l.iter().enumerate().map(move |(i, s)| (j, i, s)))
-            .filter(|(_, _, s)| reliable(s))
-            .max_by(|a, b| (sign * normalized(a.2)).total_cmp(&(sign * normalized(b.2))));
-        let Some((j, i, s)) = best else {
-            return (edge_best, true);
-        };
-        let mut value = sign * normalized(s);
-        let same = |t: &Sample| t.gap == s.gap && t.well == s.well;
-        let line = &lines[j];
-        let prev = line[..i]
-            .iter()
-            .rev()
-            .find(|t| same(t))
-            .map_or(s.energy, |t| t.energy);
-        let next = line[i + 1..]
-            .iter()
-            .find(|t| same(t))
-            .map_or(s.energy, |t| t.energy);
-        let at = |kappa: f64, energy: f64| -> f64 {
-            sampler
-                .solve(kappa, energy, s, false)
-                .map(|(_, r)| r)
-                .filter(|r| (r.rotation_number).abs() > r.error_estimate.max(tol).max(SIGN_FLOOR))
-                .map_or(f64::NEG_INFINITY, |r| {
-                    sign * r.rotation_number * energy.sqrt() / kappa
-                })
-        };
-        // Along ε (in log ε), then κ (in log κ), then ε again.
-        let (mut kappa, mut energy) = (s.kappa, s.energy);
-        let log_golden = |f: &dyn Fn(f64) -> f64, a: f64, b: f64| -> (f64, f64) {
-            if a == b {
-                return (a, f(a));
-            }
-            let (x, v) = golden_max(|u| f(u.exp()), a.ln(), b.ln(), 1e-9);
-            (x.exp(), v)
-        };
-        let (e, v) = log_golden(&|e| at(kappa, e), prev, next);
-        if v > value {
-            (energy, value) = (e, v);
-        }
-        let kprev = if j > 0 {
-            lines[j - 1].first().map_or(kappa, |t| t.kappa)
-        } else {
-            kappa
-        };
-        let knext = lines
-            .get(j + 1)
-            .and_then(|l| l.first())
-            .map_or(kappa, |t| t.kappa);
-        let (k, v) = log_golden(&|k| at(k, energy), kprev, knext);
-        if v > value {
-            (kappa, value) = (k, v);
-        }
-        let (lo, hi) = (energy.min(prev).min(next), energy.max(prev).max(next));
-        let (_, v) = log_golden(&|e| at(kappa, e), lo, hi);
-        let sampled = value.max(v);
+        let sampled = refined_extreme(sampler, lines, sign, &reliable, &normalized)
+            .unwrap_or(f64::NEG_INFINITY);
         (sampled.max(edge_best), edge_best >= sampled)
     };
     let (sup, sup_edge) = extreme(1.0);
@@ -985,6 +1055,20 @@ fn fail_margin(
             n_lo_edge,
         ],
     }
+}
+
+/// The smallest and the largest N over the samples, each refined ([`refined_extreme`]), and
+/// over the high-energy limit's N∞ (κ → ∞).
+fn rotation_number_range(
+    sampler: &Sampler<'_>,
+    lines: &[Vec<Sample>],
+    high_energy: &HighEnergyLimit,
+) -> (f64, f64) {
+    let n = |n: f64, _: f64, _: f64| n;
+    let any = |_: &Sample| true;
+    let hi = refined_extreme(sampler, lines, 1.0, &any, &n).unwrap_or(f64::NEG_INFINITY);
+    let lo = -refined_extreme(sampler, lines, -1.0, &any, &n).unwrap_or(f64::NEG_INFINITY);
+    (lo.min(high_energy.n_min), hi.max(high_energy.n_max))
 }
 
 /// The terms of the fail margin: each positive exactly when its resonance exists.
@@ -1344,6 +1428,27 @@ fn illinois(
     Ok((0.5 * (a + b), 0.5 * (b - a).abs()))
 }
 
+/// How far a root of a margin term on the sampled plane (`root`, in the bracket (lo, hi))
+/// moves when the plane is sampled at half the resolution (`coarse`): the sampling's part of
+/// the boundary's error bar (at convergence of order p ≥ 1 in the sampling step, the move
+/// from half resolution is (2^p − 1) times the error left at full resolution, so at least
+/// that error). Where the coarse sampling does not see the change in (lo, hi), the whole
+/// bracket is the term.
+fn resolution_term(
+    coarse: impl Fn(f64) -> Result<f64>,
+    lo: f64,
+    hi: f64,
+    root: f64,
+    xtol: f64,
+) -> Result<f64> {
+    let (fa, fb) = (coarse(lo)?, coarse(hi)?);
+    if !(fa.is_finite() && fb.is_finite() && (fa > 0.0) != (fb > 0.0)) {
+        return Ok((hi - lo).abs());
+    }
+    let (coarse_root, width) = illinois(coarse, (lo, fa), (hi, fb), xtol)?;
+    Ok((coarse_root - root).abs() + width)
+}
+
 fn key(v: &Verdict) -> (Case, Option<bool>) {
     (v.case, v.holds)
 }
@@ -1419,6 +1524,17 @@ pub fn boundaries_with(
             reason: "must lie in 1e-3 ... 1e3 for the boundaries, the bodies the verdict decides (docs/hypothesis.md)",
         });
     }
+    // A boundary's error bar holds the move of its root from half the resolution; below 32
+    // both can miss the same extremum (at α = 0.5 the N = −1 boundary is 9e-4 off at 16 and
+    // 2e-4 at 8, where their difference is 1.4e-4).
+    if options.verdict.resolution < 32 {
+        return Err(AtlasError::InvalidParameter {
+            name: "resolution",
+            value: options.verdict.resolution as f64,
+            reason: "must be >= 32 for the boundaries: coarser sampling misses the extrema they \
+                     are found on, by more than its error bar shows",
+        });
+    }
     if !(4..=10_000).contains(&options.scan) {
         return Err(AtlasError::InvalidParameter {
             name: "scan",
@@ -1437,6 +1553,14 @@ pub fn boundaries_with(
         ..options.verdict
     };
     let margin = |beta: f64| -> Result<Verdict> { verdict_until(&body(beta)?, &margin_only, stop) };
+    // The same at half the resolution: how far a boundary on the sampled plane moves with
+    // the sampling is part of its error bar.
+    let coarse_only = VerdictOptions {
+        resolution: (options.verdict.resolution / 2).max(8),
+        ..margin_only
+    };
+    let coarse_margin =
+        |beta: f64| -> Result<Verdict> { verdict_until(&body(beta)?, &coarse_only, stop) };
     let mut betas: Vec<f64> = (0..options.scan)
         .map(|i| (b0.ln() + (b1.ln() - b0.ln()) * i as f64 / (options.scan - 1) as f64).exp())
         .collect();
@@ -1513,14 +1637,20 @@ pub fn boundaries_with(
                 if (fa > 0.0) != (fb > 0.0) && fa.is_finite() && fb.is_finite() {
                     let xtol = if limit_only { 1e-10 } else { BOUNDARY_XTOL };
                     let (root, width) = illinois(f, (lo.beta, fa), (hi.beta, fb), xtol)?;
-                    let source = if limit_only {
-                        "high-energy limit"
+                    let (source, error) = if limit_only {
+                        ("high-energy limit", width)
                     } else {
-                        "sampled plane"
+                        let coarse = |beta: f64| -> Result<f64> {
+                            Ok(coarse_margin(beta)?
+                                .margins
+                                .map_or(f64::NAN, |m| m.terms()[t]))
+                        };
+                        let moved = resolution_term(coarse, lo.beta, hi.beta, root, xtol)?;
+                        ("sampled plane", width + moved)
                     };
                     located = Some(boundary(
                         root,
-                        width,
+                        error,
                         format!("fail_margin: {} ({source})", Margins::NAMES[t]),
                     ));
                 }

@@ -1370,6 +1370,8 @@ def read_table(path: str | Path) -> xr.Dataset:
         if path.suffix.lower() == ".csv":
             return _read_csv(path)
         ds = xr.open_dataset(path, engine="h5netcdf")
+    except _DamagedTable as e:
+        raise ValueError(str(e)) from None
     except (OSError, ValueError) as e:
         raise ValueError(f"{path}: not a table ({_one_line(e)}); {tables}") from None
     with ds:
@@ -1378,6 +1380,10 @@ def read_table(path: str | Path) -> xr.Dataset:
                              "and open_atlas opens an atlas")
         with _reading(ds):
             return ds.load()
+
+
+class _DamagedTable(ValueError):
+    """A CSV table refused by its own checks: its message is already the one line to give."""
 
 
 def _read_csv(path: Path) -> xr.Dataset:
@@ -1398,24 +1404,147 @@ def _read_csv(path: Path) -> xr.Dataset:
     # A rubber-atlas table names its program, ends with a newline and (since the row count
     # was added) says how many rows it has: a foreign or cut-short file is refused.
     if attrs.get("program") != "rubber-atlas":
-        raise ValueError(f"{path}: not a rubber-atlas table (its header has no '# program: rubber-atlas' line)")
+        raise _DamagedTable(f"{path}: not a rubber-atlas table (its header has no '# program: rubber-atlas' line)")
     with path.open("rb") as f:
         f.seek(0, 2)
         size = f.tell()
         f.seek(max(size - 1, 0))
         if size == 0 or f.read(1) != b"\n":
-            raise ValueError(f"{path}: the table is cut short (its last line is not complete); write it again")
+            raise _DamagedTable(f"{path}: the table is cut short (its last line is not complete); write it again")
     rows = attrs.pop("rows", None)
-    frame = pd.read_csv(path, comment="#")
+    if rows is not None and not (isinstance(rows, float) and rows >= 0 and rows == int(rows)):
+        raise _DamagedTable(f"{path}: the table's '# rows' line is not a count ({rows!r}): the table was edited "
+                         "or damaged; write it again")
+    types = _csv_types(path, attrs.pop("columns", None))
+    _check_csv_fields(path)
+    frame = pd.read_csv(path, comment="#", low_memory=False)
     if rows is not None and len(frame) != rows:
-        raise ValueError(f"{path}: the table is cut short or damaged: {len(frame)} rows where its header "
+        raise _DamagedTable(f"{path}: the table is cut short or damaged: {len(frame)} rows where its header "
                          f"says {rows:.0f}; write it again")
+    if types is not None and list(frame.columns) != list(types):
+        raise _DamagedTable(f"{path}: the column names {','.join(map(str, frame.columns))} differ from the table's "
+                         f"'# columns' line ({','.join(types)}): the table was edited or damaged; write it again")
     if len(frame) == 0:
         frame = frame.astype(np.float64)
+    _check_csv_numbers(path, frame)
+    if types is not None:
+        frame = _typed_columns(path, frame, types)
     dim = frame.columns[0]
     ds = xr.Dataset.from_dataframe(frame.set_index(dim))
+    if types is not None:
+        # (A pandas index is int64 whatever its column was.)
+        ds = ds.assign_coords({dim: ds[dim].to_numpy().astype(types[dim])})
     ds.attrs.update(attrs)
     return ds
+
+
+def _csv_types(path: Path, line) -> dict | None:
+    """The column names and types of a CSV table's ``# columns: name:type …`` line (written
+    since it was added; None for an older table)."""
+    if line is None:
+        return None
+    types = {}
+    for item in str(line).split():
+        name, _, kind = item.partition(":")
+        if kind not in ("float64", "int32", "uint8") or name in types:
+            raise _DamagedTable(f"{path}: the table's '# columns' line is damaged at {item!r}; write it again")
+        types[name] = kind
+    return types
+
+
+def _check_csv_fields(path: Path) -> None:
+    """Refuses a CSV table with a data row of another number of fields than its column names,
+    or with an empty field (pandas fills a missing or empty field with NaN, which a table may
+    hold). A count of commas and line ends, and a search for an empty field, in blocks (0.2 s
+    for a million rows); only a damaged table is scanned row by row, to name the row."""
+    with path.open("rb") as f:
+        line = f.readline()
+        while line.startswith(b"#"):
+            line = f.readline()
+        columns = line.count(b",") + 1
+        commas = ends = 0
+        before = b"\n"
+        damaged = False
+        while chunk := f.read(1 << 22):
+            b = np.frombuffer(before + chunk, dtype=np.uint8)
+            comma, end = b == 44, b == 10
+            following = b[1:]
+            damaged = damaged or bool(
+                (comma[:-1] & (end[1:] | (following == 44) | (following == 13)) | end[:-1] & comma[1:]).any())
+            commas += int(np.count_nonzero(comma[1:]))
+            ends += int(np.count_nonzero(end[1:]))
+            before = chunk[-1:]
+    if damaged or commas != ends * (columns - 1):
+        _locate_csv_damage(path)
+
+
+def _locate_csv_damage(path: Path) -> None:
+    """Names the first data row of a CSV table with another number of fields than its column
+    names or an empty field, reading it in blocks of whole lines."""
+    with path.open("rb") as f:
+        line = f.readline()
+        while line.startswith(b"#"):
+            line = f.readline()
+        columns = line.count(b",") + 1
+        row = 0
+        rest = b""
+        while True:
+            chunk = f.read(1 << 22)
+            data = rest + chunk
+            cut = data.rfind(b"\n") + 1 if chunk else len(data)
+            block, rest = data[:cut], data[cut:]
+            if block:
+                b = np.frombuffer(block, dtype=np.uint8)
+                ends = np.flatnonzero(b == 10)
+                commas = np.cumsum(b == 44, dtype=np.int64)[ends]
+                per_row = np.diff(commas, prepend=0) + 1
+                bad = np.flatnonzero(per_row != columns)
+                if bad.size:
+                    r = row + int(bad[0])
+                    raise _DamagedTable(f"{path}: data row {r} has {per_row[bad[0]]} fields where the header "
+                                     f"names {columns}: the table was edited or damaged; write it again")
+                line_starts = np.concatenate(([0], ends[:-1] + 1))
+                comma = np.flatnonzero(b == 44)
+                following = b[np.minimum(comma + 1, b.size - 1)]
+                empty = np.concatenate((comma[np.isin(following, (44, 10, 13))],
+                                        line_starts[b[line_starts] == 44]))
+                if empty.size:
+                    r = row + int(np.searchsorted(ends, empty.min()))
+                    raise _DamagedTable(f"{path}: data row {r} has an empty field: the table was edited or damaged; "
+                                     "write it again")
+                row += ends.size
+            if not chunk:
+                break
+
+
+def _check_csv_numbers(path: Path, frame) -> None:
+    """Refuses a CSV table with a field that is not a number: every column rubber-atlas writes
+    is numeric (NaN and inf included)."""
+    import pandas as pd
+
+    for name in frame.columns:
+        if frame[name].dtype.kind not in "iuf":
+            values = pd.to_numeric(frame[name], errors="coerce")
+            row = int(np.flatnonzero(values.isna() & frame[name].notna())[0])
+            raise _DamagedTable(f"{path}: column {name!r}, data row {row}: {frame[name].iloc[row]!r} is not a "
+                             "number: the table was edited or damaged; write it again")
+
+
+def _typed_columns(path: Path, frame, types: dict):
+    """The index and flag columns back in their types (int32, uint8), as the HDF5 table has
+    them; a value that is not a whole number in range is refused."""
+    for name, kind in types.items():
+        if kind == "float64":
+            continue
+        values = frame[name].to_numpy(dtype=np.float64)
+        info = np.iinfo(kind)
+        bad = np.flatnonzero(~(np.isfinite(values) & (values == np.round(values)) & (values >= info.min)
+                               & (values <= info.max)))
+        if bad.size:
+            raise _DamagedTable(f"{path}: column {name!r}, data row {int(bad[0])}: {float(values[bad[0]])!r} is not "
+                             f"a whole number of {kind}: the table was edited or damaged; write it again")
+        frame[name] = values.astype(kind)
+    return frame
 
 
 def diagram(alpha: float, beta: float | None, nu: float | None = None, eta: float | None = None, *,
@@ -1889,7 +2018,7 @@ def boundaries(alpha: float, nu: float, eta: float, *, beta_min: float = 0.05, b
     Examples
     --------
     >>> import rubber_atlas as ra
-    >>> b = ra.boundaries(0.5, 0.5, 0.5, beta_min=0.5, beta_max=1.0, scan=4, resolution=8)
+    >>> b = ra.boundaries(0.5, 0.5, 0.5, beta_min=0.5, beta_max=1.0, scan=4, resolution=32)
     >>> [round(float(x), 3) for x in b.boundary_beta]
     [0.744]
     >>> names = ra.flag_names(b.holds_below)

@@ -422,3 +422,73 @@ def test_read_table_refuses_a_foreign_or_cut_short_csv(tmp_path):
     foreign = tmp_path / "foreign.csv"
     foreign.write_text("a,b\n1,2\n")
     refused(ValueError, lambda: ra.read_table(foreign), "not a rubber-atlas table")
+
+
+def test_read_table_refuses_edited_rows(tmp_path):
+    """Issue 22, third pass: a CSV whose data rows were edited (a field dropped, a field added,
+    a non-number) was read: pandas fills a missing field with NaN and keeps a word as text."""
+    whole = tmp_path / "t.csv"
+    run("trajectory", "--alpha", "0.5", "--beta", "3", "--nu", "0.5", "--eta", "0.5", "--kappa", "0.8",
+        "--energy", "2.5", "--t-end", "3", "--samples", "5", "--out", whole)
+    assert ra.read_table(whole).sizes["t"] == 6
+    lines = whole.read_text().splitlines(keepends=True)
+    last = len(lines) - 1
+
+    def edited(name, row):
+        path = tmp_path / name
+        path.write_text("".join(lines[:last - 2] + [row] + lines[last - 1:]))
+        return path
+
+    fields = lines[last - 2].rstrip("\n").split(",")
+    dropped = edited("dropped.csv", ",".join(fields[:-1]) + "\n")
+    refused(ValueError, lambda: ra.read_table(dropped), "data row 3", "9 fields", "10")
+    added = edited("added.csv", ",".join(fields + ["1"]) + "\n")
+    refused(ValueError, lambda: ra.read_table(added), "data row 3", "11 fields")
+    word = edited("word.csv", ",".join(fields[:4] + ["x"] + fields[5:]) + "\n")
+    refused(ValueError, lambda: ra.read_table(word), "column 'psi'", "data row 3", "'x'", "not a number")
+    # NaN and inf are numbers a table may hold.
+    nan = edited("nan.csv", ",".join(fields[:4] + ["NaN", "inf"] + fields[6:]) + "\n")
+    back = ra.read_table(nan)
+    assert np.isnan(back.psi[3]) and np.isinf(back.x_c[3])
+
+
+def test_read_table_refuses_edited_headers_and_typed_columns_and_reads_an_empty_table(tmp_path):
+    """Issue 22, adversary of the edited-rows fix: an empty table the program wrote raised
+    IndexError; an empty field, 1.5 in an index column, a renamed or swapped column name and
+    '# rows: many' were read (or refused with a formatting error). Since the '# columns' line,
+    index and flag columns come back as int32 and uint8, as from the HDF5 table."""
+    empty = tmp_path / "empty.csv"
+    run("resonance", "--alpha", "0.5", "--beta", "3", "--nu", "0.5", "--eta", "0.5", "--rotation-number", "7/1",
+        "--kappa-min", "0.001", "--kappa-max", "0.01", "--energy-max", "2", "--grid", "4", "--out", empty)
+    assert ra.read_table(empty).sizes["sample"] == 0
+    table = tmp_path / "d.csv"
+    run("diagram", "--alpha", "0.5", "--beta", "3", "--nu", "0.5", "--eta", "0.5", "--samples", "10", "--out", table)
+    h5 = tmp_path / "d.h5"
+    run("diagram", "--alpha", "0.5", "--beta", "3", "--nu", "0.5", "--eta", "0.5", "--samples", "10", "--out", h5)
+    back, reference = ra.read_table(table), ra.read_table(h5)
+    for name in reference.variables:
+        assert back[name].dtype == reference[name].dtype, name
+        np.testing.assert_array_equal(back[name], reference[name])
+    lines = table.read_text().splitlines(keepends=True)
+    header = next(i for i, line in enumerate(lines) if not line.startswith("#"))
+    names = lines[header].rstrip("\n").split(",")
+    row = lines[header + 2].rstrip("\n").split(",")
+
+    def edited(name, at, text):
+        path = tmp_path / name
+        path.write_text("".join(lines[:at] + [text] + lines[at + 1:]))
+        return path
+
+    blank = edited("blank.csv", header + 2, ",".join(row[:3] + [""] + row[4:]) + "\n")
+    refused(ValueError, lambda: ra.read_table(blank), "data row 1", "empty field")
+    index = row.copy()
+    index[names.index("branch")] = "1.5"
+    half = edited("half.csv", header + 2, ",".join(index) + "\n")
+    refused(ValueError, lambda: ra.read_table(half), "column 'branch'", "data row 1", "1.5 is not a whole number of uint8")
+    swapped = names.copy()
+    swapped[names.index("kappa")], swapped[names.index("energy")] = "energy", "kappa"
+    renamed = edited("swapped.csv", header, ",".join(swapped) + "\n")
+    refused(ValueError, lambda: ra.read_table(renamed), "column names", "'# columns' line")
+    rows_line = next(i for i, line in enumerate(lines) if line.startswith("# rows:"))
+    many = edited("many.csv", rows_line, "# rows: many\n")
+    refused(ValueError, lambda: ra.read_table(many), "'# rows' line is not a count", "'many'")

@@ -440,9 +440,9 @@ def test_rayon_num_threads_is_honoured_when_threads_is_absent(tmp_path):
 
 
 def test_boundaries_equal_the_command():
-    found = ra.boundaries(0.5, 0.5, 0.5, scan=6, resolution=16, beta_min=0.3, beta_max=3)
+    found = ra.boundaries(0.5, 0.5, 0.5, scan=6, resolution=32, beta_min=0.3, beta_max=3)
     expected = json.loads(run("verdict", "--alpha", "0.5", "--nu", "0.5", "--eta", "0.5", "--boundaries", "--scan", "6",
-                              "--resolution", "16", "--beta-min", "0.3", "--beta-max", "3", "--json"))
+                              "--resolution", "32", "--beta-min", "0.3", "--beta-max", "3", "--json"))
     assert json.loads(found.attrs["boundaries_json"]) == expected
     assert found.sizes["boundary"] == len(expected["boundaries"]) > 0
     np.testing.assert_array_equal(found.boundary_beta, [b["beta"] for b in expected["boundaries"]])

@@ -77,7 +77,7 @@ def test_map_boundaries_and_evidence(tmp_path):
     out = tmp_path / "hyp"
     p = subprocess.run([sys.executable, str(SCRIPT), "--out", str(out), "--alphas", "2", "--betas", "5",
                         "--beta-min", "0.3", "--beta-max", "30", "--others", "0.1,1", "--other-alphas", "1",
-                        "--other-betas", "4", "--resolution", "24"], capture_output=True, text=True, env={**os.environ, "RUBBER_ATLAS_BIN": BIN})
+                        "--other-betas", "4", "--resolution", "32"], capture_output=True, text=True, env={**os.environ, "RUBBER_ATLAS_BIN": BIN})
     assert p.returncode == 0, p.stderr
     rows = list(csv.DictReader(open(out.with_suffix(".csv"))))
     # α = 0 and 0.975, five β each plus the two sides of the case line.
@@ -93,5 +93,5 @@ def test_map_boundaries_and_evidence(tmp_path):
         d = json.loads(e["distance"])
         assert abs(d[1] / d[0] - 2.0) < 1e-5
     with h5py.File(out.with_suffix(".h5")) as f:
-        assert set(f) == {"map", "boundaries", "evidence"} and f.attrs["nu"] == 0.5 and f.attrs["resolution"] == 24
+        assert set(f) == {"map", "boundaries", "evidence"} and f.attrs["nu"] == 0.5 and f.attrs["resolution"] == 32
     assert out.with_suffix(".png").stat().st_size > 10_000

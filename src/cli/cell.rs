@@ -3,7 +3,7 @@
 use super::*;
 use anyhow::Result;
 use clap::Args;
-use rubber_atlas::cell::{solve_cell, solve_component, CellOptions, CellResult, Method, Status};
+use rubber_atlas::cell::{solve_cell, solve_start, CellOptions, CellResult, Method, Status};
 use rubber_atlas::torus::EffectivePotential;
 use rubber_atlas::{Body, Shape};
 
@@ -43,7 +43,9 @@ fn solve<S: Shape>(body: &Body<S>, args: &CellArgs, options: &CellOptions) -> Re
                 kappa: start.kappa,
                 energy,
                 status: Status::Ok,
-                components: vec![solve_component(&potential, energy, &component, options)?],
+                components: vec![solve_start(
+                    &potential, &start, energy, &component, options,
+                )?],
             }
         }
         (None, None) => unreachable!("clap requires --energy or --theta0"),

@@ -651,6 +651,70 @@ fn planar_trajectories_onto_a_face_are_refused() {
     assert!(EdgedShape::disk(100.0).is_ok() && EdgedShape::disk(100.5).is_err());
 }
 
+/// The symmetric disk upright at rest (θ0 = ±π/2, κ = 0) is its unstable equilibrium: the
+/// component that holds it is the separatrix's (T = ∞, N = 0, bounded), not a motion onto a
+/// face, and its trajectory stays at rest; a start beside it at rest lands on a face.
+#[test]
+fn the_upright_disk_at_rest_is_an_equilibrium() {
+    use rubber_atlas::cell::solve_start;
+    use rubber_atlas::trajectory::{Duration, Request, StartAt};
+    let body = Body::new(EdgedShape::disk(0.0).unwrap(), 0.5, 0.5).unwrap();
+    let potential = EffectivePotential::new(&body, 0.0);
+    let options = CellOptions::default();
+    let status = |theta0: f64| {
+        let start = Start {
+            kappa: 0.0,
+            theta0,
+            theta_dot0: 0.0,
+        };
+        let energy = start.energy(&body);
+        let component = start.component_in(&potential).unwrap();
+        solve_start(&potential, &start, energy, &component, &options).unwrap()
+    };
+    for theta0 in [FRAC_PI_2, -FRAC_PI_2, 3.0 * FRAC_PI_2] {
+        let c = status(theta0);
+        assert_eq!(c.status, Status::Separatrix, "{theta0}: {c:?}");
+        assert!(c.period.is_infinite() && c.rotation_number == 0.0);
+        assert_eq!(c.bounded, Some(true));
+        let request = Request {
+            kappa: 0.0,
+            start: StartAt::Angle {
+                theta0,
+                theta_dot0: 0.0,
+            },
+            duration: Duration::Until(10.0),
+            samples: 20,
+            model: Model::Reduced,
+            tol: 1e-10,
+            step_budget: None,
+        };
+        let (_, traj) = request.run(&body).unwrap();
+        assert!(
+            traj.theta.iter().all(|t| (t - theta0).abs() < 1e-9),
+            "{theta0}"
+        );
+    }
+    assert_eq!(status(1.5).status, Status::ReachesFace);
+    // Long enough for rounding to move it off (the full model's at t = 54): either it is
+    // still at rest or the trajectory says where it left, never a motion through the face.
+    let long = Request {
+        kappa: 0.0,
+        start: StartAt::Angle {
+            theta0: FRAC_PI_2,
+            theta_dot0: 0.0,
+        },
+        duration: Duration::Until(200.0),
+        samples: 400,
+        model: Model::Full,
+        tol: 1e-10,
+        step_budget: None,
+    };
+    match long.run(&body) {
+        Ok((_, traj)) => assert!(traj.theta.iter().all(|t| (t - FRAC_PI_2).abs() <= 1e-3)),
+        Err(e) => assert!(e.to_string().contains("unstable equilibrium"), "{e}"),
+    }
+}
+
 /// A truncated ball on its N = 0 resonance curve (`resonance --shape truncated_ball`): its
 /// path runs away, and the full equations, which know the ball only through its contact point
 /// on the sphere and on the cut's edge, carry the centre of mass n·|Δζ| away after n periods.

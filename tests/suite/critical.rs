@@ -350,3 +350,54 @@ fn the_spheres_equator_is_stable_at_every_kappa() {
     assert!(equator[0].stable);
     assert!(equator[0].points.iter().all(|p| p.stable));
 }
+
+/// Near the sphere (β = 1, |α| tiny) κ climbs from 0.036 to ∞ within 8e-4 of θ0 = π/2, inside
+/// one step of the θ0 grid: the branch by π/2 still reaches κ_max, each of its points on the
+/// curve (V′ = 0) and none beyond κ_max.
+#[test]
+fn the_branch_by_the_equator_reaches_kappa_max_near_the_sphere() {
+    let highest = |set: &CriticalSet| {
+        set.branches
+            .iter()
+            .flat_map(|branch| &branch.points)
+            .map(|p| p.kappa)
+            .fold(0.0, f64::max)
+    };
+    for alpha in [1e-6, -1e-6, 1e-3] {
+        let b = EllipsoidBody::ellipsoid(alpha, 1.0, 0.5, 0.5).unwrap();
+        let set = CriticalSet::of(&b, 2000, 3.0).unwrap();
+        let top = highest(&set);
+        // (By π/2 one ulp of θ0 moves κ by 1e-9 of itself.)
+        assert!(top <= 3.0 && top > 3.0 * (1.0 - 1e-8), "{alpha}: {top}");
+        let off_the_poles = |p: &&rubber_atlas::critical::FixedPoint| p.theta0.sin() > 1e-12;
+        for p in set
+            .branches
+            .iter()
+            .flat_map(|branch| &branch.points)
+            .filter(off_the_poles)
+        {
+            let sys = ReducedSystem::new(&b, p.kappa);
+            let slope = sys.effective_potential_prime(p.theta0);
+            let scale = 1.0 + p.kappa * p.kappa / p.theta0.sin().powi(3).max(1e-300);
+            assert!(slope.abs() < 1e-9 * scale, "{alpha} {p:?}: V′ = {slope}");
+        }
+        // Before: the grid's sample nearest π/2 ended the branch at κ = 0.036 (α = 1e-6).
+        let near_equator = set
+            .branches
+            .iter()
+            .flat_map(|branch| &branch.points)
+            .filter(|p| p.kappa > 1.0)
+            .count();
+        assert!(near_equator >= 100, "{alpha}: {near_equator}");
+    }
+    // Where the last double before π/2 is below κ_max the branch goes that far (it stopped
+    // at 0.036 with κ_max = 1e5; at α = 1e-15 and κ_max = 3 at 1.1e-6).
+    for (alpha, kappa_max, reach) in [(1e-6, 1e5, 5e4), (1e-15, 3.0, 1.5)] {
+        let b = EllipsoidBody::ellipsoid(alpha, 1.0, 0.5, 0.5).unwrap();
+        let top = highest(&CriticalSet::of(&b, 2000, kappa_max).unwrap());
+        assert!(
+            top <= kappa_max && top > reach,
+            "{alpha} {kappa_max}: {top}"
+        );
+    }
+}

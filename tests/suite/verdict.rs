@@ -153,6 +153,52 @@ fn boundaries_stay_put_when_the_resolution_doubles() {
     );
 }
 
+/// The N = −1 boundaries at α = 0.5 and 0.9 lie where N's smallest value over the region
+/// (found on its edge κ = κ_max, case 2) crosses −1. The margin followed the grid there:
+/// its root moved by 9e-4 in β from resolution 16 to 64 (α = 0.5) and by 1.3e-3 from 64 to
+/// 128 (α = 0.9), with bars of 5e-8 and 4e-4. N's extremes are now refined to convergence, the
+/// boundary is the same at every resolution, the bar holds the move from half the resolution,
+/// and a resolution below 32 is refused.
+#[test]
+fn a_boundary_is_the_same_at_every_resolution_and_its_bar_covers_the_move() {
+    let at = |alpha: f64, (beta_min, beta_max): (f64, f64), resolution: usize| {
+        let options = BoundaryOptions {
+            beta_min,
+            beta_max,
+            scan: 4,
+            verdict: VerdictOptions {
+                resolution,
+                ..VerdictOptions::default()
+            },
+        };
+        boundaries(alpha, 0.5, 0.5, &options).map(|b| {
+            assert_eq!(b.boundaries.len(), 1, "{b:#?}");
+            b.boundaries[0].clone()
+        })
+    };
+    let refused = at(0.5, (15.0, 25.0), 16).unwrap_err().to_string();
+    assert!(
+        refused.contains("resolution") && refused.contains(">= 32"),
+        "{refused}"
+    );
+    for (alpha, window, expected) in [
+        (0.5, (15.0, 25.0), 19.793014),
+        (0.9, (10.5, 12.5), 11.422716),
+    ] {
+        let found = [32, 64, 128].map(|r| at(alpha, window, r).unwrap());
+        let finest = &found[2];
+        assert!(finest.quantity.contains("N reaches -1"), "{finest:?}");
+        assert!((finest.beta - expected).abs() < 1e-6, "{finest:?}");
+        for b in &found {
+            assert!(
+                (b.beta - finest.beta).abs() <= 1e-9 * expected,
+                "{b:?} vs {finest:?}"
+            );
+            assert!(b.error >= 1e-12 && b.error < 2e-3, "{b:?}");
+        }
+    }
+}
+
 #[test]
 fn the_half_resolution_shortcut_never_changes_a_verdict() {
     // `verdict` searches half the resolution first and stops at a confirmed counterexample.
