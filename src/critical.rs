@@ -261,7 +261,26 @@ impl CriticalSet {
         let (alpha, beta) = (body.shape.alpha, body.shape.beta);
         if alpha < 0.0 {
             let image = EllipsoidBody::ellipsoid(-alpha, beta, body.nu, body.eta)?;
-            return Ok(Self::of_until(&image, samples, kappa_max, stop)?.mirrored());
+            let mut set = Self::of_until(&image, samples, kappa_max, stop)?.mirrored();
+            // θ → π − θ rounds θ0 by up to an ulp; by π/2, where κ² ∝ 1/cosθ0, that put κ
+            // off the curve at the rounded θ0 (by 1e-3 at α = −1e-12): there each point is
+            // evaluated again on this body, at its own θ0.
+            for branch in set.branches.iter_mut().filter(|b| b.name != "sigma_pi2") {
+                let points = std::mem::take(&mut branch.points)
+                    .into_iter()
+                    .map(|p| match p.theta0.cos().abs() < 1e-3 {
+                        true => FixedPoint {
+                            stable: p.stable,
+                            ..fixed_point(body, p.theta0)
+                        },
+                        false => p,
+                    })
+                    .filter(|p| p.kappa <= kappa_max)
+                    .collect();
+                *branch = make_branch(points, branch.name);
+            }
+            set.branches.retain(|b| !b.points.is_empty());
+            return Ok(set);
         }
         check_kappa_max(kappa_max)?;
         crate::error::check_samples(samples)?;
@@ -375,7 +394,13 @@ fn sample_branches<S: Shape>(
         let mut pts: Vec<FixedPoint> = Vec::with_capacity(samples + 1);
         // Interior samples; a pole is added only where a branch ends at it (U″ > 0 there,
         // i.e. κ² ≥ 0 on its neighbourhood), never as a lone point.
-        let mut previous: Option<(f64, f64)> = None;
+        // A branch that ends at a pole (κ = 0 there) climbs from it: with a tiny κ_max the
+        // first sample can already lie beyond.
+        // (κ² = 0 at a pole: where the curve nears it from κ² < 0 there is no climb, and the
+        // pole itself is a point of the branch only where V″ > 0 there.)
+        let pole = if lo == 0.0 { 0.0 } else { PI };
+        let pole_probe = Some((pole, (curve.kappa_sq)(pole)));
+        let mut previous: Option<(f64, f64)> = if lo == 0.0 { pole_probe } else { None };
         for i in 1..=samples {
             stopped(i)?;
             // The last probe is the end at π/2 (on this half's side of it), where κ → ∞
@@ -399,6 +424,9 @@ fn sample_branches<S: Shape>(
             }
         }
         if lo != 0.0 {
+            if let (Some(a), Some(b)) = (previous, pole_probe) {
+                pts.extend(climb_to_kappa_max(curve, a, b, kappa_max, samples));
+            }
             // The upper half's first probe is the end at π/2 on its side.
             let t = FRAC_PI_2.next_up();
             let (k2, first) = ((curve.kappa_sq)(t), lo + (hi - lo) / samples as f64);
@@ -411,7 +439,6 @@ fn sample_branches<S: Shape>(
                 samples,
             ));
         }
-        let pole = if lo == 0.0 { 0.0 } else { PI };
         if (curve.pole_ends)(pole) && !pts.is_empty() {
             pts.push((curve.point)(pole));
         }

@@ -153,10 +153,23 @@ pub(super) fn print_diagram(set: &CriticalSet) {
         );
     }
     if set.diagram_type == Some(rubber_atlas::critical::DiagramType::C) && cusps.is_empty() {
-        println!(
-            "  cusp not resolved: sigma_u lies within the sampling (or the spacing of doubles) \
-             of theta = pi/2 at this alpha"
-        );
+        // σ_u climbing to κ_max without meeting σ_s0: the cusp lies above κ_max.
+        let above = set
+            .branches
+            .iter()
+            .any(|b| !b.stable && b.kappa_range[1] >= set.kappa_max * (1.0 - 1e-6));
+        if above {
+            println!(
+                "  cusp above kappa_max = {}: sigma_u reaches it without meeting sigma_s0",
+                digits(set.kappa_max, 12)
+            );
+        } else {
+            println!(
+                "  cusp not resolved below kappa_max = {}: it lies above, or sigma_u lies \
+                 within the sampling (or the spacing of doubles) of theta = pi/2 at this alpha",
+                digits(set.kappa_max, 12)
+            );
+        }
     }
     for c in &set.stability_changes_at_kinks {
         println!(

@@ -363,12 +363,13 @@ fn the_branch_by_the_equator_reaches_kappa_max_near_the_sphere() {
             .map(|p| p.kappa)
             .fold(0.0, f64::max)
     };
-    for alpha in [1e-6, -1e-6, 1e-3] {
+    for alpha in [1e-6, -1e-6, 1e-3, -1e-12] {
         let b = EllipsoidBody::ellipsoid(alpha, 1.0, 0.5, 0.5).unwrap();
         let set = CriticalSet::of(&b, 2000, 3.0).unwrap();
         let top = highest(&set);
-        // (By π/2 one ulp of θ0 moves κ by 1e-9 of itself.)
-        assert!(top <= 3.0 && top > 3.0 * (1.0 - 1e-8), "{alpha}: {top}");
+        // (By π/2 one ulp of θ0 moves κ by 1e-9 of itself; by 1e-3 at |α| = 1e-12.)
+        let reach = if alpha.abs() < 1e-9 { 1e-2 } else { 1e-8 };
+        assert!(top <= 3.0 && top > 3.0 * (1.0 - reach), "{alpha}: {top}");
         let off_the_poles = |p: &&rubber_atlas::critical::FixedPoint| p.theta0.sin() > 1e-12;
         for p in set
             .branches
@@ -399,5 +400,24 @@ fn the_branch_by_the_equator_reaches_kappa_max_near_the_sphere() {
             top <= kappa_max && top > reach,
             "{alpha} {kappa_max}: {top}"
         );
+    }
+}
+
+/// With a κ_max below the first sample's κ, the branches that start at κ = 0 at a pole still
+/// climb from it to κ_max (σ_s0 and σ_spi were missing at κ_max = 1e-6, the disk had none).
+#[test]
+fn a_tiny_kappa_max_keeps_the_branches_from_the_poles() {
+    use rubber_atlas::body::{Body, EdgedShape};
+    let b = EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 0.5).unwrap();
+    let set = CriticalSet::of(&b, 2000, 1e-6).unwrap();
+    let disk = Body::new(EdgedShape::disk(0.3).unwrap(), 0.5, 0.5).unwrap();
+    let disk_set = CriticalSet::of_edged(&disk, 2000, 1e-6, &|| false).unwrap();
+    for set in [&set, &disk_set] {
+        for name in ["sigma_s0", "sigma_spi"] {
+            let branch = set.branches.iter().find(|b| b.name == name).unwrap();
+            assert!(branch.points.len() > 10, "{name}: {branch:?}");
+            let top = branch.points.iter().map(|p| p.kappa).fold(0.0, f64::max);
+            assert!(top <= 1e-6 && top > 0.999e-6, "{name}: {top}");
+        }
     }
 }
