@@ -728,10 +728,7 @@ fn level_offset_error<S: Shape>(
     // The step stays well inside the family: below a quarter of the depth and of the
     // distance to every saddle at or next to the component.
     let saddles = component
-        .interior
-        .iter()
-        .chain(component.neighbours.iter().flatten())
-        .filter(|p| p.kind != CriticalKind::Minimum)
+        .saddles()
         .map(|p| (energy - p.value).abs())
         .fold(f64::INFINITY, f64::min);
     // Away from a pole X(ε) is analytic on the scale of the depth, the end's reach and the
@@ -1040,12 +1037,7 @@ fn drift_radius(drift: f64, drift_error: f64, n: f64, n_error: f64) -> (f64, f64
 /// A level a few ulps off is integrated like any other: its orbit is real, and the saddle's
 /// conditioning (ulp(V_s)/(λ |ε − V_s|) per passage) says how little its values are worth.
 pub(crate) fn separatrix(component: &Component, energy: f64) -> Option<CriticalPoint> {
-    component
-        .interior
-        .iter()
-        .chain(component.neighbours.iter().flatten())
-        .find(|p| p.kind != CriticalKind::Minimum && energy == p.value)
-        .copied()
+    component.saddles().find(|p| energy == p.value).copied()
 }
 
 /// Whether a maximum inside the component or at one of its ends lies within 4 ulps (of its
@@ -1053,13 +1045,8 @@ pub(crate) fn separatrix(component: &Component, energy: f64) -> Option<CriticalP
 /// saddle's conditioning), too poor to trace a curve by.
 pub fn within_rounding_of_separatrix(component: &Component, energy: f64) -> bool {
     component
-        .interior
-        .iter()
-        .chain(component.neighbours.iter().flatten())
-        .any(|p| {
-            p.kind != CriticalKind::Minimum
-                && (energy - p.value).abs() <= 4.0 * f64::EPSILON * p.scale
-        })
+        .saddles()
+        .any(|p| (energy - p.value).abs() <= 4.0 * f64::EPSILON * p.scale)
 }
 
 fn on_separatrix<S: Shape>(

@@ -394,27 +394,39 @@ fn sample_branches<S: Shape>(
         let mut pts: Vec<FixedPoint> = Vec::with_capacity(samples + 1);
         // Interior samples; a pole is added only where a branch ends at it (U″ > 0 there,
         // i.e. κ² ≥ 0 on its neighbourhood), never as a lone point.
-        // A branch that ends at a pole (κ = 0 there) climbs from it: with a tiny κ_max the
-        // first sample can already lie beyond.
-        // (κ² = 0 at a pole: where the curve nears it from κ² < 0 there is no climb, and the
-        // pole itself is a point of the branch only where V″ > 0 there.)
+        // The probes of the curve run from one end of the half to the other: its pole (κ² = 0:
+        // a branch that ends there climbs from it, where a tiny κ_max lies below the first
+        // sample; where the curve nears it from κ² < 0 there is no climb), the samples, and
+        // the last double on this half's side of π/2, where κ → ∞ unless U′(π/2) = 0. The
+        // ends only bracket a climb ([`climb_to_kappa_max`]); a sample is a point itself.
         let pole = if lo == 0.0 { 0.0 } else { PI };
-        let pole_probe = Some((pole, (curve.kappa_sq)(pole)));
-        let mut previous: Option<(f64, f64)> = if lo == 0.0 { pole_probe } else { None };
+        let equator = if lo == 0.0 {
+            FRAC_PI_2
+        } else {
+            FRAC_PI_2.next_up()
+        };
+        let (first, last) = if lo == 0.0 {
+            (pole, equator)
+        } else {
+            (equator, pole)
+        };
+        let mut previous = (first, (curve.kappa_sq)(first));
         for i in 1..=samples {
             stopped(i)?;
-            // The last probe is the end at π/2 (on this half's side of it), where κ → ∞
-            // unless U′(π/2) = 0: it only brackets a climb to κ_max.
-            let t = match (i, lo) {
-                (i, _) if i < samples => lo + (hi - lo) * i as f64 / samples as f64,
-                (_, 0.0) => FRAC_PI_2,
-                _ => break,
+            let t = if i < samples {
+                lo + (hi - lo) * i as f64 / samples as f64
+            } else {
+                last
             };
             let k2 = (curve.kappa_sq)(t);
-            if let Some(a) = previous {
-                pts.extend(climb_to_kappa_max(curve, a, (t, k2), kappa_max, samples));
-            }
-            previous = Some((t, k2));
+            pts.extend(climb_to_kappa_max(
+                curve,
+                previous,
+                (t, k2),
+                kappa_max,
+                samples,
+            ));
+            previous = (t, k2);
             if i == samples || k2 < 0.0 {
                 continue;
             }
@@ -422,22 +434,6 @@ fn sample_branches<S: Shape>(
             if p.kappa <= kappa_max {
                 pts.push(p);
             }
-        }
-        if lo != 0.0 {
-            if let (Some(a), Some(b)) = (previous, pole_probe) {
-                pts.extend(climb_to_kappa_max(curve, a, b, kappa_max, samples));
-            }
-            // The upper half's first probe is the end at π/2 on its side.
-            let t = FRAC_PI_2.next_up();
-            let (k2, first) = ((curve.kappa_sq)(t), lo + (hi - lo) / samples as f64);
-            let k1 = (curve.kappa_sq)(first);
-            pts.extend(climb_to_kappa_max(
-                curve,
-                (t, k2),
-                (first, k1),
-                kappa_max,
-                samples,
-            ));
         }
         if (curve.pole_ends)(pole) && !pts.is_empty() {
             pts.push((curve.point)(pole));

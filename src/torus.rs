@@ -189,6 +189,15 @@ impl Component {
         self.upper.theta
     }
 
+    /// The maxima and inflections of V inside the component or at its ends (the saddles its
+    /// level may sit on), in order.
+    pub fn saddles(&self) -> impl Iterator<Item = &CriticalPoint> {
+        self.interior
+            .iter()
+            .chain(self.neighbours.iter().flatten())
+            .filter(|p| p.kind != CriticalKind::Minimum)
+    }
+
     /// The lowest critical point inside (the centre of a libration).
     pub fn minimum(&self) -> Option<&CriticalPoint> {
         self.interior

@@ -158,17 +158,11 @@ impl Start {
         if self.kappa != 0.0 || self.theta_dot0 != 0.0 {
             return None;
         }
-        let tau = std::f64::consts::TAU;
-        let near = |p: &&CriticalPoint| {
-            let apart = (self.circle_angle() - p.site.theta).rem_euclid(tau);
-            apart.min(tau - apart) <= 1e-7
-        };
         component
-            .interior
-            .iter()
-            .chain(component.neighbours.iter().flatten())
-            .filter(|p| p.kind != crate::torus::CriticalKind::Minimum && energy == p.value)
-            .find(near)
+            .saddles()
+            .find(|p| {
+                energy == p.value && circle_distance(self.circle_angle(), p.site.theta) <= 1e-7
+            })
             .copied()
     }
 
@@ -376,18 +370,20 @@ impl Request {
     }
 }
 
+/// How far apart two angles lie on the circle, in [0, π].
+fn circle_distance(a: f64, b: f64) -> f64 {
+    let tau = std::f64::consts::TAU;
+    let d = (a - b).rem_euclid(tau);
+    d.min(tau - d)
+}
+
 /// A start at rest on an unstable equilibrium whose level reaches a face stays at rest; the
 /// integrator's rounding grows like e^(λt) and, once θ is 1e-3 off, the body follows the
 /// separatrix onto the face within a few 1/λ, where the motion ends: refused from there.
 /// (θ on the circle, and up to its sign: the full model's θ is the axis's angle in [0, π].)
 fn check_still_at_rest(start: &Start, traj: &Trajectory) -> Result<()> {
-    let tau = std::f64::consts::TAU;
-    let apart = |a: f64, b: f64| {
-        let d = (a - b).rem_euclid(tau);
-        d.min(tau - d)
-    };
     let Some(i) = traj.theta.iter().position(|&t| {
-        let off = apart(t, start.theta0).min(apart(t, -start.theta0));
+        let off = circle_distance(t, start.theta0).min(circle_distance(t, -start.theta0));
         off.is_nan() || off > 1e-3
     }) else {
         return Ok(());

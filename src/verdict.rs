@@ -880,10 +880,9 @@ pub fn verdict_until(
     Ok(verdict)
 }
 
-/// The largest `sign` · `value` over the samples that pass `eligible`, refined by golden
-/// section round the best of them: along ε between the neighbouring samples of its family,
-/// then along κ between the neighbouring lines, then along ε again, so that it follows the
-/// lobe's true peak rather than the grid. `value(N, κ, ε)`; None without an eligible sample.
+/// The largest `sign` · `value` over the samples that pass `eligible`, refined round the best
+/// of them by golden sections until it stops growing (below), so that it follows the true
+/// extremum rather than the grid. `value(N, κ, ε)`; None without an eligible sample.
 fn refined_extreme(
     sampler: &Sampler<'_>,
     lines: &[Vec<Sample>],
@@ -927,30 +926,19 @@ fn refined_extreme(
         let (x, v) = golden_max(|u| f(u.exp()), a.ln(), b.ln(), 1e-7);
         (x.exp(), v)
     };
-    // The neighbouring lines (a line within rounding of this one, or with no samples, is
-    // passed over: the linear and the log-spaced lines can nearly coincide).
-    let kappa_of = |l: &Vec<Sample>| l.first().map(|t| t.kappa);
-    let kprev = lines[..j]
-        .iter()
-        .rev()
-        .filter_map(kappa_of)
-        .find(|&k| k < s.kappa * (1.0 - 1e-9))
-        .unwrap_or(s.kappa);
-    let knext = lines[j + 1..]
-        .iter()
-        .filter_map(kappa_of)
-        .find(|&k| k > s.kappa * (1.0 + 1e-9))
-        .unwrap_or(s.kappa);
-    let (mut k_lo, mut k_hi) = (kprev.min(knext).min(s.kappa), kprev.max(knext).max(s.kappa));
-    // The next line beyond a κ, downwards or upwards, if any.
+    // The next line beyond a κ, downwards or upwards, if any (a line within rounding of it,
+    // or with no samples, is passed over: the linear and the log-spaced lines can nearly
+    // coincide).
     let line_beyond = |k: f64, up: bool| -> Option<f64> {
-        let mut ks = lines.iter().filter_map(kappa_of);
+        let mut ks = lines.iter().filter_map(|l| l.first().map(|t| t.kappa));
         if up {
             ks.find(|&q| q > k * (1.0 + 1e-9))
         } else {
             ks.rev().find(|&q| q < k * (1.0 - 1e-9))
         }
     };
+    let mut k_lo = line_beyond(s.kappa, false).unwrap_or(s.kappa);
+    let mut k_hi = line_beyond(s.kappa, true).unwrap_or(s.kappa);
     let (mut e_lo, mut e_hi) = (prev.min(next).min(s.energy), prev.max(next).max(s.energy));
     // The family's next sample on the best line beyond an ε, downwards or upwards, if any.
     let energy_beyond = |e: f64, up: bool| -> Option<f64> {
@@ -962,10 +950,23 @@ fn refined_extreme(
         }
     };
     // Coordinate search to convergence inside the box of the neighbouring samples and lines:
-    // along log ε at fixed λ = κ/√ε, along log κ at fixed ε, along log ε at fixed κ. Far out N is chiefly a
-    // function of λ, so the two directions are nearly independent; three line searches in κ
-    // and ε alone stopped short in the valley along λ (at α = 0.9 the N = −1 boundary still
-    // moved by 1.3e-3 in β from resolution 64 to 128).
+    // along log ε at fixed λ = κ/√ε, along log κ at fixed ε, along log ε at fixed κ. Far out
+    // N is chiefly a function of λ, so the first two are nearly independent; line searches
+    // in κ and ε alone stopped short in the valley along λ (at α = 0.9 the N = −1 boundary
+    // still moved by 1.3e-3 in β from resolution 64 to 128).
+    // Moves the box's edge that `x` sits on (within the golden sections' 1e-7) to the next
+    // sample `beyond` it; false where there is none or `x` is inside.
+    let grow =
+        |x: f64, (lo, hi): (&mut f64, &mut f64), beyond: &dyn Fn(f64, bool) -> Option<f64>| {
+            let (edge, up) = if x <= *lo * (1.0 + 1e-6) {
+                (lo, false)
+            } else if x >= *hi * (1.0 - 1e-6) {
+                (hi, true)
+            } else {
+                return false;
+            };
+            beyond(*edge, up).map(|b| *edge = b).is_some()
+        };
     let (mut kappa, mut energy) = (s.kappa, s.energy);
     for _ in 0..64 {
         let before = best;
@@ -993,21 +994,9 @@ fn refined_extreme(
             // An extreme on the box's κ edge lies beyond it, or on the region's edge (the
             // first line, κ_max in case 2): the box grows by a line and the search goes on.
             // Likewise on the box's ε edge, by the family's next sample on the best line.
-            let grown_kappa = if kappa <= k_lo * (1.0 + 1e-6) {
-                line_beyond(k_lo, false).map(|k| k_lo = k)
-            } else if kappa >= k_hi * (1.0 - 1e-6) {
-                line_beyond(k_hi, true).map(|k| k_hi = k)
-            } else {
-                None
-            };
-            let grown_energy = if energy <= e_lo * (1.0 + 1e-6) {
-                energy_beyond(e_lo, false).map(|e| e_lo = e)
-            } else if energy >= e_hi * (1.0 - 1e-6) {
-                energy_beyond(e_hi, true).map(|e| e_hi = e)
-            } else {
-                None
-            };
-            if grown_kappa.is_none() && grown_energy.is_none() {
+            let grown_kappa = grow(kappa, (&mut k_lo, &mut k_hi), &line_beyond);
+            let grown_energy = grow(energy, (&mut e_lo, &mut e_hi), &energy_beyond);
+            if !(grown_kappa || grown_energy) {
                 break;
             }
         }

@@ -1414,16 +1414,16 @@ def _read_csv(path: Path) -> xr.Dataset:
     rows = attrs.pop("rows", None)
     if rows is not None and not (isinstance(rows, float) and rows >= 0 and rows == int(rows)):
         raise _DamagedTable(f"{path}: the table's '# rows' line is not a count ({rows!r}): the table was edited "
-                         "or damaged; write it again")
+                            "or damaged; write it again")
     types = _csv_types(path, attrs.pop("columns", None))
     _check_csv_fields(path)
     frame = pd.read_csv(path, comment="#", low_memory=False)
     if rows is not None and len(frame) != rows:
         raise _DamagedTable(f"{path}: the table is cut short or damaged: {len(frame)} rows where its header "
-                         f"says {rows:.0f}; write it again")
+                            f"says {rows:.0f}; write it again")
     if types is not None and list(frame.columns) != list(types):
         raise _DamagedTable(f"{path}: the column names {','.join(map(str, frame.columns))} differ from the table's "
-                         f"'# columns' line ({','.join(types)}): the table was edited or damaged; write it again")
+                            f"'# columns' line ({','.join(types)}): the table was edited or damaged; write it again")
     if len(frame) == 0:
         frame = frame.astype(np.float64)
     _check_csv_numbers(path, frame)
@@ -1452,16 +1452,22 @@ def _csv_types(path: Path, line) -> dict | None:
     return types
 
 
+def _csv_columns(f) -> int:
+    """Reads a CSV table's file `f` past its ``# …`` lines and its column names; returns how
+    many columns these name."""
+    line = f.readline()
+    while line.startswith(b"#"):
+        line = f.readline()
+    return line.count(b",") + 1
+
+
 def _check_csv_fields(path: Path) -> None:
     """Refuses a CSV table with a data row of another number of fields than its column names,
     or with an empty field (pandas fills a missing or empty field with NaN, which a table may
     hold). A count of commas and line ends, and a search for an empty field, in blocks (0.2 s
     for a million rows); only a damaged table is scanned row by row, to name the row."""
     with path.open("rb") as f:
-        line = f.readline()
-        while line.startswith(b"#"):
-            line = f.readline()
-        columns = line.count(b",") + 1
+        columns = _csv_columns(f)
         commas = ends = 0
         before = b"\n"
         damaged = False
@@ -1482,10 +1488,7 @@ def _locate_csv_damage(path: Path) -> None:
     """Names the first data row of a CSV table with another number of fields than its column
     names or an empty field, reading it in blocks of whole lines."""
     with path.open("rb") as f:
-        line = f.readline()
-        while line.startswith(b"#"):
-            line = f.readline()
-        columns = line.count(b",") + 1
+        columns = _csv_columns(f)
         row = 0
         rest = b""
         while True:
@@ -1502,7 +1505,7 @@ def _locate_csv_damage(path: Path) -> None:
                 if bad.size:
                     r = row + int(bad[0])
                     raise _DamagedTable(f"{path}: data row {r} has {per_row[bad[0]]} fields where the header "
-                                     f"names {columns}: the table was edited or damaged; write it again")
+                                        f"names {columns}: the table was edited or damaged; write it again")
                 line_starts = np.concatenate(([0], ends[:-1] + 1))
                 comma = np.flatnonzero(b == 44)
                 following = b[np.minimum(comma + 1, b.size - 1)]
@@ -1511,7 +1514,7 @@ def _locate_csv_damage(path: Path) -> None:
                 if empty.size:
                     r = row + int(np.searchsorted(ends, empty.min()))
                     raise _DamagedTable(f"{path}: data row {r} has an empty field: the table was edited or damaged; "
-                                     "write it again")
+                                        "write it again")
                 row += ends.size
             if not chunk:
                 break
@@ -1527,7 +1530,7 @@ def _check_csv_numbers(path: Path, frame) -> None:
             values = pd.to_numeric(frame[name], errors="coerce")
             row = int(np.flatnonzero(values.isna() & frame[name].notna())[0])
             raise _DamagedTable(f"{path}: column {name!r}, data row {row}: {frame[name].iloc[row]!r} is not a "
-                             "number: the table was edited or damaged; write it again")
+                                "number: the table was edited or damaged; write it again")
 
 
 def _typed_columns(path: Path, frame, types: dict):
@@ -1542,7 +1545,7 @@ def _typed_columns(path: Path, frame, types: dict):
                                & (values <= info.max)))
         if bad.size:
             raise _DamagedTable(f"{path}: column {name!r}, data row {int(bad[0])}: {float(values[bad[0]])!r} is not "
-                             f"a whole number of {kind}: the table was edited or damaged; write it again")
+                                f"a whole number of {kind}: the table was edited or damaged; write it again")
         frame[name] = values.astype(kind)
     return frame
 

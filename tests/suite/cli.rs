@@ -1005,18 +1005,15 @@ fn an_unresolved_cusp_is_said() {
         "{text}"
     );
     // A cusp above κ_max is said as such (it was "not resolved ... within the sampling").
-    let o = Command::new(env!("CARGO_BIN_EXE_rubber-atlas"))
-        .args([
-            "diagram",
-            "--alpha",
-            "0.5",
-            "--beta",
-            "3",
-            "--kappa-max",
-            "0.1",
-        ])
-        .output()
-        .unwrap();
+    let o = run(&[
+        "diagram",
+        "--alpha",
+        "0.5",
+        "--beta",
+        "3",
+        "--kappa-max",
+        "0.1",
+    ]);
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(text.contains("cusp above kappa_max = 0.1"), "{text}");
     let o = Command::new(env!("CARGO_BIN_EXE_rubber-atlas"))
