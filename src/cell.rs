@@ -382,7 +382,7 @@ pub fn solve_start<S: Shape>(
     component: &Component,
     options: &CellOptions,
 ) -> Result<ComponentResult> {
-    match start.rest_on_saddle(component, energy) {
+    match start.rest_on_saddle(potential, component, energy) {
         Some(saddle) if reaches_face(potential, component) => {
             Ok(on_separatrix(potential, component, &saddle, options))
         }

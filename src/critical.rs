@@ -122,7 +122,8 @@ pub struct Branch {
 /// An equilibrium κ = 0.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Equilibrium {
-    /// `sigma_0` (resting on the vertex θ = 0), `sigma_pi` (θ = π), `theta_star` (inclined).
+    /// `sigma_0` (resting on the vertex θ = 0), `sigma_pi` (θ = π), `theta_star` (inclined);
+    /// for edged bodies also `face_0`, `face_pi`, `inclined` and `neutral_arc`.
     pub name: &'static str,
     /// Inclination θ of the axis.
     pub theta: f64,
@@ -132,6 +133,10 @@ pub struct Equilibrium {
     pub stable: bool,
     /// No branch of permanent rotations ends at this point of the (κ, ε) plane.
     pub isolated: bool,
+    /// The far end of a `neutral_arc`: U′ vanishes on all of [θ, θ_end] (a ball whose centre
+    /// of mass is its centre, rolling on its sphere), every inclination there an equilibrium.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub theta_end: Option<f64>,
 }
 
 /// The cusp of type (c): the saddle-node where σ_s0 and σ_u meet (V′ = V″ = 0, `eq2`).
@@ -297,6 +302,7 @@ impl CriticalSet {
                 energy: u(0.0),
                 stable: upp(0.0) > 0.0,
                 isolated: upp(0.0) < 0.0,
+                theta_end: None,
             },
             Equilibrium {
                 name: "sigma_pi",
@@ -304,6 +310,7 @@ impl CriticalSet {
                 energy: u(PI),
                 stable: upp(PI) > 0.0,
                 isolated: upp(PI) < 0.0,
+                theta_end: None,
             },
         ];
         if let Some(ts) = theta_star {
@@ -314,6 +321,7 @@ impl CriticalSet {
                 stable: upp(ts) > 0.0,
                 // The branch σ_u (type c) or σ_sπ (type a) ends at κ = 0 on θ*.
                 isolated: false,
+                theta_end: None,
             });
         }
 
@@ -551,8 +559,9 @@ fn equator_branches(
             stable,
             rho_c: f64::INFINITY,
             rho_p: f64::INFINITY,
-            // ψ̇ = 0 on the equator: the librations about it do not precess.
-            rotation_number: stable.then_some(0.0),
+            // ψ̇ = 0 on the equator: the librations about it do not precess. At κ_c, where
+            // one segment ends and the next begins, both rows carry the stable side's 0.
+            rotation_number: (stable || force.is_some()).then_some(0.0),
         });
     };
     for i in 0..=samples {
@@ -627,7 +636,8 @@ impl CriticalSet {
             .into_iter()
             .map(|e| Equilibrium {
                 name: mirror_name(e.name),
-                theta: PI - e.theta,
+                theta: PI - e.theta_end.unwrap_or(e.theta),
+                theta_end: e.theta_end.map(|_| PI - e.theta),
                 ..e
             })
             .collect();
@@ -738,7 +748,8 @@ pub fn general_fixed_point<S: Shape>(body: &Body<S>, theta0: f64) -> FixedPoint 
 /// The equilibria (κ = 0) of an edged body: both poles, where the body stands on a vertex of
 /// the sphere (`sigma_0`, `sigma_pi`) or lies on a face (`face_0`, `face_pi`: a corner of U,
 /// stable where U rises from it), and the inclined ones (`inclined`), the roots of U′ inside,
-/// found by a scan of 4096 cells and bisection.
+/// found by a scan of 4096 cells and bisection. Where U′ vanishes on a whole arc (α = 0 on a
+/// ball's sphere), every inclination there is a neutral equilibrium: one `neutral_arc`.
 fn edged_equilibria(body: &Body<EdgedShape>) -> Vec<Equilibrium> {
     let shape = &body.shape;
     let faces = shape.faces();
@@ -762,6 +773,7 @@ fn edged_equilibria(body: &Body<EdgedShape>) -> Vec<Equilibrium> {
                 energy,
                 stable: slope > 0.0,
                 isolated: slope <= 0.0,
+                theta_end: None,
             });
         } else {
             let upp = shape.potential_second_at(exact);
@@ -771,15 +783,47 @@ fn edged_equilibria(body: &Body<EdgedShape>) -> Vec<Equilibrium> {
                 energy,
                 stable: upp > 0.0,
                 isolated: upp < 0.0,
+                theta_end: None,
             });
         }
     }
     let cells = 4096;
     let at = |i: usize| PI * i as f64 / cells as f64;
     let slope = |t: f64| shape.potential_prime(t);
-    for i in 1..cells - 1 {
+    // +1 where U′ vanishes exactly, −1 elsewhere: the ends of an arc where U′ ≡ 0.
+    let flat = |t: f64| if slope(t) == 0.0 { 1.0 } else { -1.0 };
+    let mut i = 1;
+    while i < cells - 1 {
         let (lo, hi) = (at(i), at(i + 1));
         let (a, b) = (slope(lo), slope(hi));
+        if a == 0.0 && b == 0.0 {
+            // U′ ≡ 0 on an arc (α = 0 on a ball's sphere): one neutral arc of equilibria,
+            // not an equilibrium per scan cell.
+            let mut j = i + 1;
+            while j < cells && slope(at(j)) == 0.0 {
+                j += 1;
+            }
+            let start = if slope(at(i - 1)) == 0.0 {
+                at(i - 1)
+            } else {
+                bisect(&flat, at(i - 1), lo, true)
+            };
+            let end = if j == cells {
+                PI
+            } else {
+                bisect(&flat, at(j - 1), at(j), false)
+            };
+            out.push(Equilibrium {
+                name: "neutral_arc",
+                theta: start,
+                energy: shape.potential(start),
+                stable: false,
+                isolated: false,
+                theta_end: Some(end),
+            });
+            i = j;
+            continue;
+        }
         if a == 0.0 || a * b < 0.0 {
             let theta = if a == 0.0 {
                 lo
@@ -794,8 +838,10 @@ fn edged_equilibria(body: &Body<EdgedShape>) -> Vec<Equilibrium> {
                 stable: a < 0.0 || (a == 0.0 && b > 0.0),
                 // A branch of permanent rotations ends at κ = 0 on every inclined one.
                 isolated: false,
+                theta_end: None,
             });
         }
+        i += 1;
     }
     out.sort_by(|a, b| a.theta.total_cmp(&b.theta));
     out

@@ -650,7 +650,7 @@ fn verdicts(
     threads: Option<i64>,
 ) -> PyResult<Vec<String>> {
     use rayon::prelude::*;
-    let resolution = count("resolution", resolution, 1)?;
+    let resolution = count("resolution", resolution, 8)?;
     let pool = pool(threads)?;
     let n = alpha.len();
     if [beta.len(), nu.len(), eta.len()].iter().any(|&m| m != n) {
@@ -705,7 +705,7 @@ fn boundaries(
     threads: Option<i64>,
 ) -> PyResult<String> {
     let scan = count("scan", scan, 1)?;
-    let resolution = count("resolution", resolution, 1)?;
+    let resolution = count("resolution", resolution, 32)?;
     let pool = pool(threads)?;
     let options = verdict::BoundaryOptions {
         beta_min,

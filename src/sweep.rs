@@ -135,6 +135,9 @@ pub struct RunRequest {
     /// scene by this build for this shard, continue an interrupted run of the same, and
     /// compute everything else afresh, replacing what is stale.
     pub update: bool,
+    /// With `update`: whether the existing output is current ([`output_is_current`], which
+    /// the caller may ask in a child process). An output that is not is replaced.
+    pub output_current: bool,
     pub shard: Shard,
     /// Attributes the caller adds to the file's root (command line, creation time).
     pub attributes: Vec<(String, AttrValue)>,
@@ -246,10 +249,16 @@ pub fn footprint(scene: &Scene, shard: Shard, threads: usize) -> Footprint {
 }
 
 /// Whether `out` is an atlas made from `scene` (its text and this build: the fingerprint)
-/// for this shard, and whole ([`AtlasFile::is_whole`]).
-fn output_is_current(out: &Path, scene: &Scene, shard: Shard, axis: &ComponentAxis) -> bool {
+/// for this shard, and intact ([`AtlasFile::is_intact`]). A damaged file can crash HDF5
+/// itself (a length in its global heap read as written): a caller that must survive that
+/// asks this in a child process, as `run --update` does, and passes the answer in
+/// [`RunRequest::output_current`].
+pub fn output_is_current(out: &Path, scene: &Scene, shard: Shard) -> bool {
+    let Ok(axis) = AtlasFile::read_axis(out) else {
+        return false;
+    };
     let region = shard.region(scene.shape());
-    let Ok(file) = AtlasFile::open(out, scene, &region, &atlas::scene_variables(scene), axis)
+    let Ok(file) = AtlasFile::open(out, scene, &region, &atlas::scene_variables(scene), &axis)
     else {
         return false;
     };
@@ -257,7 +266,7 @@ fn output_is_current(out: &Path, scene: &Scene, shard: Shard, axis: &ComponentAx
         == Some(format!("{:016x}", scene.fingerprint()).as_str())
         && file.integer_attribute("shard_index") == Some(shard.index as i64)
         && file.integer_attribute("shard_count") == Some(shard.count as i64)
-        && file.is_whole()
+        && file.is_intact(scene)
 }
 
 /// Runs `scene` as `request` says; returns the summary.
@@ -270,18 +279,14 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
         .check_against(scene.shape(), scene.second_name())?;
     // Held until the file is in place and the journal gone.
     let _claim = crate::store::OutputLock::acquire(out)?;
-    // A current output (made from this scene by this build for this shard) carries the axis
-    // this build lays its grid out on: --update keeps it without a census.
-    if out.exists() && request.update {
-        if let Ok(axis) = AtlasFile::read_axis(out) {
-            if output_is_current(out, scene, request.shard, &axis) {
-                return Ok(Summary {
-                    up_to_date: true,
-                    seconds: started.elapsed().as_secs_f64(),
-                    ..Summary::default()
-                });
-            }
-        }
+    // A current output (made from this scene by this build for this shard): --update
+    // keeps it without a census.
+    if out.exists() && request.update && request.output_current {
+        return Ok(Summary {
+            up_to_date: true,
+            seconds: started.elapsed().as_secs_f64(),
+            ..Summary::default()
+        });
     }
     if out.exists() && !request.force && !request.update {
         return Err(AtlasError::atlas(

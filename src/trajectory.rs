@@ -7,7 +7,7 @@ use crate::error::{AtlasError, Result};
 use crate::full::{FullState, FullSystem, FULL_STATE_LEN};
 use crate::ode::{integrate_sampled, Rate};
 use crate::reduced::ReducedSystem;
-use crate::torus::{Component, CriticalPoint, EffectivePotential, MotionKind};
+use crate::torus::{Component, CriticalKind, CriticalPoint, EffectivePotential, MotionKind, Site};
 use nalgebra::SVector;
 
 /// Which equations are integrated.
@@ -151,19 +151,38 @@ impl Start {
     }
 
     /// The unstable equilibrium this start rests on, if it does: θ̇(0) = 0 at κ = 0 on the
-    /// level of a maximum (or inflection) of V within 1e-7 of θ(0) on the circle. The body
-    /// then stays there, even where the level's other motions land on a face (the upright
-    /// disk at rest): it is the separatrix's equilibrium, not a motion onto the face.
-    pub fn rest_on_saddle(&self, component: &Component, energy: f64) -> Option<CriticalPoint> {
+    /// level of a maximum (or inflection) of V within 1e-7 of θ(0) on the circle, or where
+    /// V′(θ(0)) vanishes exactly off a minimum (a neutral equilibrium on an arc where U′ ≡ 0:
+    /// a cut ball with α = 0 resting on its sphere). The body then stays there, even where the
+    /// level's other motions land on a face (the upright disk at rest): it is the separatrix's
+    /// equilibrium, not a motion onto the face.
+    pub fn rest_on_saddle<S: Shape>(
+        &self,
+        potential: &EffectivePotential<'_, S>,
+        component: &Component,
+        energy: f64,
+    ) -> Option<CriticalPoint> {
         if self.kappa != 0.0 || self.theta_dot0 != 0.0 {
             return None;
         }
-        component
+        let theta = self.circle_angle();
+        let saddle = component
             .saddles()
-            .find(|p| {
-                energy == p.value && circle_distance(self.circle_angle(), p.site.theta) <= 1e-7
+            .find(|p| energy == p.value && circle_distance(theta, p.site.theta) <= 1e-7)
+            .copied();
+        let site = Site::at(theta);
+        let flat = component.kind != MotionKind::FixedPoint
+            && potential.slope(site.angle()) == 0.0
+            && potential.curvature_at(site.angle()) == 0.0;
+        saddle.or_else(|| {
+            flat.then(|| CriticalPoint {
+                site,
+                value: energy,
+                scale: potential.value_scale(site.angle()),
+                curvature: 0.0,
+                kind: CriticalKind::Inflection,
             })
-            .copied()
+        })
     }
 
     /// θ(0), at κ = 0 (θ an angle on the circle) taken within π of 0 when it lies beyond:
@@ -290,7 +309,7 @@ impl Request {
             let component = start.component_in(&potential)?;
             if crate::cell::reaches_face(&potential, &component) {
                 if start
-                    .rest_on_saddle(&component, start.energy(body))
+                    .rest_on_saddle(&potential, &component, start.energy(body))
                     .is_none()
                 {
                     return Err(AtlasError::Unsupported {

@@ -1516,12 +1516,12 @@ pub fn boundaries_with(
     // A boundary's error bar holds the move of its root from half the resolution; below 32
     // both can miss the same extremum (at α = 0.5 the N = −1 boundary is 9e-4 off at 16 and
     // 2e-4 at 8, where their difference is 1.4e-4).
-    if options.verdict.resolution < 32 {
+    if !(32..=4096).contains(&options.verdict.resolution) {
         return Err(AtlasError::InvalidParameter {
             name: "resolution",
             value: options.verdict.resolution as f64,
-            reason: "must be >= 32 for the boundaries: coarser sampling misses the extrema they \
-                     are found on, by more than its error bar shows",
+            reason: "must be between 32 and 4096 for the boundaries (coarser sampling misses \
+                     the extrema they are found on, by more than its error bar shows)",
         });
     }
     if !(4..=10_000).contains(&options.scan) {

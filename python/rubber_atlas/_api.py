@@ -1099,9 +1099,36 @@ def _read_every_chunk(path: Path) -> None:
                 else:
                     for block in data.iter_chunks():
                         data[block]
+            name = "the text attributes"
+            written = f.attrs.get("text_attributes_crc32")
+            if written is not None and int(written) != _text_attributes_crc32(f):
+                raise ValueError("their CRC-32 is not the one the file was written with")
     except (OSError, KeyError, RuntimeError, ValueError, TypeError, AttributeError, IndexError) as e:
-        raise ValueError(f"{path}: the file is damaged: the values of {name!r} cannot be read "
-                         f"({_one_line(e)}); compute it again") from None
+        raise ValueError(f"{path}: the file is damaged: {name if name.startswith('the text') else repr(name)} "
+                         f"cannot be read as written ({_one_line(e)}); compute it again") from None
+
+
+def _text_attributes_crc32(f) -> int:
+    """The CRC-32 of the variable-length text attributes of an atlas file's root and of its
+    datasets (HDF5's global heap, which keeps their letters, has no checksum of its own), as
+    `rubber-atlas` writes it in the root attribute `text_attributes_crc32` (docs/files.md)."""
+    import zlib
+    import h5py
+
+    crc = 0
+    for object_name, obj in [("", f)] + [(n, f[n]) for n in sorted(f.keys())]:
+        for name in sorted(obj.attrs.keys()):
+            info = h5py.check_string_dtype(obj.attrs.get_id(name).dtype)
+            if info is None or info.length is not None:
+                continue
+            value = obj.attrs.get_id(name)
+            raw = np.empty((), dtype=h5py.string_dtype())
+            value.read(raw)
+            text = raw[()]
+            text = text if isinstance(text, bytes) else str(text).encode()
+            for part in (object_name.encode(), name.encode(), text):
+                crc = zlib.crc32(part + b"\0", crc)
+    return crc
 
 
 def _file(path) -> Path:

@@ -188,6 +188,9 @@ def test_a_request_beyond_memory_is_refused_before_its_inputs_are_materialised(c
     (lambda: ra.verdict(0.5, 3, 0.5, 0.5, resolution=2.5), TypeError, ["resolution"]),
     (lambda: ra.verdict(0.5, 3, 0.5, 0.5, threads=2**70), ValueError, ["threads"]),
     (lambda: ra.boundaries(0.5, 0.5, 0.5, scan=2**70), ValueError, ["scan"]),
+    (lambda: ra.boundaries(0.5, 0.5, 0.5, resolution=0), ValueError, ["resolution = 0", "32"]),
+    (lambda: ra.boundaries(0.5, 0.5, 0.5, resolution=10**8), ValueError, ["resolution", "32 and 4096"]),
+    (lambda: ra.verdict(0.5, 3, 0.5, 0.5, resolution=0), ValueError, ["resolution = 0", "8"]),
     (lambda: ra.boundaries(0.5, 0.5, 0.5, beta_min="x"), TypeError, ["beta_min"]),
     (lambda: ra.flag_names(np.array([1, 2])), TypeError, ["flag_names"]),
 ])
@@ -309,6 +312,15 @@ def test_a_damaged_atlas_is_named_as_damaged_by_the_accessor(slice_atlas, tmp_pa
     with ra.open_atlas(slice_atlas, check=True) as whole:
         assert whole.rotation_number.load().size > 0
     refused(TypeError, lambda: ra.open_atlas(slice_atlas, check="yes"), "check")
+    # A letter of a text attribute (HDF5's global heap has no checksum): the file's
+    # text_attributes_crc32 finds it.
+    data = bytearray(Path(slice_atlas).read_bytes())
+    at = data.find(b"unbounded bounded no_value")
+    assert at > 0
+    data[at + 20] ^= 1
+    letter = tmp_path / "letter.h5"
+    letter.write_bytes(bytes(data))
+    refused(ValueError, lambda: ra.open_atlas(letter, check=True), str(letter), "damaged", "text attributes")
 
 
 

@@ -129,15 +129,21 @@ def test_submit_passes_options_and_names_logs(tmp_path):
     assert ignored.returncode == 0
 
 
-def test_a_damaged_shard_is_not_taken_as_current(tmp_path):
-    """--update reads the whole shard: one with a variable missing, or a chunk overwritten,
-    is recomputed; the result equals the undamaged shard."""
+def _first_shard_and_a_copy(tmp_path: Path) -> tuple[Path, Path]:
+    """Shard 1 of 3 of the tiny scene, made by its array task, and a copy of it."""
     (tmp_path / "atlas").mkdir()
     (tmp_path / "atlas" / "tiny.toml").write_text(SCENE)
     sbatch(tmp_path, "atlas/tiny.toml", task=1)
     shard = tmp_path / "atlas" / "tiny.shard-1-of-3.h5"
     good = tmp_path / "good.h5"
     good.write_bytes(shard.read_bytes())
+    return shard, good
+
+
+def test_a_damaged_shard_is_not_taken_as_current(tmp_path):
+    """--update reads the whole shard: one with a variable missing, or a chunk overwritten,
+    is recomputed; the result equals the undamaged shard."""
+    shard, good = _first_shard_and_a_copy(tmp_path)
     with h5py.File(shard, "r+") as f:
         del f["drift"]
     assert "nothing to do" not in sbatch(tmp_path, "atlas/tiny.toml", task=1)
@@ -148,3 +154,52 @@ def test_a_damaged_shard_is_not_taken_as_current(tmp_path):
     shard.write_bytes(bytes(data))
     assert "nothing to do" not in sbatch(tmp_path, "atlas/tiny.toml", task=1)
     assert _same_arrays(shard, good)
+
+
+def _attributes(path: Path) -> dict:
+    """Every attribute of the root and of each dataset, as text (references by the name of
+    the object they point to), and each dataset's dimension scales."""
+    out = {}
+    with h5py.File(path) as f:
+        for name, obj in [("/", f)] + [(n, f[n]) for n in sorted(f)]:
+            for key in obj.attrs:
+                if key in ("DIMENSION_LIST", "REFERENCE_LIST"):
+                    continue
+                out[(name, key)] = repr(obj.attrs[key])
+            if name != "/":
+                out[(name, "dims")] = [[scale.name for scale in d.values()] for d in obj.dims]
+    return out
+
+
+def test_a_shard_with_a_flipped_bit_is_recomputed_or_unchanged(tmp_path):
+    """Issue 22: --update on a shard with one bit flipped, anywhere in the file, either
+    recomputes it (then its values equal the undamaged shard's) or keeps it as current only
+    where the flip changed nothing a reader sees: values, attributes (text included, by the
+    file's text_attributes_crc32) and dimension scales. Also a flip in a text attribute and
+    one in a coordinate's values, each at a known place."""
+    import random
+
+    shard, good = _first_shard_and_a_copy(tmp_path)
+    pristine = good.read_bytes()
+    seen = _attributes(good)
+    text = pristine.find(b"unbounded bounded no_value")
+    with h5py.File(good) as f:
+        kappa = f["kappa"].id.get_chunk_info(0).byte_offset
+    assert text > 0 and kappa is not None
+    rng = random.Random(22)
+    flips = [(text + 20, 1), (kappa + 8 * 5 + 3, 16)]
+    flips += [(rng.randrange(len(pristine)), 1 << rng.randrange(8)) for _ in range(40)]
+    kept = 0
+    for offset, bit in flips:
+        data = bytearray(pristine)
+        data[offset] ^= bit
+        shard.write_bytes(bytes(data))
+        said = sbatch(tmp_path, "atlas/tiny.toml", task=1)
+        if "nothing to do" in said:
+            kept += 1
+            assert _same_arrays(shard, good), offset
+            assert _attributes(shard) == seen, offset
+        else:
+            assert _same_arrays(shard, good), offset
+    # The two placed flips were recomputed; most random ones hit the structure.
+    assert kept < len(flips) - 2

@@ -130,6 +130,16 @@ pub(super) fn print_diagram(set: &CriticalSet) {
         println!("  inclined equilibrium theta* = {t:.12}");
     }
     for e in &set.equilibria {
+        if let Some(end) = e.theta_end {
+            println!(
+                "  equilibria  {:<10} theta = {:.12} ... {:.12}  eps = {}  neutral (U' = 0 on the arc)",
+                e.name,
+                e.theta,
+                end,
+                digits(e.energy, 12)
+            );
+            continue;
+        }
         println!(
             "  equilibrium {:<10} theta = {:.12}  eps = {}  {}{}",
             e.name,

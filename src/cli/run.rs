@@ -75,6 +75,46 @@ pub struct RunArgs {
     /// No progress and no summary.
     #[arg(long)]
     pub quiet: bool,
+    /// (Internal, for --update) Exit 0 if the output is current, 3 if not: asked in a
+    /// child process, since reading a damaged file can crash HDF5.
+    #[arg(long, hide = true)]
+    pub probe_current: bool,
+}
+
+/// Whether the existing output `out` is current for `args`' scene and shard, asked of this
+/// program in a child process: a damaged file that crashes HDF5 (a length in its global
+/// heap) then crashes the child, and the output is computed afresh.
+fn output_current(args: &RunArgs, out: &std::path::Path) -> bool {
+    use std::process::{Command, Stdio};
+    let Ok(exe) = std::env::current_exe() else {
+        return false;
+    };
+    let mut probe = Command::new(exe);
+    probe
+        .arg("run")
+        .arg(&args.scene)
+        .arg("--out")
+        .arg(out)
+        .arg("--probe-current");
+    if let Some(shard) = &args.shard {
+        probe.arg("--shard").arg(shard);
+    }
+    let status = probe
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status();
+    match status {
+        Ok(status) if status.code() == Some(0) => true,
+        Ok(status) if status.code().is_none() && !args.quiet => {
+            eprintln!(
+                "rubber-atlas: reading {} crashed HDF5 (a damaged file); it is computed afresh",
+                out.display()
+            );
+            false
+        }
+        _ => false,
+    }
 }
 
 pub(super) fn run_scene(args: RunArgs) -> Result<()> {
@@ -98,6 +138,13 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
     if args.print_out {
         println!("{}", out.display());
         return Ok(());
+    }
+    if args.probe_current {
+        std::process::exit(if sweep::output_is_current(&out, &scene, shard) {
+            0
+        } else {
+            3
+        });
     }
     // Before any work: never a directory, device, symlink or the scene itself.
     check_output(
@@ -159,6 +206,7 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
         resume: args.resume,
         force: args.force,
         update: args.update,
+        output_current: args.update && out.exists() && output_current(&args, &out),
         shard,
         attributes: invocation_attributes(),
     };

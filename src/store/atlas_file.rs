@@ -35,6 +35,9 @@ pub struct AtlasFile {
     second: bool,
 }
 
+/// The root attribute holding [`super::h5::text_attributes_crc32`] of the file as written.
+pub const TEXT_CRC: &str = "text_attributes_crc32";
+
 impl AtlasFile {
     /// Creates the file at `path` (which must not exist) for the part `region` of the
     /// scene's grid (all of it, or a shard's), with its coordinates, every variable at its
@@ -59,7 +62,17 @@ impl AtlasFile {
         axis: &ComponentAxis,
         attributes: &[(&str, AttrValue)],
     ) -> hdf5::Result<AtlasFile> {
-        let file = hdf5::File::create_excl(path)?;
+        // HDF5 1.10's formats: every header, B-tree and chunk index carries a checksum, so a
+        // flipped bit in the file's structure or attributes is refused when read, not taken
+        // (the chunks' zlib streams carry their own).
+        let file = hdf5::File::with_options()
+            .with_fapl(|p| {
+                p.libver_bounds(
+                    hdf5::file::LibraryVersion::V110,
+                    hdf5::file::LibraryVersion::latest(),
+                )
+            })
+            .create_excl(path)?;
         text_attr(&file, "Conventions", cf::CONVENTIONS)?;
         text_attr(&file, "component_layout", axis.layout.name())?;
         for (name, value) in attributes {
@@ -104,7 +117,14 @@ impl AtlasFile {
         .collect();
         let mut scales = Vec::new();
         for (name, values, (long_name, units)) in coords {
-            let d = file.new_dataset_builder().with_data(values).create(name)?;
+            // Chunked, for the Fletcher-32 checksum of the values (a contiguous dataset has
+            // none: a flipped bit in κ would read as another grid).
+            let d = file
+                .new_dataset_builder()
+                .chunk(values.len())
+                .fletcher32()
+                .with_data(values)
+                .create(name)?;
             describe(&d, long_name, units)?;
             set_scale(&d, name)?;
             scales.push(d);
@@ -117,10 +137,13 @@ impl AtlasFile {
             describe(&d, long_name, units)?;
         }
         // By family: the families' codes (u8 flags); by θ_min: the ranks 0, 1, … (int32).
+        let slots_len = axis.len();
         let d = match axis.flag_attributes() {
             Some((values, meanings)) => {
                 let d = file
                     .new_dataset_builder()
+                    .chunk(slots_len)
+                    .fletcher32()
                     .with_data(&axis.labels)
                     .create("component")?;
                 describe(&d, "torus family", cf::NUMBER)?;
@@ -131,6 +154,8 @@ impl AtlasFile {
                 let ranks: Vec<i32> = axis.labels.iter().map(|&k| i32::from(k)).collect();
                 let d = file
                     .new_dataset_builder()
+                    .chunk(slots_len)
+                    .fletcher32()
                     .with_data(&ranks)
                     .create("component")?;
                 describe(
@@ -233,6 +258,11 @@ impl AtlasFile {
             }
             datasets.push(d);
         }
+        // Last: it covers every text attribute written above.
+        let crc = super::h5::text_attributes_crc32(&file)?;
+        file.new_attr::<i64>()
+            .create(TEXT_CRC)?
+            .write_scalar(&i64::from(crc))?;
         Ok(AtlasFile {
             path: path.to_path_buf(),
             file,
@@ -309,6 +339,64 @@ impl AtlasFile {
                     Kind::Value | Kind::CellValue => d.read_raw::<f64>().is_ok(),
                     Kind::Flag | Kind::CellFlag => d.read_raw::<u8>().is_ok(),
                 }
+        })
+    }
+
+    /// Whether the file is the one a run of `scene` writes, whole: every variable reads
+    /// ([`Self::is_whole`]), the coordinates and ν, η are the scene's value for value
+    /// ([`Self::coordinates_match`]), every variable's dimensions are attached to their
+    /// scales, and every attribute of the root and of every dataset opens and reads (the
+    /// HDF5 1.10 headers' checksums refuse a flipped bit there), and the text attributes'
+    /// letters, kept in HDF5's global heap without a checksum, have the CRC-32 the file was
+    /// written with (`text_attributes_crc32`). Reading a damaged file can crash HDF5: ask
+    /// this in a child process ([`crate::sweep::output_is_current`]).
+    pub fn is_intact(&self, scene: &Scene) -> bool {
+        let scalar = |name: &str, want: f64| {
+            self.file
+                .dataset(name)
+                .and_then(|d| d.read_scalar::<f64>())
+                .is_ok_and(|got| got.to_bits() == want.to_bits())
+        };
+        let Ok(names) = self.file.member_names() else {
+            return false;
+        };
+        self.is_whole()
+            && self.coordinates_match(scene)
+            && scalar("nu", scene.nu)
+            && scalar("eta", scene.eta)
+            && self.scales_attached(scene)
+            && super::h5::text_attributes_crc32(&self.file)
+                .is_ok_and(|crc| self.integer_attribute(TEXT_CRC) == Some(i64::from(crc)))
+            && super::h5::attributes_read(&self.file)
+            && names.iter().all(|name| {
+                self.file
+                    .dataset(name)
+                    .is_ok_and(|d| super::h5::attributes_read(&d))
+            })
+    }
+
+    /// Whether each variable's dimensions carry their coordinates as dimension scales.
+    fn scales_attached(&self, scene: &Scene) -> bool {
+        let [row, column] = scene.plane.axis_names();
+        let mut grid: Vec<&str> = vec!["alpha"];
+        grid.extend(scene.second_name());
+        grid.extend([row, column]);
+        let Ok(grid) = grid
+            .iter()
+            .map(|name| self.file.dataset(name))
+            .collect::<hdf5::Result<Vec<_>>>()
+        else {
+            return false;
+        };
+        let Ok(component) = self.file.dataset("component") else {
+            return false;
+        };
+        self.variables.iter().zip(&self.datasets).all(|(v, d)| {
+            let own = grid
+                .iter()
+                .chain((!v.kind.per_cell()).then_some(&component));
+            own.enumerate()
+                .all(|(i, scale)| super::h5::is_attached(d, scale, i))
         })
     }
 

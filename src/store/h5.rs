@@ -13,6 +13,9 @@ extern "C" {
         dsid: hdf5_sys::h5i::hid_t,
         idx: c_uint,
     ) -> c_int;
+    fn H5DSis_attached(did: hdf5_sys::h5i::hid_t, dsid: hdf5_sys::h5i::hid_t, idx: c_uint)
+        -> c_int;
+    fn H5DSget_num_scales(did: hdf5_sys::h5i::hid_t, idx: c_uint) -> c_int;
 }
 
 /// Writes a scalar string attribute.
@@ -75,4 +78,75 @@ pub fn attach_scale(
         return Err("H5DSattach_scale failed".into());
     }
     Ok(())
+}
+
+/// Whether `scale` is the one dimension scale attached to dimension `index` of `dataset`
+/// (false where the dimension-scale attributes cannot be read).
+pub fn is_attached(dataset: &hdf5::Dataset, scale: &hdf5::Dataset, index: usize) -> bool {
+    let index = index as c_uint;
+    hdf5::sync::sync(|| unsafe {
+        H5DSget_num_scales(dataset.id(), index) == 1
+            && H5DSis_attached(dataset.id(), scale.id(), index) > 0
+    })
+}
+
+/// Whether every attribute of `loc` opens and its value reads (the dimension scales'
+/// references, of types the `hdf5` crate does not describe, are opened only; their
+/// content is checked by [`is_attached`]).
+pub fn attributes_read(loc: &hdf5::Location) -> bool {
+    use hdf5::types::TypeDescriptor as T;
+    let Ok(names) = loc.attr_names() else {
+        return false;
+    };
+    names.iter().all(|name| {
+        let Ok(attr) = loc.attr(name) else {
+            return false;
+        };
+        let Ok(dtype) = attr.dtype() else {
+            return false;
+        };
+        match dtype.to_descriptor() {
+            Ok(T::VarLenUnicode) => attr.read_raw::<VarLenUnicode>().is_ok(),
+            Ok(T::Float(_)) => attr.read_raw::<f64>().is_ok(),
+            Ok(T::Integer(_)) => attr.read_raw::<i64>().is_ok(),
+            Ok(T::Unsigned(_)) => attr.read_raw::<u64>().is_ok(),
+            _ => true,
+        }
+    })
+}
+
+/// The CRC-32 of every variable-length text attribute of the root and of each dataset:
+/// HDF5 keeps their letters in its global heap, which has no checksum. Over each object in
+/// name order (the root as ""), each such attribute in name order, the bytes of
+/// `object \0 name \0 value \0` (docs/files.md says so for other readers).
+pub fn text_attributes_crc32(file: &hdf5::File) -> hdf5::Result<u32> {
+    let mut crc = crc32fast::Hasher::new();
+    let root: &hdf5::Location = file;
+    let mut objects = vec![(String::new(), root.clone())];
+    let mut names = file.member_names()?;
+    names.sort();
+    for name in names {
+        let dataset = file.dataset(&name)?;
+        let location: &hdf5::Location = &dataset;
+        objects.push((name, location.clone()));
+    }
+    for (object, location) in &objects {
+        let mut attrs = location.attr_names()?;
+        attrs.sort();
+        for name in attrs {
+            let attr = location.attr(&name)?;
+            if !matches!(
+                attr.dtype()?.to_descriptor(),
+                Ok(hdf5::types::TypeDescriptor::VarLenUnicode)
+            ) {
+                continue;
+            }
+            let value = attr.read_scalar::<VarLenUnicode>()?;
+            for part in [object.as_bytes(), name.as_bytes(), value.as_bytes()] {
+                crc.update(part);
+                crc.update(&[0]);
+            }
+        }
+    }
+    Ok(crc.finalize())
 }

@@ -547,6 +547,118 @@ fn the_critical_set_of_each_edged_body_holds_on_its_own_equations() {
 /// At tiny κ the well by a face sits at sinθ ≈ (κ²/U′)^⅓, far nearer the pole than a smooth
 /// pole's (κ²/U″)^¼: it is found (it was missed below κ ≈ 1e-18), so the components are those
 /// at κ = 1e-6, down to κ = 1e-200.
+/// The values `cell` gives the component of a start at rest at θ0 with κ = 0.
+fn component_at_rest(body: &Body<EdgedShape>, theta0: f64) -> rubber_atlas::cell::ComponentResult {
+    let potential = EffectivePotential::new(body, 0.0);
+    let start = Start {
+        kappa: 0.0,
+        theta0,
+        theta_dot0: 0.0,
+    };
+    let energy = start.energy(body);
+    let component = start.component_in(&potential).unwrap();
+    rubber_atlas::cell::solve_start(
+        &potential,
+        &start,
+        energy,
+        &component,
+        &CellOptions::default(),
+    )
+    .unwrap()
+}
+
+/// A ball whose centre of mass is its centre (α = 0) rests neutrally at every inclination
+/// where it stands on its sphere: the diagram gives that arc once, from the kink (the edge
+/// of the cut) to the pole or to the other kink, not an equilibrium per scan cell.
+#[test]
+fn a_centred_cut_ball_has_one_neutral_arc_of_equilibria() {
+    use rubber_atlas::critical::CriticalSet;
+    for (shape, arc) in [
+        (
+            EdgedShape::truncated_ball(0.0, 0.5).unwrap(),
+            (PI / 3.0, PI),
+        ),
+        (
+            EdgedShape::truncated_ball(0.0, -0.3).unwrap(),
+            ((-0.3f64).acos(), PI),
+        ),
+        (
+            EdgedShape::wheel(0.0, 0.5).unwrap(),
+            (PI / 3.0, 2.0 * PI / 3.0),
+        ),
+    ] {
+        let body = Body::new(shape, 0.7, 1.3).unwrap();
+        let set = CriticalSet::of_edged(&body, 400, 3.0, &|| false).unwrap();
+        let arcs: Vec<_> = set
+            .equilibria
+            .iter()
+            .filter(|e| e.name == "neutral_arc")
+            .collect();
+        assert_eq!(arcs.len(), 1, "{shape:?}: {:?}", set.equilibria);
+        let end = arcs[0].theta_end.unwrap();
+        assert!(
+            (arcs[0].theta - arc.0).abs() < 1e-12,
+            "{shape:?}: {:?}",
+            arcs[0]
+        );
+        assert!((end - arc.1).abs() < 1e-12, "{shape:?}: {:?}", arcs[0]);
+        assert!(
+            set.equilibria.iter().all(|e| e.name != "inclined"),
+            "{shape:?}"
+        );
+        assert!(set.equilibria.len() <= 4, "{shape:?}: {:?}", set.equilibria);
+        // U′ vanishes inside the arc and not beside it.
+        assert_eq!(shape.potential_prime(0.5 * (arcs[0].theta + end)), 0.0);
+        assert_ne!(shape.potential_prime(arcs[0].theta - 1e-9), 0.0);
+    }
+    // At rest anywhere on the arc the body stays (the separatrix's equilibria, N = 0,
+    // bounded), in both models, where the level's other motions land on a face.
+    use rubber_atlas::trajectory::{Duration, Request, StartAt};
+    for (shape, theta0) in [
+        (EdgedShape::wheel(0.0, 0.5).unwrap(), 1.2),
+        (EdgedShape::truncated_ball(0.0, 0.5).unwrap(), 2.0),
+        (EdgedShape::truncated_ball(0.0, 0.5).unwrap(), 2.0 - TAU),
+    ] {
+        let body = Body::new(shape, 0.5, 0.5).unwrap();
+        let at_rest = |theta0: f64| component_at_rest(&body, theta0);
+        let c = at_rest(theta0);
+        assert_eq!(c.status, Status::Separatrix, "{shape:?} {theta0}: {c:?}");
+        assert_eq!((c.rotation_number, c.bounded), (0.0, Some(true)));
+        for model in [Model::Reduced, Model::Full] {
+            let request = Request {
+                kappa: 0.0,
+                start: StartAt::Angle {
+                    theta0,
+                    theta_dot0: 0.0,
+                },
+                duration: Duration::Until(50.0),
+                samples: 20,
+                model,
+                tol: 1e-10,
+                step_budget: None,
+            };
+            let (_, traj) = request.run(&body).unwrap();
+            // (The full model gives θ on the circle: 2 for 2 − 2π.)
+            let on_circle = |t: f64| {
+                let d = t - theta0;
+                (d - TAU * (d / TAU).round()).abs() < 1e-12
+            };
+            assert!(
+                traj.theta.iter().all(|t| on_circle(*t)),
+                "{shape:?} {model:?}"
+            );
+        }
+        // Beside the arc, on the edge, at rest: a motion onto a face.
+        let c = at_rest(0.5);
+        assert_ne!(c.status, Status::Separatrix, "{shape:?}: {c:?}");
+    }
+    // A cut ball with α ≠ 0 has none.
+    let shape = EdgedShape::truncated_ball(1e-9, 0.5).unwrap();
+    let body = Body::new(shape, 0.7, 1.3).unwrap();
+    let set = CriticalSet::of_edged(&body, 400, 3.0, &|| false).unwrap();
+    assert!(set.equilibria.iter().all(|e| e.theta_end.is_none()));
+}
+
 #[test]
 fn the_well_by_a_face_is_found_at_the_tiniest_kappa() {
     for (alpha, cut, energy) in [(-0.1, 0.4, 2.0), (0.2, 0.4, 0.7), (0.2, 0.4, 0.85)] {
@@ -656,21 +768,9 @@ fn planar_trajectories_onto_a_face_are_refused() {
 /// face, and its trajectory stays at rest; a start beside it at rest lands on a face.
 #[test]
 fn the_upright_disk_at_rest_is_an_equilibrium() {
-    use rubber_atlas::cell::solve_start;
     use rubber_atlas::trajectory::{Duration, Request, StartAt};
     let body = Body::new(EdgedShape::disk(0.0).unwrap(), 0.5, 0.5).unwrap();
-    let potential = EffectivePotential::new(&body, 0.0);
-    let options = CellOptions::default();
-    let status = |theta0: f64| {
-        let start = Start {
-            kappa: 0.0,
-            theta0,
-            theta_dot0: 0.0,
-        };
-        let energy = start.energy(&body);
-        let component = start.component_in(&potential).unwrap();
-        solve_start(&potential, &start, energy, &component, &options).unwrap()
-    };
+    let status = |theta0: f64| component_at_rest(&body, theta0);
     for theta0 in [FRAC_PI_2, -FRAC_PI_2, 3.0 * FRAC_PI_2] {
         let c = status(theta0);
         assert_eq!(c.status, Status::Separatrix, "{theta0}: {c:?}");

@@ -351,6 +351,34 @@ fn the_spheres_equator_is_stable_at_every_kappa() {
     assert!(equator[0].points.iter().all(|p| p.stable));
 }
 
+/// Where a curve changes stability (κ_c on the equator of α = 0, β = 3; the cusp of
+/// α = 0.5, β = 3) one segment ends and the next begins on the same point: the two rows
+/// differ in their stability alone, the rotation number included.
+#[test]
+fn a_change_of_stability_is_one_point_shared_by_two_segments() {
+    for (alpha, beta) in [(0.0, 3.0), (0.5, 3.0), (-0.5, 3.0)] {
+        let b = EllipsoidBody::ellipsoid(alpha, beta, 0.5, 0.5).unwrap();
+        let set = CriticalSet::of(&b, 500, 3.0).unwrap();
+        let points: Vec<_> = set.branches.iter().flat_map(|br| &br.points).collect();
+        let mut shared = 0;
+        for (i, p) in points.iter().enumerate() {
+            for q in &points[i + 1..] {
+                if p.theta0 == q.theta0 && p.kappa == q.kappa {
+                    shared += 1;
+                    assert_ne!(p.stable, q.stable, "{alpha} {beta}: {p:?} {q:?}");
+                    assert_eq!(p.energy, q.energy);
+                    assert_eq!(
+                        p.rotation_number.map(f64::to_bits),
+                        q.rotation_number.map(f64::to_bits),
+                        "{alpha} {beta}: {p:?} {q:?}"
+                    );
+                }
+            }
+        }
+        assert_eq!(shared, 1, "{alpha} {beta}");
+    }
+}
+
 /// Near the sphere (β = 1, |α| tiny) κ climbs from 0.036 to ∞ within 8e-4 of θ0 = π/2, inside
 /// one step of the θ0 grid: the branch by π/2 still reaches κ_max, each of its points on the
 /// curve (V′ = 0) and none beyond κ_max.

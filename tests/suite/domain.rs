@@ -59,6 +59,10 @@ fn check_answer(alpha: f64, beta: f64, nu: f64, eta: f64, kappa: f64, energy: f6
         if !c.rotation_number.is_finite() && c.status != Status::Separatrix {
             assert_eq!(c.bounded, None, "bounded without N: {at}");
         }
+        // On a separatrix N may be ±∞ (JSON's null; docs/files.md), never missing.
+        if c.status == Status::Separatrix {
+            assert!(!c.rotation_number.is_nan() && c.bounded.is_some(), "{at}");
+        }
         assert!(!c.error_estimate.is_nan(), "NaN error estimate: {at}");
         // A verdict on the path only where the numbers carry it: N known to better than
         // ±1/2, and unbounded only with a drift beyond its error.

@@ -176,11 +176,13 @@ fn a_boundary_is_the_same_at_every_resolution_and_its_bar_covers_the_move() {
             b.boundaries[0].clone()
         })
     };
-    let refused = at(0.5, (15.0, 25.0), 16).unwrap_err().to_string();
-    assert!(
-        refused.contains("resolution") && refused.contains(">= 32"),
-        "{refused}"
-    );
+    for resolution in [16, 5000] {
+        let refused = at(0.5, (15.0, 25.0), resolution).unwrap_err().to_string();
+        assert!(
+            refused.contains("resolution") && refused.contains("between 32 and 4096"),
+            "{refused}"
+        );
+    }
     for (alpha, window, expected) in [
         (0.5, (15.0, 25.0), 19.793014),
         (0.9, (10.5, 12.5), 11.422716),
