@@ -1127,9 +1127,20 @@ fn fixed_point<S: Shape>(
         .filter(|k| k.theta != m.site.theta)
         .map(|k| (two_sided(potential.curvature_sides_at(k.angle())) - period).abs())
         .fold(0.0, f64::max);
-    let psi_rate = potential.psi_rate(a);
+    // On the equator (the double nearest π/2, whose cosine is 6e-17 rather than 0) ψ̇ is 0:
+    // the fixed point is the equator itself, rolling on a straight line (it gave N = −5e-17,
+    // a circle of radius 1.6e16 and `bounded`).
+    let psi_rate = if m.site.theta == std::f64::consts::FRAC_PI_2 {
+        0.0
+    } else {
+        potential.psi_rate(a)
+    };
     let psi_advance = psi_rate * period;
-    let n = -psi_advance / TAU;
+    let n = if psi_rate == 0.0 {
+        0.0
+    } else {
+        -psi_advance / TAU
+    };
     let (drift, radius) = if potential.kappa == 0.0 {
         (0.0, 0.0)
     } else if psi_rate == 0.0 {

@@ -787,43 +787,43 @@ fn edged_equilibria(body: &Body<EdgedShape>) -> Vec<Equilibrium> {
             });
         }
     }
+    let slope = |t: f64| shape.potential_prime(t);
+    // The pieces of U between the poles and the kinks: where U′ vanishes all over one (α = 0
+    // on a ball's sphere), every inclination there is a neutral equilibrium, one arc from
+    // kink to kink (or pole), however short the piece.
+    let mut ends = vec![0.0];
+    ends.extend(shape.kinks().iter().copied());
+    ends.push(PI);
+    ends.sort_by(f64::total_cmp);
+    let arcs: Vec<(f64, f64)> = ends
+        .windows(2)
+        .map(|w| (w[0], w[1]))
+        .filter(|&(lo, hi)| {
+            hi > lo
+                && [0.25, 0.5, 0.75]
+                    .iter()
+                    .all(|f| slope(lo + f * (hi - lo)) == 0.0)
+        })
+        .collect();
+    for &(lo, hi) in &arcs {
+        out.push(Equilibrium {
+            name: "neutral_arc",
+            theta: lo,
+            energy: shape.potential(lo),
+            stable: false,
+            isolated: false,
+            theta_end: Some(hi),
+        });
+    }
+    let on_arc = |t: f64| arcs.iter().any(|&(lo, hi)| (lo..=hi).contains(&t));
     let cells = 4096;
     let at = |i: usize| PI * i as f64 / cells as f64;
-    let slope = |t: f64| shape.potential_prime(t);
-    // +1 where U′ vanishes exactly, −1 elsewhere: the ends of an arc where U′ ≡ 0.
-    let flat = |t: f64| if slope(t) == 0.0 { 1.0 } else { -1.0 };
-    let mut i = 1;
-    while i < cells - 1 {
+    for i in 1..cells - 1 {
         let (lo, hi) = (at(i), at(i + 1));
-        let (a, b) = (slope(lo), slope(hi));
-        if a == 0.0 && b == 0.0 {
-            // U′ ≡ 0 on an arc (α = 0 on a ball's sphere): one neutral arc of equilibria,
-            // not an equilibrium per scan cell.
-            let mut j = i + 1;
-            while j < cells && slope(at(j)) == 0.0 {
-                j += 1;
-            }
-            let start = if slope(at(i - 1)) == 0.0 {
-                at(i - 1)
-            } else {
-                bisect(&flat, at(i - 1), lo, true)
-            };
-            let end = if j == cells {
-                PI
-            } else {
-                bisect(&flat, at(j - 1), at(j), false)
-            };
-            out.push(Equilibrium {
-                name: "neutral_arc",
-                theta: start,
-                energy: shape.potential(start),
-                stable: false,
-                isolated: false,
-                theta_end: Some(end),
-            });
-            i = j;
+        if on_arc(lo) || on_arc(hi) {
             continue;
         }
+        let (a, b) = (slope(lo), slope(hi));
         if a == 0.0 || a * b < 0.0 {
             let theta = if a == 0.0 {
                 lo
@@ -841,7 +841,6 @@ fn edged_equilibria(body: &Body<EdgedShape>) -> Vec<Equilibrium> {
                 theta_end: None,
             });
         }
-        i += 1;
     }
     out.sort_by(|a, b| a.theta.total_cmp(&b.theta));
     out

@@ -88,6 +88,16 @@ fn count(name: &str, value: i64, min: i64) -> PyResult<usize> {
     usize::try_from(value).map_err(|_| bad(format!("invalid {name} = {value}: too large")))
 }
 
+/// `resolution` of a verdict (from `lowest`) or of the boundaries, refused naming its range.
+fn resolution_between(value: i64, lowest: i64, what: &str) -> PyResult<usize> {
+    if !(lowest..=4096).contains(&value) {
+        return Err(bad(format!(
+            "invalid resolution = {value}: must be between {lowest} and 4096{what}"
+        )));
+    }
+    Ok(value as usize)
+}
+
 /// The pool of `threads` threads, capped at the machine's cores as the command line caps
 /// them (None: rayon's global pool, which honours RAYON_NUM_THREADS).
 fn pool(threads: Option<i64>) -> PyResult<Option<rayon::ThreadPool>> {
@@ -650,7 +660,7 @@ fn verdicts(
     threads: Option<i64>,
 ) -> PyResult<Vec<String>> {
     use rayon::prelude::*;
-    let resolution = count("resolution", resolution, 8)?;
+    let resolution = resolution_between(resolution, 8, "")?;
     let pool = pool(threads)?;
     let n = alpha.len();
     if [beta.len(), nu.len(), eta.len()].iter().any(|&m| m != n) {
@@ -705,7 +715,7 @@ fn boundaries(
     threads: Option<i64>,
 ) -> PyResult<String> {
     let scan = count("scan", scan, 1)?;
-    let resolution = count("resolution", resolution, 32)?;
+    let resolution = resolution_between(resolution, 32, " for the boundaries")?;
     let pool = pool(threads)?;
     let options = verdict::BoundaryOptions {
         beta_min,

@@ -48,7 +48,7 @@ pub struct VerdictArgs {
     pub tol: f64,
     /// κ-lines of each kind and energies per line of the sampling (doubling it halves the
     /// spacing).
-    #[arg(long, default_value_t = 64, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 64, allow_hyphen_values = true, value_parser = resolution)]
     pub resolution: usize,
     /// Print one JSON object (docs/hypothesis.md contract).
     #[arg(long)]
@@ -255,4 +255,16 @@ pub(super) fn print_verdict(v: &verdict::Verdict) {
             println!("    {l}");
         }
     }
+}
+
+/// `--resolution` as a count; what is not one (negative, a fraction, beyond 2^32) is refused
+/// naming the range (the verdict's own check refuses the counts outside it).
+fn resolution(text: &str) -> std::result::Result<usize, String> {
+    let range = "must be a whole number between 8 and 4096 (32 and 4096 with --boundaries)";
+    text.trim()
+        .parse::<i128>()
+        .ok()
+        .and_then(|n| u32::try_from(n).ok())
+        .map(|n| n as usize)
+        .ok_or_else(|| range.to_string())
 }

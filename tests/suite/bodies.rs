@@ -547,6 +547,37 @@ fn the_critical_set_of_each_edged_body_holds_on_its_own_equations() {
 /// At tiny κ the well by a face sits at sinθ ≈ (κ²/U′)^⅓, far nearer the pole than a smooth
 /// pole's (κ²/U″)^¼: it is found (it was missed below κ ≈ 1e-18), so the components are those
 /// at κ = 1e-6, down to κ = 1e-200.
+/// A permanent rotation on the equator of a body symmetric about it (α = 0) rolls along a
+/// straight line: N = 0 and unbounded (the double nearest π/2 has a cosine of 6e-17, which
+/// gave N = −5e-17 on a circle of radius 1.6e16, `bounded`).
+#[test]
+fn the_equators_permanent_rotation_rolls_on_a_line() {
+    fn check<S: Shape>(body: &Body<S>) {
+        let start = Start {
+            kappa: 1.0,
+            theta0: FRAC_PI_2,
+            theta_dot0: 0.0,
+        };
+        let potential = EffectivePotential::new(body, 1.0);
+        let component = start.component_in(&potential).unwrap();
+        let c = rubber_atlas::cell::solve_start(
+            &potential,
+            &start,
+            start.energy(body),
+            &component,
+            &CellOptions::default(),
+        )
+        .unwrap();
+        assert_eq!(c.status, Status::FixedPoint, "{c:?}");
+        assert_eq!(c.rotation_number, 0.0, "{c:?}");
+        assert!(c.drift > 0.0 && c.drift_radius.is_infinite(), "{c:?}");
+        assert_eq!(c.bounded, Some(false), "{c:?}");
+    }
+    check(&Body::new(EdgedShape::wheel(0.0, 0.5).unwrap(), 0.5, 0.5).unwrap());
+    check(&Body::new(EdgedShape::truncated_ball(0.0, 0.5).unwrap(), 0.5, 0.5).unwrap());
+    check(&rubber_atlas::EllipsoidBody::ellipsoid(0.0, 0.5, 0.5, 0.5).unwrap());
+}
+
 /// The values `cell` gives the component of a start at rest at θ0 with κ = 0.
 fn component_at_rest(body: &Body<EdgedShape>, theta0: f64) -> rubber_atlas::cell::ComponentResult {
     let potential = EffectivePotential::new(body, 0.0);
@@ -585,6 +616,15 @@ fn a_centred_cut_ball_has_one_neutral_arc_of_equilibria() {
         (
             EdgedShape::wheel(0.0, 0.5).unwrap(),
             (PI / 3.0, 2.0 * PI / 3.0),
+        ),
+        // Pieces shorter than the 4096-cell scan: the arc is found by its ends, the kinks.
+        (
+            EdgedShape::wheel(0.0, 0.9999999).unwrap(),
+            (0.9999999f64.acos(), PI - 0.9999999f64.acos()),
+        ),
+        (
+            EdgedShape::truncated_ball(0.0, -0.999999).unwrap(),
+            ((-0.999999f64).acos(), PI),
         ),
     ] {
         let body = Body::new(shape, 0.7, 1.3).unwrap();
