@@ -3,7 +3,7 @@
 //! stays bounded, a status and error estimates — by quadrature ([`crate::torus`]) or, as an
 //! independent check, by integrating one period of the reduced system ([`crate::period_ode`]).
 
-use crate::body::{Body, Shape};
+use crate::body::{Angle, Body, Shape};
 use crate::dd::DoubleDouble;
 use crate::error::{AtlasError, Result};
 use crate::family::Family;
@@ -13,7 +13,7 @@ use crate::torus::{
     Component, CriticalKind, CriticalPoint, EffectivePotential, MotionKind, PeriodIntegrals, Site,
 };
 use serde::Serialize;
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 /// How the period integrals are computed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -1127,14 +1127,13 @@ fn fixed_point<S: Shape>(
         .filter(|k| k.theta != m.site.theta)
         .map(|k| (two_sided(potential.curvature_sides_at(k.angle())) - period).abs())
         .fold(0.0, f64::max);
-    // On the equator (the double nearest π/2, whose cosine is 6e-17 rather than 0) ψ̇ is 0:
-    // the fixed point is the equator itself, rolling on a straight line (it gave N = −5e-17,
-    // a circle of radius 1.6e16 and `bounded`).
-    let psi_rate = if m.site.theta == std::f64::consts::FRAC_PI_2 {
-        0.0
-    } else {
-        potential.psi_rate(a)
-    };
+    // Where U′(π/2) = 0 the fixed point found at the double nearest π/2 (cosine 6e-17) is
+    // the equator itself, where ψ̇ = 0: rolling on a straight line (it gave N = −5e-17, a
+    // circle of radius 1.6e16 and `bounded`).
+    let equator = Angle::EQUATOR;
+    let on_equator =
+        m.site.theta == FRAC_PI_2 && potential.body.shape.potential_prime_at(equator) == 0.0;
+    let psi_rate = potential.psi_rate(if on_equator { equator } else { a });
     let psi_advance = psi_rate * period;
     let n = if psi_rate == 0.0 {
         0.0

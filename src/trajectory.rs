@@ -170,11 +170,11 @@ impl Start {
             .saddles()
             .find(|p| energy == p.value && circle_distance(theta, p.site.theta) <= 1e-7)
             .copied();
-        let site = Site::at(theta);
-        let flat = component.kind != MotionKind::FixedPoint
-            && potential.slope(site.angle()) == 0.0
-            && potential.curvature_at(site.angle()) == 0.0;
         saddle.or_else(|| {
+            let site = Site::at(theta);
+            let flat = component.kind != MotionKind::FixedPoint
+                && potential.slope(site.angle()) == 0.0
+                && potential.curvature_at(site.angle()) == 0.0;
             flat.then(|| CriticalPoint {
                 site,
                 value: energy,

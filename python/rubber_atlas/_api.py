@@ -1121,11 +1121,8 @@ def _text_attributes_crc32(f) -> int:
             info = h5py.check_string_dtype(obj.attrs.get_id(name).dtype)
             if info is None or info.length is not None:
                 continue
-            value = obj.attrs.get_id(name)
-            raw = np.empty((), dtype=h5py.string_dtype())
-            value.read(raw)
-            text = raw[()]
-            text = text if isinstance(text, bytes) else str(text).encode()
+            text = obj.attrs[name]
+            text = text if isinstance(text, bytes) else text.encode()
             for part in (object_name.encode(), name.encode(), text):
                 crc = zlib.crc32(part + b"\0", crc)
     return crc

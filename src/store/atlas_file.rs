@@ -357,9 +357,6 @@ impl AtlasFile {
                 .and_then(|d| d.read_scalar::<f64>())
                 .is_ok_and(|got| got.to_bits() == want.to_bits())
         };
-        let Ok(names) = self.file.member_names() else {
-            return false;
-        };
         self.is_whole()
             && self.coordinates_match(scene)
             && scalar("nu", scene.nu)
@@ -367,23 +364,37 @@ impl AtlasFile {
             && self.scales_attached(scene)
             && super::h5::text_attributes_crc32(&self.file)
                 .is_ok_and(|crc| self.integer_attribute(TEXT_CRC) == Some(i64::from(crc)))
-            && super::h5::attributes_read(&self.file)
-            && names.iter().all(|name| {
-                self.file
-                    .dataset(name)
-                    .is_ok_and(|d| super::h5::attributes_read(&d))
+            && super::h5::objects(&self.file).is_ok_and(|objects| {
+                objects
+                    .iter()
+                    .all(|(_, location)| super::h5::attributes_read(location))
             })
+    }
+
+    /// The grid's coordinates of this file's region of `scene`, by name, in the order of the
+    /// variables' dimensions (before `component`).
+    fn grid_coordinates<'s>(&self, scene: &'s Scene) -> Vec<(&'s str, &'s [f64])> {
+        let r = &self.region;
+        let [row, column] = scene.plane.axis_names();
+        let second = scene
+            .second_name()
+            .map(|name| (name, &scene.second.values[r.beta.clone()]));
+        [("alpha", &scene.alpha.values[r.alpha.clone()])]
+            .into_iter()
+            .chain(second)
+            .chain([
+                (row, &scene.kappa.values[r.rows.clone()]),
+                (column, &scene.energy.values[..]),
+            ])
+            .collect()
     }
 
     /// Whether each variable's dimensions carry their coordinates as dimension scales.
     fn scales_attached(&self, scene: &Scene) -> bool {
-        let [row, column] = scene.plane.axis_names();
-        let mut grid: Vec<&str> = vec!["alpha"];
-        grid.extend(scene.second_name());
-        grid.extend([row, column]);
-        let Ok(grid) = grid
+        let Ok(grid) = self
+            .grid_coordinates(scene)
             .iter()
-            .map(|name| self.file.dataset(name))
+            .map(|(name, _)| self.file.dataset(name))
             .collect::<hdf5::Result<Vec<_>>>()
         else {
             return false;
@@ -431,19 +442,7 @@ impl AtlasFile {
         if layout.as_deref() != Some(self.axis.layout.name()) || labels != Some(want) {
             return false;
         }
-        let r = &self.region;
-        let [row, column] = scene.plane.axis_names();
-        let second = scene
-            .second_name()
-            .map(|name| (name, &scene.second.values[r.beta.clone()]));
-        let expected: Vec<(&str, &[f64])> = [("alpha", &scene.alpha.values[r.alpha.clone()])]
-            .into_iter()
-            .chain(second)
-            .chain([
-                (row, &scene.kappa.values[r.rows.clone()]),
-                (column, &scene.energy.values[..]),
-            ])
-            .collect();
+        let expected = self.grid_coordinates(scene);
         expected.iter().all(|(name, want)| {
             self.file
                 .dataset(name)

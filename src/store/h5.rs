@@ -115,12 +115,8 @@ pub fn attributes_read(loc: &hdf5::Location) -> bool {
     })
 }
 
-/// The CRC-32 of every variable-length text attribute of the root and of each dataset:
-/// HDF5 keeps their letters in its global heap, which has no checksum. Over each object in
-/// name order (the root as ""), each such attribute in name order, the bytes of
-/// `object \0 name \0 value \0` (docs/files.md says so for other readers).
-pub fn text_attributes_crc32(file: &hdf5::File) -> hdf5::Result<u32> {
-    let mut crc = crc32fast::Hasher::new();
+/// The root (named "") and each dataset of `file`, in name order.
+pub fn objects(file: &hdf5::File) -> hdf5::Result<Vec<(String, hdf5::Location)>> {
     let root: &hdf5::Location = file;
     let mut objects = vec![(String::new(), root.clone())];
     let mut names = file.member_names()?;
@@ -130,7 +126,16 @@ pub fn text_attributes_crc32(file: &hdf5::File) -> hdf5::Result<u32> {
         let location: &hdf5::Location = &dataset;
         objects.push((name, location.clone()));
     }
-    for (object, location) in &objects {
+    Ok(objects)
+}
+
+/// The CRC-32 of every variable-length text attribute of the root and of each dataset:
+/// HDF5 keeps their letters in its global heap, which has no checksum. Over each object in
+/// name order (the root as ""), each such attribute in name order, the bytes of
+/// `object \0 name \0 value \0` (docs/files.md says so for other readers).
+pub fn text_attributes_crc32(file: &hdf5::File) -> hdf5::Result<u32> {
+    let mut crc = crc32fast::Hasher::new();
+    for (object, location) in &objects(file)? {
         let mut attrs = location.attr_names()?;
         attrs.sort();
         for name in attrs {

@@ -994,10 +994,7 @@ fn the_diagram_of_an_edged_body_names_its_shape() {
 /// within 1e-18 of π/2) says so instead of a diagram that silently lacks it.
 #[test]
 fn an_unresolved_cusp_is_said() {
-    let o = Command::new(env!("CARGO_BIN_EXE_rubber-atlas"))
-        .args(["diagram", "--alpha", "1e-15", "--beta", "1e3"])
-        .output()
-        .unwrap();
+    let o = run(&["diagram", "--alpha", "1e-15", "--beta", "1e3"]);
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success());
     assert!(
@@ -1016,10 +1013,7 @@ fn an_unresolved_cusp_is_said() {
     ]);
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(text.contains("cusp above kappa_max = 0.1"), "{text}");
-    let o = Command::new(env!("CARGO_BIN_EXE_rubber-atlas"))
-        .args(["diagram", "--alpha", "0.5", "--beta", "3"])
-        .output()
-        .unwrap();
+    let o = run(&["diagram", "--alpha", "0.5", "--beta", "3"]);
     assert!(!String::from_utf8_lossy(&o.stdout).contains("not resolved"));
 }
 
