@@ -374,7 +374,9 @@ pub fn solve_component<S: Shape>(
 /// The values of the component that holds a start (`component`, at the start's `energy`):
 /// those of [`solve_component`], except that a start at rest on an unstable equilibrium is
 /// that equilibrium, on its separatrix (T = ∞, `bounded`), even where the level's other
-/// motions land on a face (the upright disk at rest) and so have no values.
+/// motions land on a face (the upright disk at rest) and so have no values; and a start
+/// whose level is lost in rounding has no values and no turning points (NaN), status `tolerance_not_reached`
+/// ([`crate::trajectory::Start::is_resolved_by`]).
 pub fn solve_start<S: Shape>(
     potential: &EffectivePotential<'_, S>,
     start: &crate::trajectory::Start,
@@ -382,6 +384,13 @@ pub fn solve_start<S: Shape>(
     component: &Component,
     options: &CellOptions,
 ) -> Result<ComponentResult> {
+    if !start.is_resolved_by(potential, component) {
+        // The level set of the doubles is not the start's: no values, and no turning points.
+        let mut result = unresolved(component);
+        result.theta_min = f64::NAN;
+        result.theta_max = f64::NAN;
+        return Ok(result);
+    }
     match start.rest_on_saddle(potential, component, energy) {
         Some(saddle) if reaches_face(potential, component) => {
             Ok(on_separatrix(potential, component, &saddle, options))

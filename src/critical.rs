@@ -462,7 +462,8 @@ fn sample_branches<S: Shape>(
                     if last.stable != p.stable && contiguous {
                         let c = locate_cusp(curve, last.theta0, p.theta0, last.stable);
                         cusps.push(c);
-                        let at = (curve.point)(c.theta);
+                        let stable_side = if last.stable { last.theta0 } else { p.theta0 };
+                        let at = shared_point(curve, c.theta, stable_side);
                         let mut at_end = at;
                         at_end.stable = last.stable;
                         run.push(at_end);
@@ -696,6 +697,31 @@ fn make_branch(points: Vec<FixedPoint>, stable_name: &'static str) -> Branch {
     }
 }
 
+/// The permanent rotation at a change of stability θ0, the point two segments share, with
+/// the stable side's limit of N (the stable samples lie towards `stable_side`). At a kink θk
+/// V″ jumps through 0 and N is the stable piece's, taken 1e-9 into it (N varies by about
+/// 1e-9 of itself there); at a cusp V″ → 0, so ω_θ → 0 while ψ̇ = −κ cosθ0/(J sin²θ0)
+/// (`dpsi`) stays finite: N → ±∞ with the sign of cosθ0 (0 at κ = 0, where ψ stays put).
+fn shared_point<S: Shape>(curve: &Curve<'_, S>, theta: f64, stable_side: f64) -> FixedPoint {
+    let mut at = (curve.point)(theta);
+    let kinks = curve.body.shape.kinks();
+    at.rotation_number = Some(match kinks.iter().find(|k| (*k - theta).abs() <= 1e-9) {
+        Some(&kink) => {
+            let inside = kink + 1e-9 * (stable_side - kink).signum();
+            (curve.point)(inside).rotation_number.unwrap_or(f64::NAN)
+        }
+        None if at.kappa == 0.0 => 0.0,
+        None => f64::INFINITY.copysign(theta.cos()),
+    });
+    at
+}
+
+/// Whether a change of stability at θ0 is one at a kink of U (V″ jumping through 0, not a
+/// cusp): θ0 bisected to within 1e-9 of it.
+fn at_kink(kinks: &[f64], theta: f64) -> bool {
+    kinks.iter().any(|k| (k - theta).abs() <= 1e-9)
+}
+
 /// The zero of V″(θ0) along the fixed-point curve between two samples of opposite stability.
 fn locate_cusp<S: Shape>(curve: &Curve<'_, S>, lo: f64, hi: f64, lo_stable: bool) -> Cusp {
     let f = |t: f64| {
@@ -883,13 +909,31 @@ impl CriticalSet {
         };
         let (mut branches, changes) = sample_branches(&curve, samples, kappa_max, &stopped)?;
         // A change of stability at a kink is V″ jumping through 0, not a cusp.
-        let at_kink = |c: &Cusp| kinks.iter().any(|k| (k - c.theta).abs() <= 1e-9);
-        let cusps: Vec<Cusp> = changes.iter().filter(|c| !at_kink(c)).copied().collect();
-        let kink_changes: Vec<Cusp> = changes.iter().filter(|c| at_kink(c)).copied().collect();
+        let cusps: Vec<Cusp> = changes
+            .iter()
+            .filter(|c| !at_kink(&kinks, c.theta))
+            .copied()
+            .collect();
+        let kink_changes: Vec<Cusp> = changes
+            .iter()
+            .filter(|c| at_kink(&kinks, c.theta))
+            .copied()
+            .collect();
         let mut kappa_c_equator = None;
-        if body.shape.symmetric_about_equator() {
-            let a = crate::body::Angle::EQUATOR;
-            let curvature = body.shape.potential_second_at(a);
+        // V′(π/2) = U′(π/2) for every κ (the κ term's slope vanishes there): the equator is a
+        // permanent rotation at every κ where U′(π/2) = 0 exactly, as for a body symmetric
+        // about it or a ball centred on its sphere's centre (α = 0) whose sphere holds π/2.
+        let a = crate::body::Angle::EQUATOR;
+        if body.shape.symmetric_about_equator() || body.shape.potential_prime_at(a) == 0.0 {
+            // At a kink, the side where U bends down the more decides the stability.
+            let curvature = if at_kink(&kinks, FRAC_PI_2) {
+                let step = 1e-9;
+                body.shape
+                    .potential_second(FRAC_PI_2 - step)
+                    .min(body.shape.potential_second(FRAC_PI_2 + step))
+            } else {
+                body.shape.potential_second_at(a)
+            };
             kappa_c_equator = (curvature < 0.0).then(|| (-curvature).sqrt());
             branches.extend(equator_branches(
                 body.shape.potential_at(a),

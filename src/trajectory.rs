@@ -20,6 +20,11 @@ pub enum Model {
     Full,
 }
 
+/// How far outside its component a start may lie and still be held by it: the turning
+/// points of a start at rest are found from ε = V(θ0) to within the rounding of V over
+/// |V′|, far below this unless that level is lost in rounding.
+pub const HOLD: f64 = 1e-6;
+
 /// Where a trajectory starts: θ(0), θ̇(0), at φ = ψ = 0 and the centre of mass at the origin.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Start {
@@ -129,25 +134,51 @@ impl Start {
     ) -> Result<Component> {
         let energy = self.energy(potential.body);
         let comps = potential.components(energy)?;
-        // At κ = 0, θ is an angle on the circle: θ(0) and θ(0) − 2πk are one start (6.5 lies
-        // in the torus [−0.22, 0.22], not in the nearer [2.46, 3.83] of the lifted line). The
-        // components of the lifted circle lie within [−2π, 3π].
-        let theta0 = self.circle_angle();
-        let distance = |c: &Component| {
-            if self.kappa != 0.0 {
-                return c.distance_to(theta0);
-            }
-            [-1.0, 0.0, 1.0]
-                .iter()
-                .map(|k| c.distance_to(theta0 + k * std::f64::consts::TAU))
-                .fold(f64::INFINITY, f64::min)
-        };
         let nearest = comps
             .into_iter()
-            .min_by(|a, b| distance(a).total_cmp(&distance(b)));
+            .min_by(|a, b| self.distance_to(a).total_cmp(&self.distance_to(b)));
         nearest.ok_or(AtlasError::NotPeriodic {
             reason: "no component holds theta0",
         })
+    }
+
+    /// How far θ(0) lies outside `component`. At κ = 0, θ is an angle on the circle: θ(0)
+    /// and θ(0) − 2πk are one start (6.5 lies in the torus [−0.22, 0.22], not in the nearer
+    /// [2.46, 3.83] of the lifted line). The components of the lifted circle lie within
+    /// [−2π, 3π].
+    fn distance_to(&self, component: &Component) -> f64 {
+        let theta0 = self.circle_angle();
+        if self.kappa != 0.0 {
+            return component.distance_to(theta0);
+        }
+        [-1.0, 0.0, 1.0]
+            .iter()
+            .map(|k| component.distance_to(theta0 + k * std::f64::consts::TAU))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// Whether `component` (from [`Self::component_in`]) is this start's motion as far as
+    /// doubles can tell. It must hold θ(0), up to [`HOLD`]: a start at rest is a turning
+    /// point, found again from ε = V(θ0) within the rounding of V over |V′|; where V′ is lost
+    /// in that rounding (κ² below an ulp of U on a ball's sphere, where U′ ≡ 0) the level set
+    /// of the doubles is not the start's, and the nearest component may lie far from it. And
+    /// with κ ≠ 0, a start at rest must not sit where V′ and V″ are both 0 off a minimum (κ²
+    /// so small that the κ term, which alone moves the body there, rounds away).
+    pub fn is_resolved_by<S: Shape>(
+        &self,
+        potential: &EffectivePotential<'_, S>,
+        component: &Component,
+    ) -> bool {
+        if self.distance_to(component) > HOLD {
+            return false;
+        }
+        let a = Site::at(self.circle_angle()).angle();
+        let flat = self.kappa != 0.0
+            && self.theta_dot0 == 0.0
+            && component.kind != MotionKind::FixedPoint
+            && potential.slope(a) == 0.0
+            && potential.curvature_at(a) == 0.0;
+        !flat
     }
 
     /// The unstable equilibrium this start rests on, if it does: θ̇(0) = 0 at κ = 0 on the
@@ -199,7 +230,14 @@ impl Start {
 
     /// The θ-period of the component that holds θ(0), from the quadrature of [`crate::torus`].
     pub fn period<S: Shape>(&self, body: &Body<S>, tol: f64) -> Result<f64> {
-        let comp = self.component(body)?;
+        let potential = EffectivePotential::new(body, self.kappa);
+        let comp = self.component_in(&potential)?;
+        if !self.is_resolved_by(&potential, &comp) {
+            return Err(AtlasError::NotPeriodic {
+                reason: "the level of the start is not resolved in double precision at \
+                         theta0 (kappa's term lost in rounding); give --t-end",
+            });
+        }
         if comp.kind == MotionKind::FixedPoint {
             return Err(AtlasError::NotPeriodic {
                 reason: "the start is a fixed point (a permanent rotation); give --t-end",
@@ -212,7 +250,6 @@ impl Start {
                          asymptotic to one): its period is infinite; give --t-end",
             });
         }
-        let potential = EffectivePotential::new(body, self.kappa);
         Ok(potential.integrate(energy, &comp, tol, false)?.period)
     }
 }

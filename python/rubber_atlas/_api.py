@@ -205,7 +205,10 @@ def _count(name: str, value) -> int:
     if isinstance(value, (bool, np.bool_)) or not whole:
         raise TypeError(f"{name} must be a whole number, not {value!r}")
     if abs(int(value)) >= 2**63:
-        raise ValueError(f"invalid {name} = {_shown(int(value))}: beyond a 64-bit integer")
+        # Near the limit every digit matters (2**63 is one past it); far beyond, 3 do.
+        shown = str(int(value)) if abs(int(value)) < 10**20 else _shown(int(value))
+        raise ValueError(f"invalid {name} = {shown}: beyond the largest signed 64-bit integer, "
+                         f"{2**63 - 1} (in size)")
     return int(value)
 
 

@@ -167,6 +167,9 @@ def test_a_request_beyond_memory_is_refused_before_its_inputs_are_materialised(c
 
 @pytest.mark.parametrize("call, error, words", [
     (lambda: ra.cells(*BODY, 0.8, 2.5, threads=2**70), ValueError, ["threads"]),
+    (lambda: ra.cells(*BODY, 0.8, 2.5, threads=2**63), ValueError,
+     ["threads = 9223372036854775808", "largest signed 64-bit integer, 9223372036854775807"]),
+    (lambda: ra.cells(*BODY, 0.8, 2.5, threads=-2**63), ValueError, ["threads = -9223372036854775808"]),
     (lambda: ra.cells(*BODY, 0.8, 2.5, threads=2.5), TypeError, ["threads"]),
     (lambda: ra.cells(*BODY, 0.8, 2.5, threads="x"), TypeError, ["threads"]),
     (lambda: ra.cells(*BODY, 0.8, 2.5, threads=True), TypeError, ["threads"]),

@@ -580,9 +580,18 @@ fn the_equators_permanent_rotation_rolls_on_a_line() {
 
 /// The values `cell` gives the component of a start at rest at θ0 with κ = 0.
 fn component_at_rest(body: &Body<EdgedShape>, theta0: f64) -> rubber_atlas::cell::ComponentResult {
-    let potential = EffectivePotential::new(body, 0.0);
+    component_at_rest_with(body, 0.0, theta0)
+}
+
+/// [`component_at_rest`] at κ.
+fn component_at_rest_with(
+    body: &Body<EdgedShape>,
+    kappa: f64,
+    theta0: f64,
+) -> rubber_atlas::cell::ComponentResult {
+    let potential = EffectivePotential::new(body, kappa);
     let start = Start {
-        kappa: 0.0,
+        kappa,
         theta0,
         theta_dot0: 0.0,
     };
@@ -899,4 +908,163 @@ fn a_resonant_truncated_ball_runs_away_in_the_full_equations() {
             periods * comp.drift
         );
     }
+}
+
+/// A ball centred on its sphere's centre (α = 0) has U′(π/2) = 0 where its sphere holds the
+/// equator, so V′(π/2) = 0 at every κ: the equator is a permanent rotation, σ_π/2, though the
+/// ball is not its own mirror image (the diagram had no such branch). Stable at every κ > 0
+/// where the sphere holds both sides (U″ = 0 there); for the hemisphere, whose edge meets
+/// the sphere at π/2 (U = sinθ on the edge side, U″ = −1), unstable up to κ_c = 1. Checked
+/// against V itself on either side of π/2.
+#[test]
+fn a_centred_cut_balls_equator_is_a_permanent_rotation_at_every_kappa() {
+    use rubber_atlas::body::Angle;
+    use rubber_atlas::critical::CriticalSet;
+    for (cut, kappa_c) in [(0.5, None), (0.2, None), (0.0, Some(1.0))] {
+        let body = Body::new(EdgedShape::truncated_ball(0.0, cut).unwrap(), 0.7, 1.3).unwrap();
+        let set = CriticalSet::of_edged(&body, 400, 3.0, &|| false).unwrap();
+        assert_eq!(set.kappa_c_equator, kappa_c, "cut {cut}");
+        let equator: Vec<_> = set
+            .branches
+            .iter()
+            .filter(|b| b.name == "sigma_pi2")
+            .collect();
+        assert_eq!(equator.len(), 1 + kappa_c.is_some() as usize, "cut {cut}");
+        for kappa in [0.3, 0.9, 1.1, 2.5] {
+            let potential = EffectivePotential::new(&body, kappa);
+            let at = potential.value(Angle::EQUATOR);
+            // V′(π/2) = 0 on each side (V″ may jump there): each one-sided slope is V″ h/2.
+            let h = 1e-6;
+            for side in [-1.0, 1.0] {
+                let beside = potential.value(Angle::new(FRAC_PI_2 + side * h));
+                let slope = (beside - at) / h;
+                let bound = 2.0 * h * (1.0 + kappa * kappa);
+                assert!(slope.abs() < bound, "cut {cut}, κ {kappa}: V′ = {slope}");
+            }
+            let step = 1e-3;
+            let below = potential.value(Angle::new(FRAC_PI_2 - step));
+            let above = potential.value(Angle::new(FRAC_PI_2 + step));
+            let minimum = below > at && above > at;
+            let row = equator
+                .iter()
+                .flat_map(|b| &b.points)
+                .find(|p| p.kappa >= kappa)
+                .unwrap();
+            assert_eq!(row.theta0, FRAC_PI_2);
+            assert_eq!(row.stable, minimum, "cut {cut}, κ {kappa}: {row:?}");
+            assert_eq!(
+                minimum,
+                kappa > kappa_c.unwrap_or(0.0),
+                "cut {cut}, κ {kappa}"
+            );
+            assert_eq!(row.rotation_number, minimum.then_some(0.0));
+        }
+    }
+    // Off the centre U′(π/2) ≠ 0: no permanent rotation on the equator.
+    let body = Body::new(EdgedShape::truncated_ball(1e-9, 0.5).unwrap(), 0.7, 1.3).unwrap();
+    let set = CriticalSet::of_edged(&body, 400, 3.0, &|| false).unwrap();
+    assert!(set.branches.iter().all(|b| b.name != "sigma_pi2"));
+}
+
+/// Where a branch ends on a cusp, V″ → 0 along it: ω_θ → 0 while ψ̇ = −κ cosθ0/(J sin²θ0)
+/// stays finite, so N → ±∞, the sign of cosθ0. Both rows of the shared point carry that limit
+/// (at α = 0 the rounding of V″ gave 1.95e7, at α = 1e-12 NaN), and the sampled stable
+/// points climb towards it. At a kink V″ jumps instead: N there is the stable piece's, finite.
+#[test]
+fn a_cusp_carries_the_stable_sides_infinite_rotation_number() {
+    use rubber_atlas::critical::CriticalSet;
+    for shape in [
+        EdgedShape::truncated_ball(0.0, 0.5).unwrap(),
+        EdgedShape::truncated_ball(1e-12, 0.5).unwrap(),
+        EdgedShape::wheel(0.0, 0.5).unwrap(),
+        EdgedShape::wheel(-0.2, 0.3).unwrap(),
+        EdgedShape::disk(0.3).unwrap(),
+    ] {
+        let body = Body::new(shape, 0.5, 0.5).unwrap();
+        let set = CriticalSet::of_edged(&body, 2000, 3.0, &|| false).unwrap();
+        assert!(!set.cusps.is_empty(), "{shape:?}");
+        let rows: Vec<_> = set.branches.iter().flat_map(|b| &b.points).collect();
+        for cusp in &set.cusps {
+            let at: Vec<_> = rows.iter().filter(|p| p.theta0 == cusp.theta).collect();
+            assert_eq!(at.len(), 2, "{shape:?}: {cusp:?}");
+            let limit = f64::INFINITY.copysign(cusp.theta.cos());
+            for p in &at {
+                assert_eq!(p.rotation_number, Some(limit), "{shape:?}: {p:?}");
+            }
+            // The stable side's sampled points nearest the cusp: |N| large and growing.
+            let mut near: Vec<_> = rows
+                .iter()
+                .filter(|p| p.stable && p.theta0 != cusp.theta)
+                .filter(|p| (p.theta0 - cusp.theta).abs() < 0.05)
+                .map(|p| ((p.theta0 - cusp.theta).abs(), p.rotation_number.unwrap()))
+                .collect();
+            near.sort_by(|a, b| a.0.total_cmp(&b.0));
+            assert!(near.len() > 4, "{shape:?}: {near:?}");
+            assert!(near[0].1.abs() > 5.0, "{shape:?}: {near:?}");
+            assert!(near.windows(2).all(|w| w[0].1.abs() > w[1].1.abs()));
+        }
+        for change in &set.stability_changes_at_kinks {
+            let at: Vec<_> = rows.iter().filter(|p| p.theta0 == change.theta).collect();
+            assert_eq!(at.len(), 2, "{shape:?}: {change:?}");
+            let n = at[0].rotation_number.unwrap();
+            assert!(n.is_finite(), "{shape:?}: {at:?}");
+            assert_eq!(at[1].rotation_number, Some(n));
+            // The stable piece's samples beside the kink lead to it.
+            let nearest = rows
+                .iter()
+                .filter(|p| p.stable && p.theta0 != change.theta)
+                .min_by(|a, b| {
+                    let d =
+                        |p: &&&rubber_atlas::critical::FixedPoint| (p.theta0 - change.theta).abs();
+                    d(a).total_cmp(&d(b))
+                })
+                .unwrap();
+            let gap = (nearest.rotation_number.unwrap() - n).abs();
+            assert!(
+                gap < 0.05 * n.abs().max(0.01),
+                "{shape:?}: {nearest:?} vs {n}"
+            );
+        }
+    }
+}
+
+/// On a centred ball's sphere U′ ≡ 0, and at rest with κ ≠ 0 only the κ term moves the body:
+/// a slow libration round the equator between θ0 and π − θ0. Where κ² rounds away beside U
+/// (κ ≤ 1e-8 against U = 1) V is flat in doubles, and the level set of ε = V(θ0) is not the
+/// start's: its nearest component lay elsewhere (1e-8 … π/2, a `separatrix`), or κ² = 0
+/// made it one. That start has no values and no turning points, `tolerance_not_reached`,
+/// and `trajectory --periods` refuses it; where the term is resolved the component holds θ0.
+#[test]
+fn a_start_at_rest_whose_level_rounds_away_is_unresolved() {
+    use rubber_atlas::cell::Status;
+    let body = Body::new(EdgedShape::truncated_ball(0.0, 0.5).unwrap(), 0.5, 0.5).unwrap();
+    for kappa in [1e-8, 1e-12, 1e-30, 1e-300] {
+        let c = component_at_rest_with(&body, kappa, 2.0);
+        assert_eq!(c.status, Status::ToleranceNotReached, "κ {kappa}: {c:?}");
+        assert!(
+            c.theta_min.is_nan() && c.theta_max.is_nan(),
+            "κ {kappa}: {c:?}"
+        );
+        assert!(
+            c.rotation_number.is_nan() && c.bounded.is_none(),
+            "κ {kappa}: {c:?}"
+        );
+        let start = Start {
+            kappa,
+            theta0: 2.0,
+            theta_dot0: 0.0,
+        };
+        assert!(start.period(&body, 1e-10).is_err(), "κ {kappa}");
+    }
+    // Resolved: the turning point is θ0 to within the rounding of V over |V′|, and the
+    // other one its mirror π − θ0 (the sphere's V is symmetric about π/2).
+    for kappa in [1e-4, 1e-2, 0.5] {
+        let c = component_at_rest_with(&body, kappa, 2.0);
+        assert!((c.theta_max - 2.0).abs() < 1e-6, "κ {kappa}: {c:?}");
+        assert!((c.theta_min - (PI - 2.0)).abs() < 1e-6, "κ {kappa}: {c:?}");
+        assert!(c.rotation_number.abs() < 1e-9, "κ {kappa}: {c:?}");
+    }
+    // κ = 0: the neutral equilibrium itself.
+    let c = component_at_rest_with(&body, 0.0, 2.0);
+    assert_eq!(c.status, Status::Separatrix);
 }
