@@ -39,6 +39,41 @@ fn two_prod(a: f64, b: f64) -> (f64, f64) {
     (p, a.mul_add(b, -p))
 }
 
+/// Σ xᵢ by Ogita, Rump and Oishi's Sum2 (2005): TwoSum's rounding errors are summed apart
+/// and added once at the end, so the result is within u|Σ xᵢ| + γ²ₙ₋₁ Σ|xᵢ| of the exact
+/// sum (γₙ = nu/(1 − nu)), as if summed in twice the precision and rounded once. The plain
+/// loop's bound is γₙ₋₁ Σ|xᵢ|: over the ~850 nodes of a deep tanh-sinh level, 1.9e-13 of
+/// Σ|xᵢ|, far beyond the few ulps the quadrature's rounding bounds allow it.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct CompensatedSum {
+    sum: f64,
+    carry: f64,
+}
+
+impl CompensatedSum {
+    /// Adds x.
+    #[inline]
+    pub fn add(&mut self, x: f64) {
+        let (s, e) = two_sum(self.sum, x);
+        self.sum = s;
+        self.carry += e;
+    }
+
+    /// The sum, rounded once.
+    #[inline]
+    pub fn value(self) -> f64 {
+        self.sum + self.carry
+    }
+}
+
+impl std::iter::Sum<f64> for CompensatedSum {
+    fn sum<I: Iterator<Item = f64>>(iter: I) -> Self {
+        let mut total = Self::default();
+        iter.for_each(|x| total.add(x));
+        total
+    }
+}
+
 impl DoubleDouble {
     /// A double, exactly.
     pub const fn from_f64(x: f64) -> Self {

@@ -10,6 +10,7 @@ use super::{
     DriftEstimate, EffectivePotential, NodeSample, PeriodIntegrals, Piece, EPS, HIDDEN_PEAK,
 };
 use crate::body::{Angle, Shape};
+use crate::dd::CompensatedSum;
 use crate::error::Result;
 use crate::quadrature::{real_fft, real_inverse_fft, IntervalNode, FINEST_COSINE_INTERVALS};
 use rustfft::num_complex::Complex;
@@ -184,13 +185,15 @@ impl Samples {
     /// Σ ½ (relative gap error) |f| with the trapezoid weights.
     fn level_sums(&self) -> LevelSums {
         let mut sums = LevelSums::default();
+        let mut t = [CompensatedSum::default(); 3];
+        let mut psi = [CompensatedSum::default(); 3];
         let last = self.nodes.len() - 1;
         for (j, node) in self.nodes.iter().enumerate() {
             let w = if j == 0 || j == last { 0.5 } else { 1.0 };
             for (level, stride) in [1, 2, 4].into_iter().enumerate() {
                 if j % stride == 0 {
-                    sums.t[level] += w * node.dt;
-                    sums.psi[level] += w * node.dpsi;
+                    t[level].add(w * node.dt);
+                    psi[level].add(w * node.dpsi);
                 }
             }
             let r = 0.5 * w * node.rounding;
@@ -200,8 +203,8 @@ impl Samples {
         }
         let h = PI / self.intervals as f64;
         for (level, stride) in [1.0, 2.0, 4.0].into_iter().enumerate() {
-            sums.t[level] *= h * stride;
-            sums.psi[level] *= h * stride;
+            sums.t[level] = t[level].value() * (h * stride);
+            sums.psi[level] = psi[level].value() * (h * stride);
         }
         sums.t_rounding *= h;
         sums.psi_rounding *= h;
