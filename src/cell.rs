@@ -860,6 +860,12 @@ fn finish(
             )
         }
     };
+    // An unbounded error of Δψ (a turn hidden by a face, `torus`) leaves N and ω_ψ unknown.
+    let (n, omega_psi) = if n_err.is_finite() {
+        (n, omega_psi)
+    } else {
+        (f64::NAN, f64::NAN)
+    };
     // A libration with ψ ≡ 0 (κ = 0) retraces its way out on the way back: Δζ = 0 exactly,
     // whatever the rounding (quadrature) or truncation (ODE method) of its integral.
     let planar = component.kind == MotionKind::Libration

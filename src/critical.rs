@@ -418,15 +418,27 @@ fn sample_branches<S: Shape>(
         } else {
             (equator, pole)
         };
+        // The extra angles are probes too: a branch climbs steeply from an inclined
+        // equilibrium (κ = 0) as well as towards π/2.
+        // (An extra angle is on the curve, κ² ≥ 0: an equilibrium's κ² = 0 may round below.)
+        let mut probes: Vec<(f64, bool)> = (1..samples)
+            .map(|i| (lo + (hi - lo) * i as f64 / samples as f64, false))
+            .chain(
+                curve
+                    .extra
+                    .iter()
+                    .filter(|&&t| t > lo && t < hi)
+                    .map(|&t| (t, true)),
+            )
+            .collect();
+        probes.sort_by(|a, b| a.0.total_cmp(&b.0));
+        probes.dedup_by(|a, b| a.0 == b.0);
+        probes.push((last, false));
         let mut previous = (first, (curve.kappa_sq)(first));
-        for i in 1..=samples {
-            stopped(i)?;
-            let t = if i < samples {
-                lo + (hi - lo) * i as f64 / samples as f64
-            } else {
-                last
-            };
+        for (i, &(t, on_curve)) in probes.iter().enumerate() {
+            stopped(i + 1)?;
             let k2 = (curve.kappa_sq)(t);
+            let k2 = if on_curve { k2.max(0.0) } else { k2 };
             pts.extend(climb_to_kappa_max(
                 curve,
                 previous,
@@ -435,7 +447,7 @@ fn sample_branches<S: Shape>(
                 samples,
             ));
             previous = (t, k2);
-            if i == samples || k2 < 0.0 {
+            if i + 1 == probes.len() || k2 < 0.0 {
                 continue;
             }
             let p = (curve.point)(t);
@@ -446,24 +458,33 @@ fn sample_branches<S: Shape>(
         if (curve.pole_ends)(pole) && !pts.is_empty() {
             pts.push((curve.point)(pole));
         }
-        for &t in &curve.extra {
-            if t > lo && t < hi {
-                pts.push((curve.point)(t));
-            }
-        }
         pts.sort_by(|a, b| a.theta0.total_cmp(&b.theta0));
         pts.dedup_by(|a, b| a.theta0 == b.theta0);
         // Runs of equal stability; a flip inside a half is the cusp (V″ = 0 on the curve).
         let mut run: Vec<FixedPoint> = Vec::new();
         for p in pts {
-            if let Some(last) = run.last() {
+            if let Some(last) = run.last().copied() {
                 let contiguous = (p.theta0 - last.theta0) <= 1.5 * (hi - lo) / samples as f64;
                 if last.stable != p.stable || !contiguous {
                     if last.stable != p.stable && contiguous {
-                        let c = locate_cusp(curve, last.theta0, p.theta0, last.stable);
+                        let mut c = locate_cusp(curve, last.theta0, p.theta0, last.stable);
+                        // The samples run up in θ0: the stable side is below if `last` is.
+                        let stable_side = if last.stable { -1.0 } else { 1.0 };
+                        // A change at a kink is on the kink itself (a sample of its own).
+                        let kink = curve.body.shape.kinks().iter().copied();
+                        if let Some(k) = kink.clone().find(|&k| at_kink(&[k], c.theta)) {
+                            let at = (curve.point)(k);
+                            c = Cusp {
+                                theta: k,
+                                kappa: at.kappa,
+                                energy: at.energy,
+                            };
+                        }
                         cusps.push(c);
-                        let stable_side = if last.stable { last.theta0 } else { p.theta0 };
                         let at = shared_point(curve, c.theta, stable_side);
+                        if run.last().is_some_and(|q| q.theta0 == c.theta) {
+                            run.pop();
+                        }
                         let mut at_end = at;
                         at_end.stable = last.stable;
                         run.push(at_end);
@@ -471,6 +492,9 @@ fn sample_branches<S: Shape>(
                         let mut at_start = at;
                         at_start.stable = p.stable;
                         run.push(at_start);
+                        if p.theta0 == c.theta {
+                            continue;
+                        }
                     } else {
                         branches.push(make_branch(std::mem::take(&mut run), stable_name));
                     }
@@ -698,7 +722,8 @@ fn make_branch(points: Vec<FixedPoint>, stable_name: &'static str) -> Branch {
 }
 
 /// The permanent rotation at a change of stability θ0, the point two segments share, with
-/// the stable side's limit of N (the stable samples lie towards `stable_side`). At a kink θk
+/// the stable side's limit of N (the stable samples lie below θ0 if `stable_side` is −1,
+/// above if +1). At a kink θk
 /// V″ jumps through 0 and N is the stable piece's, taken 1e-9 into it (N varies by about
 /// 1e-9 of itself there); at a cusp V″ → 0, so ω_θ → 0 while ψ̇ = −κ cosθ0/(J sin²θ0)
 /// (`dpsi`) stays finite: N → ±∞ with the sign of cosθ0 (0 at κ = 0, where ψ stays put).
@@ -707,7 +732,7 @@ fn shared_point<S: Shape>(curve: &Curve<'_, S>, theta: f64, stable_side: f64) ->
     let kinks = curve.body.shape.kinks();
     at.rotation_number = Some(match kinks.iter().find(|k| (*k - theta).abs() <= 1e-9) {
         Some(&kink) => {
-            let inside = kink + 1e-9 * (stable_side - kink).signum();
+            let inside = kink + 1e-9 * stable_side;
             (curve.point)(inside).rotation_number.unwrap_or(f64::NAN)
         }
         None if at.kappa == 0.0 => 0.0,
@@ -890,6 +915,13 @@ impl CriticalSet {
         let samples = samples.max(16);
         let faces = body.shape.faces();
         let kinks = body.shape.kinks().to_vec();
+        let equilibria = edged_equilibria(body);
+        // Beside the kinks, the inclined equilibria: the branch that rises from one (κ = 0)
+        // is steep there, and the grid's nearest sample may lie far up it.
+        let inclined = equilibria
+            .iter()
+            .filter(|e| e.name == "inclined")
+            .map(|e| e.theta);
         let curve = Curve {
             body,
             kappa_sq: &|t| general_kappa_sq(body, t),
@@ -905,6 +937,7 @@ impl CriticalSet {
                     general_kappa_sq(body, t) >= 0.0
                         && general_fixed_point(body, t).kappa <= kappa_max
                 })
+                .chain(inclined)
                 .collect(),
         };
         let (mut branches, changes) = sample_branches(&curve, samples, kappa_max, &stopped)?;
@@ -944,7 +977,6 @@ impl CriticalSet {
                 &stopped,
             )?);
         }
-        let equilibria = edged_equilibria(body);
         let energy_min = equilibria
             .iter()
             .map(|e| e.energy)
@@ -981,15 +1013,21 @@ fn asked_to_stop(i: usize, stop: &dyn Fn() -> bool) -> Result<()> {
     }
 }
 
-/// κ_max must be a finite number > 0.
+/// The smallest κ_max. By a pole κ² = sin³θ0 U′/cos θ0, and θ0 by θ = π is known to an ulp
+/// of π, 4.4e-16: no branch there is drawn below κ ≈ 4e-32 by a smooth pole (κ ≈ x² √U″, x
+/// from the pole) or 1e-24 by a face (κ ≈ x^{3/2} √|U′|); and by θ = 0 κ² underflows below
+/// κ ≈ 1e-154. With a lower cut the stable branches vanished.
+pub const MIN_KAPPA_MAX: f64 = 1e-20;
+
+/// κ_max must be a finite number in [[`MIN_KAPPA_MAX`], κ's largest value].
 fn check_kappa_max(kappa_max: f64) -> Result<()> {
-    // κ's range of every surface, without 0.
     crate::error::check_range(
         "kappa-max",
         kappa_max,
-        Some((f64::MIN_POSITIVE, true)),
+        Some((MIN_KAPPA_MAX, true)),
         Some((crate::error::MAX_KAPPA, true)),
-        "must be at most 1e150 and at least 2.2250738585072014e-308 (kappa's range)",
+        "must be at most 1e150 (kappa's largest) and at least 1e-20 (below it the branches \
+         by the poles are not resolved in doubles)",
     )
     .map(|_| ())
 }

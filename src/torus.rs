@@ -1020,9 +1020,13 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         psi_advance_error += psi_rounding + saddle_psi;
         // A turning point nearer its pole than the rule's last node (e^{−π sinh τ_max} of the
         // piece) hides the peak of ψ̇ ~ κ/sin²θ there, which turns ψ by up to ±π/2 as θ
-        // passes it: the sums cannot see it, so its whole size goes into the estimate.
-        let hidden = if self.kappa == 0.0 {
-            0
+        // passes it by a smooth pole: the sums cannot see it, so its whole size goes into the
+        // estimate. By a face (U rising linearly from the pole, B and J² unequal there) the
+        // turn has no such bound: at ν = 2, η = 4 a disk's passage turns ψ by 7.0, N = √5/2
+        // in the limit κ → 0. There Δψ is unknown.
+        let faces = self.body.shape.faces();
+        let hidden: Vec<bool> = if self.kappa == 0.0 {
+            Vec::new()
         } else {
             pieces
                 .iter()
@@ -1030,10 +1034,15 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 .filter(|(end, length)| {
                     end.excess == 0.0 && end.site.theta.min(end.site.from_pi) < HIDDEN_PEAK * length
                 })
-                .count()
+                .map(|(end, _)| faces[usize::from(end.site.from_pi < end.site.theta)])
+                .collect()
         };
-        if hidden > 0 {
-            psi_advance_error += PI * hidden as f64;
+        if !hidden.is_empty() {
+            psi_advance_error += if hidden.iter().any(|&face| face) {
+                f64::INFINITY
+            } else {
+                PI * hidden.len() as f64
+            };
             converged = false;
         }
         let mut drift = None;
@@ -1055,7 +1064,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 result = drift_estimate(&samples, psi, double, &mut known);
             }
             result.error += phase * result.scale;
-            if hidden > 0 {
+            if !hidden.is_empty() {
                 // The hidden turn rotates the rest of the path: Δζ is unknown to its size.
                 result.error += result.scale;
             }

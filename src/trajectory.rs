@@ -158,12 +158,12 @@ impl Start {
     }
 
     /// Whether `component` (from [`Self::component_in`]) is this start's motion as far as
-    /// doubles can tell. It must hold θ(0), up to [`HOLD`]: a start at rest is a turning
-    /// point, found again from ε = V(θ0) within the rounding of V over |V′|; where V′ is lost
-    /// in that rounding (κ² below an ulp of U on a ball's sphere, where U′ ≡ 0) the level set
-    /// of the doubles is not the start's, and the nearest component may lie far from it. And
-    /// with κ ≠ 0, a start at rest must not sit where V′ and V″ are both 0 off a minimum (κ²
-    /// so small that the κ term, which alone moves the body there, rounds away).
+    /// doubles can tell. It must hold θ(0), up to [`HOLD`]. And a start at rest with κ ≠ 0,
+    /// off a minimum, is a turning point, found again from ε = V(θ0) only to within
+    /// min(δε/|V′|, √(2δε/|V″|)), δε the rounding of V (4 eps of its scale): that must be
+    /// within [`HOLD`] too. On a ball's sphere, where U′ ≡ 0 and only the κ term moves the
+    /// body, κ² below an ulp of U leaves V flat in doubles: the level set of ε = V(θ0) is
+    /// then not the start's (it was [κ, π/2], a `separatrix`, at κ = 1e-8).
     pub fn is_resolved_by<S: Shape>(
         &self,
         potential: &EffectivePotential<'_, S>,
@@ -172,13 +172,14 @@ impl Start {
         if self.distance_to(component) > HOLD {
             return false;
         }
+        if self.kappa == 0.0 || self.theta_dot0 != 0.0 || component.kind == MotionKind::FixedPoint {
+            return true;
+        }
         let a = Site::at(self.circle_angle()).angle();
-        let flat = self.kappa != 0.0
-            && self.theta_dot0 == 0.0
-            && component.kind != MotionKind::FixedPoint
-            && potential.slope(a) == 0.0
-            && potential.curvature_at(a) == 0.0;
-        !flat
+        let rounding = 4.0 * f64::EPSILON * potential.value_scale(a);
+        let by_slope = rounding / potential.slope(a).abs();
+        let by_curvature = (2.0 * rounding / potential.curvature_at(a).abs()).sqrt();
+        by_slope.min(by_curvature) <= HOLD
     }
 
     /// The unstable equilibrium this start rests on, if it does: θ̇(0) = 0 at κ = 0 on the

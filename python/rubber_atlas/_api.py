@@ -11,6 +11,7 @@ import re
 import sys
 import time
 import functools
+import warnings
 from decimal import Decimal
 from fractions import Fraction
 from pathlib import Path
@@ -1141,6 +1142,9 @@ def _file(path) -> Path:
         raise ValueError(f"{path}: a folder, not a file")
     if not path.exists():
         raise ValueError(f"{path}: no such file")
+    if not path.is_file():
+        # A FIFO would block the reader until someone writes to it.
+        raise ValueError(f"{path}: not a regular file (a device, FIFO or socket)")
     return path
 
 
@@ -1374,8 +1378,9 @@ def read_table(path: str | Path) -> xr.Dataset:
     Raises
     ------
     ValueError
-        The file is missing, a folder, not a table (an atlas: `open_atlas` opens those), or
-        damaged; the message names it.
+        The file is missing, a folder or not a regular file, not a table of rubber-atlas (an
+        atlas: `open_atlas` opens those; an HDF5 file without the root attribute
+        ``program = "rubber-atlas"``), or damaged; the message names it.
     TypeError
         `path` is not a file's name.
 
@@ -1396,7 +1401,10 @@ def read_table(path: str | Path) -> xr.Dataset:
     try:
         if path.suffix.lower() == ".csv":
             return _read_csv(path)
-        ds = xr.open_dataset(path, engine="h5netcdf")
+        with warnings.catch_warnings():
+            # (A foreign file's unnamed dimensions: it is refused below in one line.)
+            warnings.filterwarnings("ignore", message=".*phony_dims", category=UserWarning)
+            ds = xr.open_dataset(path, engine="h5netcdf")
     except _DamagedTable as e:
         raise ValueError(str(e)) from None
     except (OSError, ValueError) as e:
@@ -1405,6 +1413,9 @@ def read_table(path: str | Path) -> xr.Dataset:
         if _is_atlas(ds):
             raise ValueError(f"{path}: an atlas (a file of rubber-atlas run or merge), not a table; {tables}, "
                              "and open_atlas opens an atlas")
+        if ds.attrs.get("program") != "rubber-atlas":
+            raise ValueError(f"{path}: not a table of rubber-atlas (no root attribute program = "
+                             f"'rubber-atlas'); {tables}")
         with _reading(ds):
             return ds.load()
 
@@ -1596,7 +1607,7 @@ def diagram(alpha: float, beta: float | None, nu: float | None = None, eta: floa
     samples : int, default 2000
         Number of θ0 samples along the curves, ≥ 2.
     kappa_max : float, default 3.0
-        The largest |κ| the curves are drawn to, > 0.
+        The largest |κ| the curves are drawn to, from 1e-20 to 1e150.
     allow_large : bool, default False
         Allow `samples` beyond 80 % of the available memory.
     shape : {"ellipsoid", "disk", "truncated_ball", "wheel"}, default "ellipsoid"

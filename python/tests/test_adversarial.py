@@ -295,6 +295,26 @@ def test_files_that_cannot_be_read_are_refused_in_one_line(tmp_path, slice_atlas
     refused(TypeError, lambda: ra.open_atlas(None), "path")
 
 
+def test_a_fifo_and_a_foreign_hdf5_file_are_refused_not_waited_on_or_read(tmp_path):
+    import os
+    import warnings
+    import h5py
+    # A FIFO blocked read_table and open_atlas until something wrote to it.
+    for name in ("pipe.h5", "pipe.csv"):
+        fifo = tmp_path / name
+        os.mkfifo(fifo)
+        refused(ValueError, lambda: ra.read_table(fifo), str(fifo), "not a regular file")
+        refused(ValueError, lambda: ra.open_atlas(fifo), str(fifo), "not a regular file")
+    # An HDF5 file of someone else's came back as a table with phony dimensions.
+    foreign = tmp_path / "foreign.h5"
+    with h5py.File(foreign, "w") as f:
+        f["precious"] = np.arange(10)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        refused(ValueError, lambda: ra.read_table(foreign), str(foreign), "not a table of rubber-atlas")
+    assert h5py.File(foreign, "r")["precious"][()].tolist() == list(range(10))
+
+
 def test_a_damaged_atlas_is_named_as_damaged_by_the_accessor(slice_atlas, tmp_path):
     import matplotlib
     matplotlib.use("Agg")

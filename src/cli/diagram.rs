@@ -46,7 +46,7 @@ pub struct DiagramArgs {
     pub samples: usize,
     #[command(flatten)]
     pub limits: Limits,
-    /// Truncate the sampled curves at this κ.
+    /// Truncate the sampled curves at this κ (1e-20 to 1e150).
     #[arg(value_parser = number, long, default_value_t = 3.0, allow_hyphen_values = true)]
     pub kappa_max: f64,
 }

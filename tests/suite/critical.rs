@@ -449,3 +449,51 @@ fn a_tiny_kappa_max_keeps_the_branches_from_the_poles() {
         }
     }
 }
+
+/// The smallest cut, κ_max = 1e-20: each stable branch that ends at a pole is still drawn,
+/// and no point lies beyond the cut (one σ_u point at κ = 2e-8 stood at θ* above κ_max =
+/// 1e-300). Below it the branches by the poles are not resolved in doubles (θ0 by π is
+/// known to 4.4e-16, so κ ≥ 4e-32 there): the cut is refused.
+#[test]
+fn the_smallest_kappa_max_keeps_every_branch_by_a_pole() {
+    use rubber_atlas::body::{Body, EdgedShape};
+    let tiny = rubber_atlas::critical::MIN_KAPPA_MAX;
+    let check = |set: &CriticalSet, what: &str, names: &[&str]| {
+        for name in names {
+            assert!(
+                set.branches.iter().any(|b| b.name == *name && b.stable),
+                "{what}: no {name} in {:?}",
+                set.branches
+            );
+        }
+        for p in set.branches.iter().flat_map(|b| &b.points) {
+            assert!(p.kappa <= tiny, "{what}: {p:?}");
+        }
+    };
+    let b = EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 0.5).unwrap();
+    check(
+        &CriticalSet::of(&b, 400, tiny).unwrap(),
+        "ellipsoid",
+        &["sigma_s0", "sigma_spi"],
+    );
+    assert!(CriticalSet::of(&b, 400, tiny * 0.1).is_err());
+    for (shape, names) in [
+        (
+            EdgedShape::disk(0.3).unwrap(),
+            &["sigma_s0", "sigma_spi"][..],
+        ),
+        (
+            EdgedShape::wheel(0.25, 0.7).unwrap(),
+            &["sigma_s0", "sigma_spi"][..],
+        ),
+        (
+            EdgedShape::truncated_ball(0.2, 0.4).unwrap(),
+            &["sigma_s0", "sigma_spi"][..],
+        ),
+    ] {
+        let body = Body::new(shape, 0.5, 0.5).unwrap();
+        let set = CriticalSet::of_edged(&body, 400, tiny, &|| false).unwrap();
+        check(&set, &format!("{shape:?}"), names);
+        assert!(CriticalSet::of_edged(&body, 400, tiny * 0.1, &|| false).is_err());
+    }
+}
