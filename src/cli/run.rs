@@ -60,7 +60,8 @@ pub struct RunArgs {
     pub force: bool,
     /// Bring the output up to date (as a Slurm task does): keep it if it was made from this
     /// scene by this build for this shard, continue an interrupted run of the same, and
-    /// compute afresh (replacing) whatever is stale.
+    /// compute afresh (replacing) whatever is stale; a file that is not an atlas of
+    /// rubber-atlas is refused (--force replaces it).
     #[arg(long, conflicts_with_all = ["force", "resume"])]
     pub update: bool,
     /// Print the output path the run would write (the default from the scene's name and
@@ -84,10 +85,10 @@ pub struct RunArgs {
 /// Whether the existing output `out` is current for `args`' scene and shard, asked of this
 /// program in a child process: a damaged file that crashes HDF5 (a length in its global
 /// heap) then crashes the child, and the output is computed afresh.
-fn output_current(args: &RunArgs, out: &std::path::Path) -> bool {
+fn output_current(args: &RunArgs, out: &std::path::Path) -> Result<bool> {
     use std::process::{Command, Stdio};
     let Ok(exe) = std::env::current_exe() else {
-        return false;
+        return Ok(false);
     };
     let mut probe = Command::new(exe);
     probe
@@ -104,8 +105,19 @@ fn output_current(args: &RunArgs, out: &std::path::Path) -> bool {
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .status();
-    match status {
+    Ok(match status {
         Ok(status) if status.code() == Some(0) => true,
+        // Someone else's file (a text file, another program's HDF5) is not an atlas to
+        // update: replacing it needs --force (which --update excludes).
+        Ok(status) if status.code() == Some(4) => {
+            return Err(AtlasError::Atlas {
+                path: out.display().to_string(),
+                reason: "exists and is not an atlas of rubber-atlas: --update replaces only \
+                         its own files (run with --force in its place to replace it)"
+                    .into(),
+            }
+            .into());
+        }
         Ok(status) if status.code().is_none() && !args.quiet => {
             eprintln!(
                 "rubber-atlas: reading {} crashed HDF5 (a damaged file); it is computed afresh",
@@ -114,7 +126,7 @@ fn output_current(args: &RunArgs, out: &std::path::Path) -> bool {
             false
         }
         _ => false,
-    }
+    })
 }
 
 pub(super) fn run_scene(args: RunArgs) -> Result<()> {
@@ -142,6 +154,8 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
     if args.probe_current {
         std::process::exit(if sweep::output_is_current(&out, &scene, shard) {
             0
+        } else if rubber_atlas::store::atlas_file::AtlasFile::is_foreign(&out) {
+            4
         } else {
             3
         });
@@ -206,7 +220,7 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
         resume: args.resume,
         force: args.force,
         update: args.update,
-        output_current: args.update && out.exists() && output_current(&args, &out),
+        output_current: args.update && out.exists() && output_current(&args, &out)?,
         shard,
         attributes: invocation_attributes(),
     };

@@ -302,6 +302,24 @@ impl AtlasFile {
         inner().map_err(|e| AtlasError::atlas(path, e))
     }
 
+    /// Whether the file at `path` is someone else's: not HDF5 at all (its signature is not at
+    /// offset 0, where this program writes it), or HDF5 that opens with neither the root
+    /// attribute `program` nor the variable `cell_status` of an atlas. A damaged atlas keeps
+    /// one of them readable or fails to open: it is not foreign, and `--update` remakes it.
+    pub fn is_foreign(path: &Path) -> bool {
+        use std::io::Read;
+        const SIGNATURE: &[u8; 8] = b"\x89HDF\r\n\x1a\n";
+        let mut start = [0u8; 8];
+        let signed = std::fs::File::open(path)
+            .and_then(|mut f| f.read_exact(&mut start))
+            .is_ok_and(|()| &start == SIGNATURE);
+        if !signed {
+            return true;
+        }
+        hdf5::File::open(path)
+            .is_ok_and(|file| file.attr("program").is_err() && file.dataset("cell_status").is_err())
+    }
+
     /// The component axis an atlas file at `path` was written with (its `component_layout`
     /// and `component` coordinate).
     pub fn read_axis(path: &Path) -> Result<ComponentAxis> {

@@ -1127,3 +1127,62 @@ fn a_trajectory_beyond_the_step_budget_is_refused_at_once_with_its_estimate() {
     let o = run(&trajectory_args(&["--periods", "3", "--out", out]));
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+/// `run --update` replaced whatever stood at the output path, a text file or another
+/// program's HDF5 file included (its data lost). It now refuses a file that is not an atlas
+/// of rubber-atlas in one line, exit 2, leaving it as it was; `--force` replaces it, and an
+/// atlas of its own is still kept when current and remade when damaged.
+#[test]
+fn update_replaces_only_its_own_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("s.toml");
+    std::fs::write(
+        &scene,
+        "name = \"s\"\n[body]\nnu = 0.5\neta = 0.5\n[axes]\nalpha = [0.5]\nbeta = [3.0]\n\
+         kappa = { start = 0.0, stop = 1.0, num = 4 }\nenergy = { start = 1.0, stop = 3.0, num = 4 }\n",
+    )
+    .unwrap();
+    let scene_s = scene.to_str().unwrap();
+    let text = dir.path().join("notes.h5");
+    std::fs::write(&text, "my notes\n").unwrap();
+    let foreign = dir.path().join("theirs.h5");
+    {
+        let f = hdf5::File::create(&foreign).unwrap();
+        f.new_dataset_builder()
+            .with_data(&[1.0f64, 2.0, 3.0])
+            .create("precious")
+            .unwrap();
+    }
+    let before = std::fs::read(&foreign).unwrap();
+    for path in [&text, &foreign] {
+        let out = path.to_str().unwrap();
+        let o = run(&["run", scene_s, "--out", out, "--update", "--quiet"]);
+        let said = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{said}");
+        assert_eq!(said.lines().count(), 1, "{said}");
+        assert!(said.contains("not an atlas of rubber-atlas"), "{said}");
+    }
+    assert_eq!(std::fs::read_to_string(&text).unwrap(), "my notes\n");
+    assert_eq!(std::fs::read(&foreign).unwrap(), before);
+    let forced = run(&[
+        "run",
+        scene_s,
+        "--out",
+        text.to_str().unwrap(),
+        "--force",
+        "--quiet",
+    ]);
+    assert!(forced.status.success(), "{}", stderr(&forced));
+    // Its own atlas: current (kept), then with its values damaged (remade).
+    let ours = text.to_str().unwrap();
+    let kept = run(&["run", scene_s, "--out", ours, "--update"]);
+    assert!(kept.status.success(), "{}", stderr(&kept));
+    assert!(String::from_utf8_lossy(&kept.stdout).contains("nothing to do"));
+    {
+        let f = hdf5::File::open_rw(&text).unwrap();
+        f.unlink("drift").unwrap();
+    }
+    let remade = run(&["run", scene_s, "--out", ours, "--update", "--quiet"]);
+    assert!(remade.status.success(), "{}", stderr(&remade));
+    assert!(hdf5::File::open(&text).unwrap().dataset("drift").is_ok());
+}
