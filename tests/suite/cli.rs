@@ -25,6 +25,21 @@ fn run(args: &[&str]) -> Output {
         .expect("the binary runs")
 }
 
+/// A scene `s.toml` in `dir`: the paper's body, κ in [0, 1] and ε in [1, 3] at `num` points.
+fn small_scene(dir: &std::path::Path, num: usize) -> std::path::PathBuf {
+    let scene = dir.join("s.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            "name = \"s\"\n[body]\nnu = 0.5\neta = 0.5\n[axes]\nalpha = [0.5]\nbeta = [3.0]\n\
+             kappa = {{ start = 0.0, stop = 1.0, num = {num} }}\n\
+             energy = {{ start = 1.0, stop = 3.0, num = {num} }}\n"
+        ),
+    )
+    .unwrap();
+    scene
+}
+
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
@@ -864,13 +879,7 @@ fn version_completions_manual_threads_and_names_follow_the_conventions() {
     );
     // RAYON_NUM_THREADS is honoured by `run` when --threads is absent.
     let dir = tempfile::tempdir().unwrap();
-    let scene = dir.path().join("s.toml");
-    std::fs::write(
-        &scene,
-        "name = \"s\"\n[body]\nnu = 0.5\neta = 0.5\n[axes]\nalpha = [0.5]\nbeta = [3.0]\n\
-         kappa = { start = 0.0, stop = 1.0, num = 8 }\nenergy = { start = 1.0, stop = 3.0, num = 8 }\n",
-    )
-    .unwrap();
+    let scene = small_scene(dir.path(), 8);
     let out = dir.path().join("s.h5");
     let o = Command::new(env!("CARGO_BIN_EXE_rubber-atlas"))
         .args([
@@ -1135,13 +1144,7 @@ fn a_trajectory_beyond_the_step_budget_is_refused_at_once_with_its_estimate() {
 #[test]
 fn update_replaces_only_its_own_files() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = dir.path().join("s.toml");
-    std::fs::write(
-        &scene,
-        "name = \"s\"\n[body]\nnu = 0.5\neta = 0.5\n[axes]\nalpha = [0.5]\nbeta = [3.0]\n\
-         kappa = { start = 0.0, stop = 1.0, num = 4 }\nenergy = { start = 1.0, stop = 3.0, num = 4 }\n",
-    )
-    .unwrap();
+    let scene = small_scene(dir.path(), 4);
     let scene_s = scene.to_str().unwrap();
     let text = dir.path().join("notes.h5");
     std::fs::write(&text, "my notes\n").unwrap();
