@@ -334,9 +334,14 @@ impl CriticalSet {
         };
         let (mut branches, cusps) = sample_branches(&curve, samples, kappa_max, &stopped)?;
         let cusp = cusps.last().copied();
-        let kappa_c_equator =
-            (alpha == 0.0 && beta > 1.0).then(|| ((beta * beta - 1.0) / beta).sqrt());
-        if alpha == 0.0 {
+        let at = crate::body::Angle::EQUATOR;
+        let equator = alpha == 0.0
+            || equator_held(
+                body.shape.potential_prime_at(at),
+                body.shape.potential_second_at(at),
+            );
+        let kappa_c_equator = (equator && beta > 1.0).then(|| ((beta * beta - 1.0) / beta).sqrt());
+        if equator {
             // σ_π/2: ε = κ²/2 + β (`s2`), stable where V″(π/2) = κ² − (β² − 1)/β > 0.
             branches.extend(equator_branches(
                 beta,
@@ -741,6 +746,19 @@ fn shared_point<S: Shape>(curve: &Curve<'_, S>, theta: f64, stable_side: f64) ->
     at
 }
 
+/// Whether the equator is a permanent rotation at every κ in doubles, from U′(π/2) =
+/// `slope` and U″(π/2) = `curvature`. V′(π/2) = U′(π/2) for every κ (the κ term's slope
+/// vanishes there), so it is one exactly where U′(π/2) = 0: a body symmetric about its
+/// equator, or a ball centred on its sphere's centre (α = 0) whose sphere holds π/2. Where
+/// U′(π/2) is not 0 but tiny, the permanent rotation lies |U′(π/2)|/|V″(π/2)| from π/2: below
+/// half an ulp of π/2 (1.1e-16) at every κ but in a window round κ_c of relative width
+/// |U′|/(2.2e-16 |U″|), which this keeps below 1e-3 (|α| ≲ 2e-19 for the disk). There the
+/// sampled curve cannot reach past κ_c (θ0 has no double between the rotation and π/2: the
+/// disk at α = 1e-300 had no branch at all for κ in (1, 3]); the equator branch stands for it.
+fn equator_held(slope: f64, curvature: f64) -> bool {
+    slope == 0.0 || slope.abs() <= 1e-3 * 1.1e-16 * curvature.abs()
+}
+
 /// Whether a change of stability at θ0 is one at a kink of U (V″ jumping through 0, not a
 /// cusp): θ0 bisected to within 1e-9 of it.
 fn at_kink(kinks: &[f64], theta: f64) -> bool {
@@ -953,20 +971,18 @@ impl CriticalSet {
             .copied()
             .collect();
         let mut kappa_c_equator = None;
-        // V′(π/2) = U′(π/2) for every κ (the κ term's slope vanishes there): the equator is a
-        // permanent rotation at every κ where U′(π/2) = 0 exactly, as for a body symmetric
-        // about it or a ball centred on its sphere's centre (α = 0) whose sphere holds π/2.
         let a = crate::body::Angle::EQUATOR;
-        if body.shape.symmetric_about_equator() || body.shape.potential_prime_at(a) == 0.0 {
-            // At a kink, the side where U bends down the more decides the stability.
-            let curvature = if at_kink(&kinks, FRAC_PI_2) {
-                let step = 1e-9;
-                body.shape
-                    .potential_second(FRAC_PI_2 - step)
-                    .min(body.shape.potential_second(FRAC_PI_2 + step))
-            } else {
-                body.shape.potential_second_at(a)
-            };
+        // At a kink, the side where U bends down the more decides the stability.
+        let curvature = if at_kink(&kinks, FRAC_PI_2) {
+            let step = 1e-9;
+            body.shape
+                .potential_second(FRAC_PI_2 - step)
+                .min(body.shape.potential_second(FRAC_PI_2 + step))
+        } else {
+            body.shape.potential_second_at(a)
+        };
+        let slope = body.shape.potential_prime_at(a);
+        if body.shape.symmetric_about_equator() || equator_held(slope, curvature) {
             kappa_c_equator = (curvature < 0.0).then(|| (-curvature).sqrt());
             branches.extend(equator_branches(
                 body.shape.potential_at(a),

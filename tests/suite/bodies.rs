@@ -1183,3 +1183,54 @@ fn an_edged_bodys_unstable_branch_reaches_its_inclined_equilibrium() {
         }
     }
 }
+
+/// |α| so small that the permanent rotation by the equator lies within half an ulp of π/2
+/// (but in a window of relative width 1e-3 round κ_c): in doubles it is the equator, and
+/// the diagram is that of α = 0. The disk at α = ±1e-300 had no branch at all for κ in
+/// (1, 3], where `cell` finds that rotation; the ellipsoid at 1e-300 none beyond κ_c.
+/// Checked against the cell solver: at κ = 2 and the row's energy, a fixed point at π/2.
+#[test]
+fn a_body_within_rounding_of_symmetric_keeps_its_equator_branch() {
+    use rubber_atlas::cell::{solve_cell, CellOptions, Status};
+    use rubber_atlas::critical::{CriticalSet, FixedPoint};
+    let summary = |set: &CriticalSet| -> Vec<(&str, bool, [f64; 2])> {
+        let mut rows: Vec<_> = set
+            .branches
+            .iter()
+            .map(|b| (b.name, b.stable, b.kappa_range))
+            .collect();
+        rows.sort_by(|a, b| a.0.cmp(b.0).then(a.2[0].total_cmp(&b.2[0])));
+        rows
+    };
+    let at_two = |set: &CriticalSet| -> FixedPoint {
+        *set.branches
+            .iter()
+            .filter(|b| b.name == "sigma_pi2" && b.stable)
+            .flat_map(|b| &b.points)
+            .find(|p| p.kappa >= 2.0)
+            .unwrap()
+    };
+    for alpha in [1e-300, -1e-300, 1e-20] {
+        let body = Body::new(EdgedShape::disk(alpha).unwrap(), 2.0, 4.0).unwrap();
+        let symmetric = Body::new(EdgedShape::disk(0.0).unwrap(), 2.0, 4.0).unwrap();
+        let set = CriticalSet::of_edged(&body, 400, 3.0, &|| false).unwrap();
+        let reference = CriticalSet::of_edged(&symmetric, 400, 3.0, &|| false).unwrap();
+        assert_eq!(summary(&set), summary(&reference), "α = {alpha}");
+        assert_eq!(set.kappa_c_equator, Some(1.0));
+        let p = at_two(&set);
+        let cell = solve_cell(&body, p.kappa, p.energy, &CellOptions::default()).unwrap();
+        let c = &cell.components[0];
+        assert_eq!(c.status, Status::FixedPoint, "α = {alpha}: {cell:?}");
+        assert!(
+            (c.theta_min - FRAC_PI_2).abs() < 1e-12,
+            "α = {alpha}: {c:?}"
+        );
+        let e = rubber_atlas::EllipsoidBody::ellipsoid(alpha, 3.0, 0.5, 0.5).unwrap();
+        let set = CriticalSet::of(&e, 400, 3.0).unwrap();
+        assert!(at_two(&set).stable, "α = {alpha}");
+    }
+    // Beyond that, the sampled curve itself draws the imperfect bifurcation.
+    let body = Body::new(EdgedShape::disk(1e-12).unwrap(), 2.0, 4.0).unwrap();
+    let set = CriticalSet::of_edged(&body, 400, 3.0, &|| false).unwrap();
+    assert!(set.branches.iter().all(|b| b.name != "sigma_pi2"));
+}
