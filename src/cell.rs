@@ -587,7 +587,10 @@ fn level_offset_error<S: Shape>(
     // Away from the poles (at an end near a pole ψ̇ peaks in a sliver of time whose share
     // the relative bounds cover): ∫|ψ̇| dt ≤ T max|ψ̇|, and the shift of the orbit by the
     // rounding of each turning point to a double (an ulp in its chart) moves Δψ by
-    // δθ ∫ |dψ̇/dθ| dt (large against Δψ itself where ψ̇ changes sign inside, round π/2).
+    // δθ ∫ |dψ̇/dθ| dt (large against Δψ itself where ψ̇ changes sign inside, round π/2): a
+    // term of the crude bound only. The integrals are those of the level V(e) at each end e
+    // as rounded, so a measured slope times δ (ε − V(e) itself, or its a-priori bound, which
+    // counts an ulp of e times V′(e)) already holds that shift.
     let far = rates.iter().zip(&sites).filter(|((x, _), _)| *x > 0.1);
     // An end near a pole at κ ≠ 0 is a passage by it, which sweeps ψ by up to π in a sliver
     // of time: Δψ may be the small difference of two such sweeps (κ → 0 at high energy), and
@@ -815,7 +818,7 @@ fn level_offset_error<S: Shape>(
             up.psi_advance,
             down.psi_advance,
             up.psi_advance_error + raw.psi_advance_error + down.psi_advance_error,
-        ) + psi_shift,
+        ),
         drift,
     }
     .plus(tilted)

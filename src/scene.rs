@@ -516,6 +516,13 @@ impl Scene {
         let mut energy = reader.axis(axes, column_name)?;
         // κ and ε of every cell must be finite numbers whose squares do not overflow.
         let largest = |a: &Axis| a.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        // The value of largest size, with its sign (for the message).
+        let widest = |a: &Axis| {
+            a.values
+                .iter()
+                .copied()
+                .fold(0.0f64, |m, v| if v.abs() > m.abs() { v } else { m })
+        };
         let smallest_positive = |a: &Axis| {
             a.values
                 .iter()
@@ -526,8 +533,8 @@ impl Scene {
             return Err(reader.error(
                 "axes.kappa",
                 format!(
-                    "{} is above {MAX_KAPPA:e} (kappa^2 would overflow)",
-                    show(largest(&kappa))
+                    "{} is above {MAX_KAPPA:e} in size (kappa^2 would overflow)",
+                    show(widest(&kappa))
                 ),
             ));
         }
@@ -564,7 +571,7 @@ impl Scene {
         if plane != Plane::Compact && largest(&energy) > MAX_ENERGY {
             return Err(reader.error(
                 &format!("axes.{column_name}"),
-                format!("{} is above {MAX_ENERGY:e} in size", show(largest(&energy))),
+                format!("{} is above {MAX_ENERGY:e} in size", show(widest(&energy))),
             ));
         }
         if plane == Plane::Compact {

@@ -288,7 +288,11 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
             ..Summary::default()
         });
     }
-    if out.exists() && !request.force && !request.update {
+    // (An interrupted run over an existing output, `--force` or a stale `--update`, left
+    // its journal beside it: `--resume` continues that run, which replaces the output as
+    // the run itself would have.)
+    let interrupted_over_it = request.resume && Journal::looks_like_one(&Journal::dir_for(out));
+    if out.exists() && !request.force && !request.update && !interrupted_over_it {
         return Err(AtlasError::atlas(
             out,
             "exists; use --force to overwrite it (a finished run has nothing to resume)",

@@ -153,6 +153,12 @@ pub const BRANCH_NAMES: [&str; 4] = ["sigma_s0", "sigma_u", "sigma_spi", "sigma_
 /// The sampled fixed-point curves of a critical set (paper §4, Fig. `bif`), one row per
 /// point; the set's summary goes in the attributes as JSON (`critical_set_json`).
 pub fn diagram(set: &CriticalSet) -> Table {
+    diagram_until(set, &|| false).expect("never stopped")
+}
+
+/// [`diagram`], given up (None) when `stop` says so, asked before each column (a column of
+/// 5e7 samples takes some 0.4 s to gather: the whole table 4 s, which Ctrl-C waited for).
+pub fn diagram_until(set: &CriticalSet, stop: &dyn Fn() -> bool) -> Option<Table> {
     let points: Vec<(usize, u8, &crate::critical::FixedPoint)> = set
         .branches
         .iter()
@@ -165,68 +171,94 @@ pub fn diagram(set: &CriticalSet) -> Table {
     let f = |g: &dyn Fn(&crate::critical::FixedPoint) -> f64| {
         Values::F64(points.iter().map(|(_, _, p)| g(p)).collect())
     };
-    let columns = vec![
-        sample_column(points.len()),
-        column(
-            "segment",
-            Values::I32(points.iter().map(|(i, _, _)| *i as i32).collect()),
-            "index of the run of one stability along a branch",
-            cf::NUMBER,
-        ),
-        flag_column(
-            "branch",
-            points.iter().map(|(_, c, _)| *c).collect(),
-            "branch of permanent rotations",
-            (&[0, 1, 2, 3], "sigma_s0 sigma_u sigma_spi sigma_pi2"),
-        ),
-        column(
-            "theta0",
-            f(&|p| p.theta0),
-            "inclination of the permanent rotation",
-            cf::ANGLE,
-        ),
-        column(
-            "kappa",
-            f(&|p| p.kappa),
-            "integral F2 on the curve (kappa >= 0)",
-            cf::PAPER,
-        ),
-        column(
-            "energy",
-            f(&|p| p.energy),
-            "energy on the curve",
-            cf::ENERGY,
-        ),
-        flag_column(
-            "stable",
-            points.iter().map(|(_, _, p)| u8::from(p.stable)).collect(),
-            "linear stability of the permanent rotation",
-            (&[0, 1], "unstable stable"),
-        ),
-        column(
-            "rho_c",
-            f(&|p| p.rho_c),
-            "radius of the circle of the centre of mass",
-            cf::LENGTH,
-        ),
-        column(
-            "rho_p",
-            f(&|p| p.rho_p),
-            "radius of the circle of the contact point",
-            cf::LENGTH,
-        ),
-        column(
-            "rotation_number",
-            f(&|p| p.rotation_number.unwrap_or(f64::NAN)),
-            "rotation number of the small oscillations, -psi_dot/omega0 (NaN where unstable)",
-            cf::NUMBER,
-        ),
+    // Each column gathered in turn, `stop` asked before each.
+    let makers: [&dyn Fn() -> TableColumn; 10] = [
+        &|| sample_column(points.len()),
+        &|| {
+            column(
+                "segment",
+                Values::I32(points.iter().map(|(i, _, _)| *i as i32).collect()),
+                "index of the run of one stability along a branch",
+                cf::NUMBER,
+            )
+        },
+        &|| {
+            flag_column(
+                "branch",
+                points.iter().map(|(_, c, _)| *c).collect(),
+                "branch of permanent rotations",
+                (&[0, 1, 2, 3], "sigma_s0 sigma_u sigma_spi sigma_pi2"),
+            )
+        },
+        &|| {
+            column(
+                "theta0",
+                f(&|p| p.theta0),
+                "inclination of the permanent rotation",
+                cf::ANGLE,
+            )
+        },
+        &|| {
+            column(
+                "kappa",
+                f(&|p| p.kappa),
+                "integral F2 on the curve (kappa >= 0)",
+                cf::PAPER,
+            )
+        },
+        &|| {
+            column(
+                "energy",
+                f(&|p| p.energy),
+                "energy on the curve",
+                cf::ENERGY,
+            )
+        },
+        &|| {
+            flag_column(
+                "stable",
+                points.iter().map(|(_, _, p)| u8::from(p.stable)).collect(),
+                "linear stability of the permanent rotation",
+                (&[0, 1], "unstable stable"),
+            )
+        },
+        &|| {
+            column(
+                "rho_c",
+                f(&|p| p.rho_c),
+                "radius of the circle of the centre of mass",
+                cf::LENGTH,
+            )
+        },
+        &|| {
+            column(
+                "rho_p",
+                f(&|p| p.rho_p),
+                "radius of the circle of the contact point",
+                cf::LENGTH,
+            )
+        },
+        &|| {
+            column(
+                "rotation_number",
+                f(&|p| p.rotation_number.unwrap_or(f64::NAN)),
+                "rotation number of the small oscillations, -psi_dot/omega0 (NaN where unstable)",
+                cf::NUMBER,
+            )
+        },
     ];
-    Table {
+    let mut columns = Vec::with_capacity(makers.len());
+    for make in makers {
+        if stop() {
+            return None;
+        }
+        columns.push(make());
+    }
+    Some(Table {
         dimension: "sample",
         columns,
         attributes: title("rubber-atlas critical set: the fixed-point curves"),
-    }
+    })
 }
 
 /// The points of traced resonance curves N = p/q, one row per point, curve after curve.

@@ -240,8 +240,10 @@ def test_ctrl_c_stops_a_long_call_at_once(tmp_path, call):
     child.send_signal(signal.SIGINT)
     out, err = child.communicate(timeout=60)
     assert child.returncode == 3 and "interrupted" in out, err
-    # Measured 0.02-0.2 s; the bound leaves room for a loaded machine.
-    assert time.perf_counter() - sent < 1.0, time.perf_counter() - sent
+    # Not a timing test (the figures in docs/python.md are measured apart): it tells an
+    # interrupt heard inside the call (0.02-0.2 s, up to 1.2 s on a loaded machine) from one
+    # heard only after the body or the batch (13 s and more after the signal in every call).
+    assert time.perf_counter() - sent < 5.0, time.perf_counter() - sent
     assert (err.endswith("\n") and "%" in err) if "progress" in call else "%" not in err
 
 

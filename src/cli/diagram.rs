@@ -212,7 +212,9 @@ pub(super) fn print_diagram(set: &CriticalSet) {
 }
 
 pub(super) fn write_diagram(out: &std::path::Path, set: &CriticalSet) -> Result<()> {
-    let mut table = rubber_atlas::table::diagram(set);
+    let Some(mut table) = rubber_atlas::table::diagram_until(set, &crate::stop::requested) else {
+        return Err(AtlasError::Stopped.into());
+    };
     let mut attributes = Vec::new();
     if let Some(shape) = set.shape {
         attributes.push(("shape", AttrValue::Text(shape.to_string())));

@@ -302,10 +302,12 @@ impl AtlasFile {
         inner().map_err(|e| AtlasError::atlas(path, e))
     }
 
-    /// Whether the file at `path` is someone else's: not HDF5 at all (its signature is not at
-    /// offset 0, where this program writes it), or HDF5 that opens with neither the root
-    /// attribute `program` nor the variable `cell_status` of an atlas. A damaged atlas keeps
-    /// one of them readable or fails to open: it is not foreign, and `--update` remakes it.
+    /// Whether the file at `path` is not an atlas of this program: not HDF5 at all (its
+    /// signature is not at offset 0, where this program writes it), or HDF5 that opens and
+    /// lacks what every atlas has: the root attributes `program` = "rubber-atlas" and `scene`,
+    /// and the variable `cell_status` (another program's file, or a table of this one, such
+    /// as `diagram --out`). A damaged atlas keeps those or fails to open: it is not foreign,
+    /// and `--update` remakes it.
     pub fn is_foreign(path: &Path) -> bool {
         use std::io::Read;
         const SIGNATURE: &[u8; 8] = b"\x89HDF\r\n\x1a\n";
@@ -316,8 +318,13 @@ impl AtlasFile {
         if !signed {
             return true;
         }
-        hdf5::File::open(path)
-            .is_ok_and(|file| file.attr("program").is_err() && file.dataset("cell_status").is_err())
+        hdf5::File::open(path).is_ok_and(|file| {
+            let ours = file
+                .attr("program")
+                .and_then(|a| a.read_scalar::<VarLenUnicode>())
+                .is_ok_and(|name| name.as_str() == "rubber-atlas");
+            !(ours && file.attr("scene").is_ok() && file.dataset("cell_status").is_ok())
+        })
     }
 
     /// The component axis an atlas file at `path` was written with (its `component_layout`

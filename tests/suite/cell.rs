@@ -625,3 +625,58 @@ fn the_level_offset_scales_bound_the_slopes_measured_by_differences() {
     eprintln!("{checked} librations: worst slope/bound T {worst_t:.3}, psi {worst_psi:.3}");
     assert!(checked >= 10_000, "only {checked} librations checked");
 }
+
+/// Issue 22, adversary pass 4: two κ = 0 librations across the pole θ = 0 whose trapezoid
+/// sums converged fast and then slowly (B = 1/η + |r|² dips sharply at θ = ±π/2 on these
+/// prolate bodies), where the estimate of T at status `ok` was 3.3 and 2.1 times short. Each
+/// must hold the ODE's T (tol 1e-12) within the two estimates, at the tolerance the pass used
+/// and at those next to it.
+#[test]
+fn a_second_slower_rate_of_convergence_is_not_missed() {
+    use rubber_atlas::trajectory::Start;
+    let cases = [
+        // (α, β, ν, η, θ(0), θ̇(0), the pass's tolerance)
+        (
+            -0.04889764426626375,
+            0.2036420629232913,
+            0.531763849460316,
+            15.858178785844538,
+            0.21813849260087032,
+            0.38823045042619464,
+            1e-8,
+        ),
+        (
+            -0.6383325990115382,
+            0.08003977955507473,
+            1.6597511274536927,
+            0.09780229561011494,
+            0.6557406937127155,
+            0.0,
+            1e-6,
+        ),
+    ];
+    for (alpha, beta, nu, eta, theta0, theta_dot0, tol) in cases {
+        let b = EllipsoidBody::ellipsoid(alpha, beta, nu, eta).unwrap();
+        let energy = Start {
+            kappa: 0.0,
+            theta0,
+            theta_dot0,
+        }
+        .energy(&b);
+        let reference = solve(&b, 0.0, energy, Method::Ode, 1e-12);
+        for tol in [0.1 * tol, tol, 10.0 * tol] {
+            let q = solve(&b, 0.0, energy, Method::Quadrature, tol);
+            assert_eq!(q.components.len(), reference.components.len());
+            for (c, r) in q.components.iter().zip(&reference.components) {
+                assert!(
+                    (c.period - r.period).abs() <= c.errors.period + r.errors.period,
+                    "alpha {alpha} tol {tol:e}: T {} ± {:e} against the ODE's {} ± {:e}",
+                    c.period,
+                    c.errors.period,
+                    r.period,
+                    r.errors.period
+                );
+            }
+        }
+    }
+}

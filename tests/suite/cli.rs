@@ -1156,8 +1156,41 @@ fn update_replaces_only_its_own_files() {
             .create("precious")
             .unwrap();
     }
+    // (Adversary pass 4: another program's file with its own `program` attribute, or with a
+    // variable named `cell_status`, and this program's diagram table were replaced.)
+    let labelled = dir.path().join("labelled.h5");
+    {
+        let f = hdf5::File::create(&labelled).unwrap();
+        f.new_dataset_builder()
+            .with_data(&[1u8, 2, 3])
+            .create("cell_status")
+            .unwrap();
+        let name: hdf5::types::VarLenUnicode = "my-precious-model".parse().unwrap();
+        f.new_attr::<hdf5::types::VarLenUnicode>()
+            .create("program")
+            .unwrap()
+            .write_scalar(&name)
+            .unwrap();
+    }
+    let table = dir.path().join("diagram.h5");
+    let o = run(&[
+        "diagram",
+        "--alpha",
+        "0.5",
+        "--beta",
+        "3",
+        "--samples",
+        "200",
+        "--out",
+        table.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
     let before = std::fs::read(&foreign).unwrap();
-    for path in [&text, &foreign] {
+    let (labelled_before, table_before) = (
+        std::fs::read(&labelled).unwrap(),
+        std::fs::read(&table).unwrap(),
+    );
+    for path in [&text, &foreign, &labelled, &table] {
         let out = path.to_str().unwrap();
         let o = run(&["run", scene_s, "--out", out, "--update", "--quiet"]);
         let said = stderr(&o);
@@ -1167,6 +1200,8 @@ fn update_replaces_only_its_own_files() {
     }
     assert_eq!(std::fs::read_to_string(&text).unwrap(), "my notes\n");
     assert_eq!(std::fs::read(&foreign).unwrap(), before);
+    assert_eq!(std::fs::read(&labelled).unwrap(), labelled_before);
+    assert_eq!(std::fs::read(&table).unwrap(), table_before);
     let forced = run(&[
         "run",
         scene_s,
@@ -1188,4 +1223,85 @@ fn update_replaces_only_its_own_files() {
     let remade = run(&["run", scene_s, "--out", ours, "--update", "--quiet"]);
     assert!(remade.status.success(), "{}", stderr(&remade));
     assert!(hdf5::File::open(&text).unwrap().dataset("drift").is_ok());
+}
+
+/// Adversary pass 4: a symbolic link at `<out>.lock` had its target overwritten with the
+/// run's PID (and the link removed). It is refused in one line now, and nothing is written.
+#[test]
+fn a_lock_file_that_is_a_symbolic_link_is_never_followed() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = small_scene(dir.path(), 4);
+    let victim = dir.path().join("victim.txt");
+    std::fs::write(&victim, "precious\n").unwrap();
+    let out = dir.path().join("linked.h5");
+    let lock = dir.path().join("linked.h5.lock");
+    std::os::unix::fs::symlink(&victim, &lock).unwrap();
+    let o = run(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    let said = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{said}");
+    assert_eq!(said.lines().count(), 1, "{said}");
+    assert!(said.contains("symbolic link"), "{said}");
+    assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious\n");
+    assert!(std::fs::symlink_metadata(&lock).unwrap().is_symlink());
+    assert!(!out.exists());
+}
+
+/// Adversary pass 4: a start (θ(0), θ̇(0)) whose energy lies beyond 1e300 ran (ε = 9.8e307
+/// with T printed as NaN, or status `ok` at 5.6e306) where an energy given directly is
+/// refused; and a scene's energy of −1e301 was reported as 1e301. Each is one line, exit 2,
+/// naming the input with its sign.
+#[test]
+fn a_start_beyond_the_largest_energy_is_refused_like_the_energy() {
+    let cell = |extra: &[&str]| {
+        let mut args = vec![
+            "cell", "--alpha", "0.5", "--beta", "3", "--nu", "0.5", "--eta", "0.5",
+        ];
+        args.extend_from_slice(extra);
+        run(&args)
+    };
+    for (extra, names) in [
+        (
+            &["--kappa", "0.8", "--theta0", "5.7e-155"][..],
+            "theta0 = 5.7e-155",
+        ),
+        (
+            &["--kappa", "0", "--theta0", "1", "--theta-dot0", "1e153"][..],
+            "theta-dot0 = 1e153",
+        ),
+    ] {
+        let o = cell(extra);
+        let said = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{said}");
+        assert_eq!(said.lines().count(), 1, "{said}");
+        assert!(said.contains(names) && said.contains("1e300"), "{said}");
+    }
+    // Just inside: a start at ε of a few 1e299 runs.
+    let o = cell(&[
+        "--kappa",
+        "0",
+        "--theta0",
+        "1",
+        "--theta-dot0",
+        "4e149",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("e.toml");
+    std::fs::write(
+        &scene,
+        "name = \"e\"\n[body]\nnu = 0.5\neta = 0.5\n[axes]\nalpha = [0.5]\nbeta = [3.0]\n\
+         kappa = [0.8]\nenergy = { start = -1e301, stop = 1.0, num = 3 }\n",
+    )
+    .unwrap();
+    let o = run(&["run", scene.to_str().unwrap(), "--quiet"]);
+    let said = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{said}");
+    assert!(said.contains("-1e301 is above 1e300 in size"), "{said}");
 }

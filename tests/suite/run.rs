@@ -1154,3 +1154,36 @@ fn edged_body_scenes_are_refused_where_the_shape_does_not_fit() {
         assert!(!stderr.contains("beta"), "{shape}: {stderr}");
     }
 }
+
+/// Adversary pass 4: a `--force` run over an existing output, stopped by SIGINT, said
+/// "continue with … --resume", and `--resume` then refused because the output existed. It
+/// continues the run now, and its output replaces the old one.
+#[test]
+fn a_forced_run_over_an_output_resumes_as_its_stop_message_says() {
+    let (_dir, scene, reference, out, journal) = slow_run();
+    let (s, o) = (scene.as_str(), out.to_str().unwrap());
+    std::fs::copy(&reference, &out).unwrap();
+    let before = std::fs::read(&out).unwrap();
+    let mut child = Command::new(BIN)
+        .args(["run", s, "--out", o, "--force", "--quiet"])
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    wait_for_units(&mut child, &journal, 1);
+    // SAFETY: a signal to our own child process.
+    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    let output = child.wait_with_output().unwrap();
+    if output.status.success() {
+        return; // finished before the signal landed: nothing to resume
+    }
+    let text = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        text.contains(&format!("rubber-atlas run {s} --out {o} --resume")),
+        "{text}"
+    );
+    // The old output is untouched until the run is done.
+    assert_eq!(std::fs::read(&out).unwrap(), before);
+    ok(&run(&["run", s, "--out", o, "--resume", "--quiet"]));
+    assert_same_arrays(&reference, &out);
+    assert!(!journal.exists());
+}
