@@ -354,12 +354,18 @@ def _broadcast(given: dict[str, object], plane: tuple[str, str] | None = None, o
         places = {name: (a.shape, tuple(dims.index(d) for d in a.dims)) for name, a in arrays.items()}
         return dims, layout, coords, places
     shapes = {name: v.shape for name, v in values.items()}
+    vectors = {k: s for k, s in shapes.items() if s}
+    # The two axes of the plane as 1-D vectors of different lengths (a length-1 one too, which
+    # numpy would broadcast), every other input a number: their grid.
+    grid = (plane is not None and set(vectors) == set(plane) and all(len(s) == 1 for s in vectors.values())
+            and vectors[plane[0]] != vectors[plane[1]])
     try:
+        if grid:
+            raise ValueError("a grid")
         shape = np.broadcast_shapes(*shapes.values())
         places = {name: (s, tuple(range(len(shape) - len(s), len(shape)))) for name, s in shapes.items()}
     except ValueError:
-        vectors = {k: s for k, s in shapes.items() if s}
-        if not (plane is not None and set(vectors) == set(plane) and all(len(s) == 1 for s in vectors.values())):
+        if not grid:
             shown = ", ".join(f"{k} {s}" for k, s in vectors.items())
             raise ValueError(
                 f"the inputs do not broadcast together ({shown}): numpy pairs their last dimensions, "
@@ -374,7 +380,13 @@ def _broadcast(given: dict[str, object], plane: tuple[str, str] | None = None, o
     if check is not None:
         check(math.prod(shape))
     layout = np.broadcast_arrays(*values.values())
-    dims, coords = _numpy_dims(shape, values)
+    if grid:
+        # (numpy's rules would not name a length-1 axis after its input)
+        dims = tuple(plane)
+        coords = {name: ((plane[plane.index(name)],), np.asarray(v).reshape(-1)) if name in plane
+                  else ((), np.asarray(v).reshape(())) for name, v in values.items()}
+    else:
+        dims, coords = _numpy_dims(shape, values)
     _refuse_outputs(dims, outputs)
     return dims, list(layout), coords, places
 

@@ -527,3 +527,18 @@ def test_read_table_refuses_edited_headers_and_typed_columns_and_reads_an_empty_
     rows_line = next(i for i, line in enumerate(lines) if line.startswith("# rows:"))
     many = edited("many.csv", rows_line, "# rows: many\n")
     refused(ValueError, lambda: ra.read_table(many), "'# rows' line is not a count", "'many'")
+
+
+def test_a_length_one_vector_with_a_longer_one_makes_a_grid():
+    """Adversary pass 4: κ of length 1 with three ε gave dimension `cell` (numpy broadcasts a
+    length-1 vector), where docs/python.md promises a grid for vectors of different lengths."""
+    for kappa, energy in [([0.8], [2.5, 3.0, 3.5]), ([0.8, 0.9], [3.0])]:
+        ds = ra.cells(0.5, 3.0, 0.5, 0.5, kappa=np.array(kappa), energy=np.array(energy))
+        assert dict(ds.cell_status.sizes) == {"kappa": len(kappa), "energy": len(energy)}
+        assert ds.kappa.dims == ("kappa",) and ds.energy.dims == ("energy",)
+        one = ra.cells(0.5, 3.0, 0.5, 0.5, kappa=kappa[-1], energy=energy[-1])
+        np.testing.assert_array_equal(ds.rotation_number.sel(kappa=kappa[-1], energy=energy[-1]).values,
+                                      one.rotation_number.values)
+    # Equal lengths still pair up, as numpy broadcasts them.
+    ds = ra.cells(0.5, 3.0, 0.5, 0.5, kappa=np.array([0.8, 0.9]), energy=np.array([2.5, 3.0]))
+    assert dict(ds.cell_status.sizes) == {"cell": 2}
