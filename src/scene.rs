@@ -515,14 +515,14 @@ impl Scene {
         let kappa = reader.axis(axes, row_name)?;
         let mut energy = reader.axis(axes, column_name)?;
         // κ and ε of every cell must be finite numbers whose squares do not overflow.
-        let largest = |a: &Axis| a.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        // The value of largest size, with its sign (for the message).
+        // The value of largest size, with its sign (for the message), and that size.
         let widest = |a: &Axis| {
             a.values
                 .iter()
                 .copied()
                 .fold(0.0f64, |m, v| if v.abs() > m.abs() { v } else { m })
         };
+        let largest = |a: &Axis| widest(a).abs();
         let smallest_positive = |a: &Axis| {
             a.values
                 .iter()

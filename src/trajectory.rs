@@ -3,7 +3,7 @@
 //! velocity of the centre of mass) or from the full system (`eqred`, `kin`).
 
 use crate::body::{Body, Shape};
-use crate::error::{AtlasError, Result};
+use crate::error::{AtlasError, Result, MAX_ENERGY};
 use crate::full::{FullState, FullSystem, FULL_STATE_LEN};
 use crate::ode::{integrate_sampled, Rate};
 use crate::reduced::ReducedSystem;
@@ -95,34 +95,23 @@ impl Start {
         ReducedSystem::new(body, self.kappa).energy(self.theta0, self.theta_dot0)
     }
 
-    /// The energy of this start, refused (naming θ(0), θ̇(0) or κ) where it overflows.
+    /// The energy of this start, refused (naming θ(0), θ̇(0) or κ) where it lies beyond 1e300
+    /// in size or overflows, as every surface refuses an energy given directly.
     pub fn checked_energy<S: Shape>(&self, body: &Body<S>) -> Result<f64> {
         let energy = self.energy(body);
-        if energy.abs() <= crate::error::MAX_ENERGY {
+        if energy.abs() <= MAX_ENERGY {
             return Ok(energy);
         }
-        // Beyond 1e300, where every surface refuses an energy given directly (the text
-        // output and the quadrature's margins assume it), or infinite.
         let potential = ReducedSystem::new(body, self.kappa).effective_potential(self.theta0);
-        let beyond = energy.is_finite();
-        let wall_fits = 0.5 * self.kappa * self.kappa <= crate::error::MAX_ENERGY;
-        if (beyond && potential.abs() > crate::error::MAX_ENERGY && wall_fits)
-            || (!beyond && !potential.is_finite() && (self.kappa * self.kappa).is_finite())
-        {
-            if beyond {
-                return Err(AtlasError::InvalidInitialAngle {
-                    theta0: self.theta0,
-                    reason: "so near a pole that the energy kappa^2/(2 sin^2 theta0) exceeds 1e300",
-                });
-            }
-            // κ²/(2 sin²θ0) overflows because θ0 is that near a pole.
+        let potential_fits = potential.abs() <= MAX_ENERGY;
+        if !potential_fits && 0.5 * self.kappa * self.kappa <= MAX_ENERGY {
+            // The wall κ²/(2 sin²θ0) alone is beyond: θ0 is that near a pole.
             return Err(AtlasError::InvalidInitialAngle {
                 theta0: self.theta0,
-                reason: "so near a pole that kappa^2/(2 sin^2 theta0) overflows",
+                reason: "so near a pole that the energy kappa^2/(2 sin^2 theta0) exceeds 1e300",
             });
         }
-        let (name, value) = if self.theta_dot0 != 0.0 && potential.abs() <= crate::error::MAX_ENERGY
-        {
+        let (name, value) = if self.theta_dot0 != 0.0 && potential_fits {
             ("theta-dot0", self.theta_dot0)
         } else {
             ("kappa", self.kappa)
@@ -130,11 +119,8 @@ impl Start {
         Err(AtlasError::InvalidParameter {
             name,
             value,
-            reason: if beyond {
-                "gives an energy B theta_dot^2/2 + V above 1e300 in size (the largest a cell takes)"
-            } else {
-                "gives an infinite energy B theta_dot^2/2 + V"
-            },
+            reason:
+                "gives an energy B theta_dot^2/2 + V above 1e300 in size (the largest a cell takes)",
         })
     }
 
