@@ -524,6 +524,15 @@ impl<S: Shape> Body<S> {
             Some((2.0, true)),
             "must satisfy 0 < nu <= 2 (i3 <= i1 + i2 = 2 i1)",
         )?;
+        // A subnormal ν is zero to every sum it enters, and makes each one slow.
+        if nu > 0.0 && nu < f64::MIN_POSITIVE {
+            return Err(AtlasError::InvalidParameter {
+                name: "nu",
+                value: nu,
+                reason: "is subnormal: nu must be >= 2.2250738585072014e-308 (the least normal \
+                         double)",
+            });
+        }
         check_range("eta", eta, Some((0.0, false)), None, "must be > 0")?;
         // The inertia 1/η must be a number: below 5.6e-309 it overflows to infinity.
         if !(1.0 / eta).is_finite() {

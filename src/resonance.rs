@@ -30,6 +30,12 @@ pub struct ResonanceOptions {
     /// Curves that hug a separatrix (N → ±∞ there) are followed until N's conditioning,
     /// which grows like 1/|ε − ε_s|, makes its error estimate exceed this.
     pub max_point_error: f64,
+    /// Search and follow the curves on their own scale where the window is much wider (κ
+    /// beyond 2 max(1, κ), ε beyond 4 max(1, |ε|)): seed rows and energies at every scale
+    /// from the window's bottom up, continuation steps of the curve's size
+    /// ([`Tracer::scale_at`]). Off, everything is measured in the window's widths (the
+    /// verdict's windows, fitted round the body's cusp).
+    pub natural_scales: bool,
 }
 
 impl ResonanceOptions {
@@ -65,6 +71,7 @@ impl ResonanceOptions {
             },
             max_points: 20_000,
             max_point_error: 1e-6,
+            natural_scales: true,
         }
     }
 }
@@ -96,9 +103,22 @@ pub struct Curve {
     pub closed: bool,
 }
 
+/// What the top of a curve (its point of largest κ) is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Top {
+    /// A fold: the curve turns smoothly there, ∂N/∂ε = 0 (the curve's tangent is along ε).
+    Fold,
+    /// A corner or an end: the curve turns sharply there (at a cusp, where the separatrix it
+    /// hugs ends) or cannot be followed further (it runs into a separatrix); ∂N/∂ε ≠ 0.
+    Corner,
+}
+
 /// The fold of the N = p/q curve of largest κ.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Fold {
+    /// Whether κ_max is a fold (∂N/∂ε = 0) or a corner of the curve.
+    pub top: Top,
     pub kappa_max: f64,
     pub energy: f64,
     pub rotation_number: f64,
@@ -310,13 +330,49 @@ fn nearest_root(
 struct Tracer<'a, S: Shape> {
     body: &'a Body<S>,
     options: &'a ResonanceOptions,
-    /// Scales of κ and ε: continuation runs in the window scaled to the unit square.
-    scale: (f64, f64),
+    /// The window's widths in κ and ε: the largest scales of [`Tracer::scale_at`].
+    window: (f64, f64),
     /// Asked between seed rows and continuation steps: true gives up (Ctrl-C in Python).
     stop: &'a (dyn Fn() -> bool + Sync),
 }
 
-impl<S: Shape> Tracer<'_, S> {
+impl<'a, S: Shape> Tracer<'a, S> {
+    fn new(
+        body: &'a Body<S>,
+        options: &'a ResonanceOptions,
+        stop: &'a (dyn Fn() -> bool + Sync),
+    ) -> Self {
+        Self {
+            body,
+            options,
+            window: (
+                options.kappa.1 - options.kappa.0,
+                options.energy.1 - options.energy.0,
+            ),
+            stop,
+        }
+    }
+
+    /// The scales of κ and ε at (κ, ε): continuation steps and distances are measured in
+    /// units of these. The window's widths, but no more than 2 max(1, |κ|) and
+    /// 4 max(1, |ε|): the curves' features have the body's unit of size where κ, ε are of
+    /// order one and grow with κ and ε beyond (ε ≥ V ≥ κ²/2 − 1), so a window far wider than
+    /// where a curve runs (ε up to 1e6, κ up to 1e150) still follows it in steps of its own
+    /// size.
+    fn scale_at(&self, kappa: f64, energy: f64) -> (f64, f64) {
+        if !self.options.natural_scales {
+            return self.window;
+        }
+        (
+            self.window.0.min(2.0 * kappa.abs().max(1.0)),
+            self.window.1.min(4.0 * energy.abs().max(1.0)),
+        )
+    }
+
+    fn scale(&self, p: &CurvePoint) -> (f64, f64) {
+        self.scale_at(p.kappa, p.energy)
+    }
+
     fn at(&self, kappa: f64, energy: f64, well: f64) -> Option<CurvePoint> {
         let potential = EffectivePotential::new(self.body, kappa);
         evaluate(&potential, energy, well, &self.options.cell)
@@ -334,21 +390,22 @@ impl<S: Shape> Tracer<'_, S> {
             && (p.rotation_number - self.options.target).abs() <= self.tol().max(p.error_estimate)
     }
 
-    /// ∇N in scaled coordinates, by central differences with steps that stay well inside
-    /// the point's gap between separatrices.
+    /// ∇N = (∂N/∂κ, ∂N/∂ε), by central differences with steps (in `p`'s scaled units)
+    /// that stay well inside the point's gap between separatrices.
     fn gradient(&self, p: &CurvePoint) -> Option<(f64, f64)> {
         let potential = EffectivePotential::new(self.body, p.kappa);
+        let scale = self.scale(p);
         let distance = side_of(&potential.separatrix_levels(), p.energy)
             .map_or(f64::INFINITY, |s| (p.energy - s.level).abs());
-        let h = (1e-7f64).min(0.01 * distance / self.scale.1).max(1e-15);
-        let (hk, he) = (h * self.scale.0, h * self.scale.1);
+        let h = (1e-7f64).min(0.01 * distance / scale.1).max(1e-15);
+        let (hk, he) = (h * scale.0, h * scale.1);
         let kp = self.at(p.kappa + hk, p.energy, p.well)?;
         let km = self.at(p.kappa - hk, p.energy, p.well)?;
         let ep = evaluate(&potential, p.energy + he, p.well, &self.options.cell)?;
         let em = evaluate(&potential, p.energy - he, p.well, &self.options.cell)?;
         Some((
-            (kp.rotation_number - km.rotation_number) / (2.0 * h),
-            (ep.rotation_number - em.rotation_number) / (2.0 * h),
+            (kp.rotation_number - km.rotation_number) / (2.0 * hk),
+            (ep.rotation_number - em.rotation_number) / (2.0 * he),
         ))
     }
 
@@ -367,6 +424,7 @@ impl<S: Shape> Tracer<'_, S> {
         let (k, e) = (self.options.kappa, self.options.energy);
         let target = self.options.target;
         let tol = self.tol();
+        let scale = self.scale(from);
         let side = side_of(
             &EffectivePotential::new(self.body, from.kappa).separatrix_levels(),
             from.energy,
@@ -385,13 +443,18 @@ impl<S: Shape> Tracer<'_, S> {
             if lo >= hi {
                 return None;
             }
-            let margin = 1e-15 * lo.abs().max(hi.abs().min(1e300));
-            let around = energy.clamp(lo + margin, hi - margin);
+            // Strictly inside the gap, by a rounding of its ends.
+            let (inner_lo, inner_hi) = (lo + 1e-15 * lo.abs(), hi - 1e-15 * hi.abs());
+            let around = if inner_lo < inner_hi {
+                energy.clamp(inner_lo, inner_hi)
+            } else {
+                0.5 * (lo + hi)
+            };
             let f = |x: f64| {
                 evaluate(&potential, x, from.well, &self.options.cell)
                     .map(|p| p.rotation_number - target)
             };
-            let root = nearest_root(f, lo, hi, around, step * self.scale.1 * 0.05, tol)?;
+            let root = nearest_root(f, lo, hi, around, step * scale.1 * 0.05, tol)?;
             evaluate(&potential, root, from.well, &self.options.cell)?
         } else {
             if energy < e.0 || energy > e.1 {
@@ -406,7 +469,7 @@ impl<S: Shape> Tracer<'_, S> {
                     .map(|p| p.rotation_number - target)
             };
             let around = kappa.clamp(k.0, k.1);
-            let root = nearest_root(f, k.0, k.1, around, step * self.scale.0 * 0.05, tol)?;
+            let root = nearest_root(f, k.0, k.1, around, step * scale.0 * 0.05, tol)?;
             self.at(root, energy, from.well)?
         };
         let potential = EffectivePotential::new(self.body, point.kappa);
@@ -414,8 +477,9 @@ impl<S: Shape> Tracer<'_, S> {
             .then_some(point)
     }
 
-    /// The curve through `seed` (on N = p/q), followed both ways until it leaves the window,
-    /// ends (its component disappears, or it runs into a separatrix) or closes.
+    /// The curve through `seed` (on N = p/q, where ∇N = `gradient`), followed both ways
+    /// until it leaves the window, ends (its component disappears, or it runs into a
+    /// separatrix) or closes.
     fn trace(&self, seed: CurvePoint, gradient: (f64, f64)) -> Curve {
         // Steps below s_min end the curve: where a curve can no longer be followed (it runs
         // into a separatrix, where the points' positions are limited by N's conditioning)
@@ -426,11 +490,13 @@ impl<S: Shape> Tracer<'_, S> {
         let mut closed = false;
         for (half, sign) in halves.iter_mut().zip([1.0, -1.0]) {
             let mut p = seed;
-            let mut t = tangent(gradient, sign);
+            let scale = self.scale(&seed);
+            let mut t = tangent((gradient.0 * scale.0, gradient.1 * scale.1), sign);
             let mut s = 0.25 * s_max;
             while half.len() < self.options.max_points && s >= s_min && !(self.stop)() {
-                let k = p.kappa + s * t.0 * self.scale.0;
-                let e = p.energy + s * t.1 * self.scale.1;
+                let scale = self.scale(&p);
+                let k = p.kappa + s * t.0 * scale.0;
+                let e = p.energy + s * t.1 * scale.1;
                 // Solve along ε unless the curve runs nearly along ε: along ε the corrector
                 // stays between the separatrices at the new κ, which a curve hugging one needs.
                 let along_energy = t.0.abs() >= 0.2;
@@ -446,8 +512,8 @@ impl<S: Shape> Tracer<'_, S> {
                     continue;
                 }
                 let t_new = (
-                    (q.kappa - p.kappa) / self.scale.0 / moved,
-                    (q.energy - p.energy) / self.scale.1 / moved,
+                    (q.kappa - p.kappa) / scale.0 / moved,
+                    (q.energy - p.energy) / scale.1 / moved,
                 );
                 // Too sharp a turn: a smaller step (not on the first step, whose direction
                 // comes from a finite-difference gradient).
@@ -480,22 +546,26 @@ impl<S: Shape> Tracer<'_, S> {
         Curve { points, closed }
     }
 
-    /// Distance of `p` from the window's edge, in scaled units.
+    /// Distance of `p` from the window's edge, in `p`'s scaled units.
     fn edge_distance(&self, p: &CurvePoint) -> f64 {
         let (k, e) = (self.options.kappa, self.options.energy);
-        let u = ((p.kappa - k.0) / self.scale.0).min((k.1 - p.kappa) / self.scale.0);
-        let v = ((p.energy - e.0) / self.scale.1).min((e.1 - p.energy) / self.scale.1);
+        let scale = self.scale(p);
+        let u = ((p.kappa - k.0) / scale.0).min((k.1 - p.kappa) / scale.0);
+        let v = ((p.energy - e.0) / scale.1).min((e.1 - p.energy) / scale.1);
         u.min(v)
     }
 
+    /// The distance from `a` to `b` in `a`'s scaled units.
     fn distance(&self, a: &CurvePoint, b: &CurvePoint) -> f64 {
-        ((a.kappa - b.kappa) / self.scale.0).hypot((a.energy - b.energy) / self.scale.1)
+        let scale = self.scale(a);
+        ((a.kappa - b.kappa) / scale.0).hypot((a.energy - b.energy) / scale.1)
     }
 
-    /// The κ of the seed rows: the grid's, and rows crowding towards every κ where the number
-    /// of critical points of V changes (a cusp, where a separatrix ends): curves that hug a
-    /// separatrix can be located in double precision only near its end, where N varies more
-    /// slowly with the distance from it.
+    /// The κ of the seed rows: the grid's; where the window is much wider than the curves'
+    /// features near κ_min (see [`Tracer::scale_at`]), [`natural_points`] from κ_min; and rows
+    /// crowding towards every κ where the number of critical points of V changes (a cusp,
+    /// where a separatrix ends): curves that hug a separatrix can be located in double
+    /// precision only near its end, where N varies more slowly with the distance from it.
     fn seed_rows(&self) -> Vec<f64> {
         let n = self.options.grid;
         let (k0, k1) = self.options.kappa;
@@ -506,6 +576,11 @@ impl<S: Shape> Tracer<'_, S> {
                 .len()
         };
         let mut rows: Vec<f64> = (0..=n).map(|i| k0 + step * i as f64).collect();
+        if self.options.natural_scales {
+            rows.extend(natural_points(k0, k1, 2.0 * k0.max(1.0), n));
+        }
+        rows.sort_by(f64::total_cmp);
+        rows.dedup();
         let counts: Vec<usize> = rows.iter().map(|&k| count(k)).collect();
         for i in 0..n {
             if counts[i] == counts[i + 1] {
@@ -530,8 +605,9 @@ impl<S: Shape> Tracer<'_, S> {
     }
 
     /// Points on N = p/q on the rows of the seed grid: for every well and every gap between
-    /// critical levels, sign changes of N − p/q on the grid's energies and on points that
-    /// approach the gap's ends geometrically, refined to the tolerance.
+    /// critical levels, sign changes of N − p/q on the grid's energies, on
+    /// [`natural_points`] from the gap's bottom where the window is much wider than that,
+    /// and on points that approach the gap's ends geometrically, refined to the tolerance.
     fn seeds(&self) -> Vec<CurvePoint> {
         use rayon::prelude::*;
         let n = self.options.grid;
@@ -546,6 +622,7 @@ impl<S: Shape> Tracer<'_, S> {
                 }
                 let potential = EffectivePotential::new(self.body, kappa);
                 let levels = potential.separatrix_levels();
+                let bottom = potential.lowest_minimum().unwrap_or(e0);
                 let wells: Vec<f64> = potential
                     .critical_points()
                     .iter()
@@ -562,7 +639,7 @@ impl<S: Shape> Tracer<'_, S> {
                     bounds.extend(levels.iter().copied());
                     bounds.push(f64::INFINITY);
                     for gap in bounds.windows(2) {
-                        let (lo, hi) = (gap[0].max(e0), gap[1].min(e1));
+                        let (lo, hi) = (gap[0].max(e0).max(bottom), gap[1].min(e1));
                         if lo >= hi {
                             continue;
                         }
@@ -570,6 +647,9 @@ impl<S: Shape> Tracer<'_, S> {
                             .map(|j| e0 + (e1 - e0) * j as f64 / n as f64)
                             .filter(|&x| x > lo && x < hi)
                             .collect();
+                        if self.options.natural_scales {
+                            xs.extend(natural_points(lo, hi, 4.0 * lo.abs().max(1.0), n));
+                        }
                         let mid = 0.5 * (lo + hi);
                         for j in 1..=52 {
                             xs.push(hi - (hi - mid) * 0.5f64.powi(j));
@@ -607,6 +687,30 @@ impl<S: Shape> Tracer<'_, S> {
             })
             .collect()
     }
+}
+
+/// Seed points in (lo, hi) on the scale `unit` of the features near `lo`, where the interval
+/// is more than twice as wide (none otherwise: the grid's own points suffice): `grid` steps
+/// over lo + (0, unit], then lo + unit·2^x up to `hi` for x four to an octave up to 8, one
+/// an octave up to 64, one in eight octaves beyond (far out, at fixed κ, N tends to its
+/// limit as ε → ∞ smoothly in log ε). A window of ε up to 1e300 takes about 200 points.
+fn natural_points(lo: f64, hi: f64, unit: f64, grid: usize) -> Vec<f64> {
+    if hi - lo <= 2.0 * unit || hi.is_nan() || lo.is_nan() {
+        return Vec::new();
+    }
+    let mut out: Vec<f64> = (1..=grid)
+        .map(|j| lo + unit * j as f64 / grid as f64)
+        .collect();
+    let octaves = (1..=32)
+        .map(|i| f64::from(i) / 4.0)
+        .chain((9..=64).map(f64::from))
+        .chain((9..).map(|i| f64::from(8 * i)));
+    out.extend(
+        octaves
+            .map(|x| lo + unit * x.exp2())
+            .take_while(|&x| x < hi),
+    );
+    out
 }
 
 /// Whether two nearby points lie on the same family of tori: both turning points within
@@ -679,6 +783,15 @@ fn check_window(options: &ResonanceOptions) -> Result<()> {
     if !options.target.is_finite() {
         return bad("rotation_number", options.target, "must be finite");
     }
+    // A curve's points have N = p/q to the tolerance: coarser, the band N = p/q ± tol is
+    // wide enough to hold points of other curves, and the continuation wanders in it.
+    check_range(
+        "tol",
+        options.cell.tol,
+        None,
+        Some((1e-4, true)),
+        "must be at most 1e-4 for resonance curves (their points have N = P/Q to the tolerance)",
+    )?;
     if !(4..=MAX_GRID).contains(&options.grid) {
         return bad(
             "grid",
@@ -708,15 +821,7 @@ pub fn trace_curves_until<S: Shape>(
     stop: &(dyn Fn() -> bool + Sync),
 ) -> Result<Vec<Curve>> {
     check_window(options)?;
-    let tracer = Tracer {
-        body,
-        options,
-        scale: (
-            options.kappa.1 - options.kappa.0,
-            options.energy.1 - options.energy.0,
-        ),
-        stop,
-    };
+    let tracer = Tracer::new(body, options, stop);
     let stopped = || {
         if stop() {
             Err(AtlasError::Stopped)
@@ -763,12 +868,52 @@ pub fn trace_curves_until<S: Shape>(
             kept.push(c);
         }
     }
-    Ok(kept)
+    Ok(stitched(&tracer, kept, near))
+}
+
+/// `curves` with every two open curves whose ends meet (within `near`, on the same torus)
+/// joined into one: where the continuation cannot follow a curve through a sharp turn (its
+/// component changing fast, by a cusp), the curve is traced again from a seed on the other
+/// side and ends there too.
+fn stitched<S: Shape>(tracer: &Tracer<'_, S>, mut curves: Vec<Curve>, near: f64) -> Vec<Curve> {
+    let meet = |a: &CurvePoint, b: &CurvePoint| tracer.distance(a, b) < near && same_torus(a, b);
+    'join: loop {
+        for i in 0..curves.len() {
+            for j in 0..curves.len() {
+                if i == j || curves[i].closed || curves[j].closed {
+                    continue;
+                }
+                // Ends of i (last, first) against ends of j (first, last).
+                for (i_last, j_first) in
+                    [(true, true), (true, false), (false, true), (false, false)]
+                {
+                    let (a, b) = (&curves[i].points, &curves[j].points);
+                    let end_a = if i_last { a[a.len() - 1] } else { a[0] };
+                    let end_b = if j_first { b[0] } else { b[b.len() - 1] };
+                    if !meet(&end_a, &end_b) {
+                        continue;
+                    }
+                    let mut second = curves.remove(j);
+                    let first = &mut curves[if j < i { i - 1 } else { i }];
+                    if !i_last {
+                        first.points.reverse();
+                    }
+                    if !j_first {
+                        second.points.reverse();
+                    }
+                    first.points.extend(second.points);
+                    continue 'join;
+                }
+            }
+        }
+        return curves;
+    }
 }
 
 /// The fold of the N = p/q curve of largest κ: the point of largest κ on the traced curves,
-/// refined by a golden-section search over ε of κ(ε), where κ(ε) solves N(κ, ε) = p/q. None
-/// if no curve is found, or if the curve of largest κ leaves the window through κ_max.
+/// refined by a golden-section search over ε of κ(ε), where κ(ε) solves N(κ, ε) = p/q; its
+/// [`Top`] says whether it is a fold (∂N/∂ε = 0) or a corner. None if no curve is found, if
+/// the curve of largest κ leaves the window through κ_max, or if it is a single point.
 pub fn fold<S: Shape>(body: &Body<S>, options: &ResonanceOptions) -> Result<Option<Fold>> {
     fold_until(body, options, &|| false)
 }
@@ -794,12 +939,7 @@ pub fn fold_until<S: Shape>(
     if top.kappa >= options.kappa.1 - 2.0 * window / options.grid as f64 {
         return Ok(None);
     }
-    let tracer = Tracer {
-        body,
-        options,
-        scale: (window, options.energy.1 - options.energy.0),
-        stop,
-    };
+    let tracer = Tracer::new(body, options, stop);
     let tol = options.cell.tol.max(1e-13);
     // κ(ε) on the curve near the top: the root of N − p/q in κ nearest the last one (the
     // line of constant ε may cross the curve again on its other branch, further off).
@@ -868,11 +1008,22 @@ pub fn fold_until<S: Shape>(
     let Some((kappa, point)) = kappa_at(energy, start) else {
         return Ok(None);
     };
-    let (gk, ge) = tracer.gradient(&point).unwrap_or((f64::NAN, f64::NAN));
-    let (dn_dkappa, dn_denergy) = (gk / window, ge / (options.energy.1 - options.energy.0));
+    let (dn_dkappa, dn_denergy) = tracer.gradient(&point).unwrap_or((f64::NAN, f64::NAN));
     // The solver's tolerance through ∂N/∂κ, plus the spread of κ over the final bracket.
     let kappa_error = tol.max(point.error_estimate) / dn_dkappa.abs() + (fc - fd).abs();
+    // A fold where the curve's tangent, (−∂N/∂ε, ∂N/∂κ) in scaled units, runs along ε to
+    // within 3° (the finite differences of N solved to 1e-10 give the angle to ~1e-3), and
+    // the top lies inside its curve.
+    let scale = tracer.scale(&point);
+    let (gk, ge) = (dn_dkappa * scale.0, dn_denergy * scale.1);
+    let inside = curve.closed || (index > 0 && index + 1 < curve.points.len());
+    let top = if inside && ge.abs() <= 0.05 * gk.hypot(ge) {
+        Top::Fold
+    } else {
+        Top::Corner
+    };
     Ok(Some(Fold {
+        top,
         kappa_max: kappa,
         energy,
         rotation_number: point.rotation_number,

@@ -282,6 +282,20 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
     // A current output (made from this scene by this build for this shard): --update
     // keeps it without a census.
     if out.exists() && request.update && request.output_current {
+        // A run over it that was stopped (a `--force`) left its journal and partial file:
+        // with the output current they hold nothing to resume. Only a journal this program
+        // made is removed (a real directory that looks like one, never through a link).
+        let journal_dir = Journal::dir_for(out);
+        let ours = std::fs::symlink_metadata(&journal_dir).is_ok_and(|m| m.is_dir())
+            && Journal::looks_like_one(&journal_dir);
+        if ours {
+            std::fs::remove_dir_all(&journal_dir)
+                .map_err(|e| AtlasError::atlas(&journal_dir, e))?;
+            let partial = temporary_path(out);
+            if std::fs::symlink_metadata(&partial).is_ok_and(|m| m.is_file()) {
+                std::fs::remove_file(&partial).map_err(|e| AtlasError::atlas(&partial, e))?;
+            }
+        }
         return Ok(Summary {
             up_to_date: true,
             seconds: started.elapsed().as_secs_f64(),

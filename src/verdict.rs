@@ -496,6 +496,7 @@ fn kappa_max(
             cell,
             max_points: 20_000,
             max_point_error: 1e-6,
+            natural_scales: false,
         };
         if let Some(fold) = resonance::fold_until(body, &options, stop)? {
             // Where the top is not a smooth fold (∂N/∂ε ≠ 0 there: the curve meets a

@@ -173,6 +173,13 @@ def _numbers(name: str, value) -> np.ndarray:
         return array
     # Converted where the values are stored: a broadcast view stays a view.
     stored = array[tuple(slice(None) if stride else slice(0, 1) for stride in array.strides)]
+    if kind == "f" and array.dtype.itemsize > 8:
+        # A long double beyond float64 would become inf (with numpy's overflow warning).
+        beyond = np.isfinite(stored) & (np.abs(stored) > np.finfo(np.float64).max)
+        if beyond.any():
+            index = tuple(int(i) for i in np.argwhere(beyond)[0]) if stored.ndim else ()
+            raise ValueError(f"invalid {name}{_at(index)} = {np.format_float_scientific(stored[index], precision=3, trim='-')}: beyond the largest float64 "
+                             f"({np.finfo(np.float64).max:.3g})")
     if stored.shape == array.shape:
         return array.astype(np.float64)
     return np.broadcast_to(stored.astype(np.float64), array.shape)
@@ -1056,7 +1063,11 @@ def open_atlas(path: str | Path, check: bool = False, **kwargs) -> xr.Dataset:
         _survives_reading(path)
     kwargs.setdefault("engine", "h5netcdf")
     try:
-        ds = xr.open_dataset(path, **kwargs)
+        # Warnings are held until the file is known to be an atlas: on another file, xarray's
+        # words about it would come before the one line that refuses it.
+        with warnings.catch_warnings(record=True) as heard:
+            warnings.simplefilter("always")
+            ds = xr.open_dataset(path, **kwargs)
     except TypeError as e:
         if "keyword" in str(e):
             raise  # a keyword open_dataset does not take: the caller's mistake, as it is
@@ -1069,6 +1080,8 @@ def open_atlas(path: str | Path, check: bool = False, **kwargs) -> xr.Dataset:
         ds.close()
         raise ValueError(f"{path}: not a rubber-atlas atlas (a file of `rubber-atlas run` or `merge` has the "
                          "attributes program and scene and the variable cell_status)")
+    for warning in heard:
+        warnings.warn_explicit(warning.message, warning.category, warning.filename, warning.lineno)
     if check:
         try:
             _read_every_chunk(path)

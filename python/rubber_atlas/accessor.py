@@ -353,13 +353,14 @@ class RubberAccessor:
         ----------
         alpha_index, beta_index : int, default 0
             The body of an atlas (indices along ``alpha`` and ``beta``), when the dataset
-            has those dimensions.
+            has those dimensions; a negative index counts from the end, as in numpy (−1 is
+            the last).
         max_q : int, default 7
             The largest denominator q of the contours N = p/q, ≥ 1; lowered where a panel
             would have more than 60 contours.
         cut_index : int, default 0
-            The cut of a truncated ball or wheel atlas (index along ``cut``; the disk's
-            atlas has no second dimension).
+            The cut of a truncated ball or wheel atlas (index along ``cut``, negative from
+            the end; the disk's atlas has no second dimension).
 
         Returns
         -------
@@ -411,7 +412,7 @@ class RubberAccessor:
             size = ds.sizes[name]
             if not -size <= index < size:
                 raise ValueError(f"invalid {name}_index = {index}: the dataset has {size} value{'s' * (size != 1)} "
-                                 f"of {name} (index 0 … {size - 1})")
+                                 f"of {name} (index 0 … {size - 1}, or {-size} … -1 from the end)")
             if name in ds.cell_status.dims:
                 cut = cut.isel({name: index})
         plane = list(cut.cell_status.dims)

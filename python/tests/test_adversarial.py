@@ -245,7 +245,8 @@ def test_plot_slice_refuses_indices_it_does_not_have(slice_atlas):
     matplotlib.use("Agg")
     with ra.open_atlas(slice_atlas) as atlas:
         refused(ValueError, lambda: atlas.rubber.plot_slice(alpha_index=5), "alpha_index = 5")
-        refused(ValueError, lambda: atlas.rubber.plot_slice(beta_index=-2), "beta_index = -2")
+        # Negative indices count from the end, as in numpy, and the message says so.
+        refused(ValueError, lambda: atlas.rubber.plot_slice(beta_index=-2), "beta_index = -2", "from the end")
         refused(TypeError, lambda: atlas.rubber.plot_slice(alpha_index="x"), "alpha_index")
         refused(ValueError, lambda: atlas.rubber.plot_slice(max_q=0), "max_q")
     cells = ra.cells(*BODY, kappa=np.linspace(0.1, 1.0, 4), energy=np.linspace(1.5, 3.5, 3))
@@ -542,3 +543,32 @@ def test_a_length_one_vector_with_a_longer_one_makes_a_grid():
     # Equal lengths still pair up, as numpy broadcasts them.
     ds = ra.cells(0.5, 3.0, 0.5, 0.5, kappa=np.array([0.8, 0.9]), energy=np.array([2.5, 3.0]))
     assert dict(ds.cell_status.sizes) == {"cell": 2}
+
+
+def test_a_foreign_hdf5_file_is_refused_before_any_warning_of_xarray(tmp_path):
+    # A dataset without dimension scales: xarray warns about its phony dimensions on opening.
+    path = tmp_path / "foreign.h5"
+    with h5py.File(path, "w") as f:
+        f.create_dataset("t", data=np.arange(3.0))
+    with warnings.catch_warnings(record=True) as heard:
+        warnings.simplefilter("always")
+        refused(ValueError, lambda: ra.open_atlas(path), "not a rubber-atlas atlas")
+    assert [str(w.message) for w in heard] == []
+
+
+def test_a_long_double_beyond_float64_is_refused_not_made_infinite():
+    if np.finfo(np.longdouble).max <= np.finfo(np.float64).max:
+        pytest.skip("this machine's long double is a float64")
+    huge = np.longdouble("1e400")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # numpy's overflow warning would be an error here
+        refused(ValueError, lambda: ra.cells(*BODY, kappa=huge, energy=2.5), "invalid kappa = 1e+400",
+                "beyond the largest float64")
+        refused(ValueError, lambda: ra.cells(*BODY, kappa=0.8, energy=np.array([2.5, -huge])),
+                "invalid energy[1] = -1e+400")
+        # Within float64's range a long double is taken as its nearest float64.
+        assert ra.cells(*BODY, kappa=np.longdouble(0.8), energy=2.5).rotation_number.notnull().any()
+
+
+def test_a_subnormal_nu_is_refused_naming_nu():
+    refused(ValueError, lambda: ra.cells(0.5, 3.0, 1e-310, 0.5, kappa=0.8, energy=2.5), "invalid nu = ")

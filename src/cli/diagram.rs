@@ -41,7 +41,9 @@ pub struct DiagramArgs {
     /// Overwrite an existing --out file.
     #[arg(long)]
     pub force: bool,
-    /// Samples of θ0 per half (θ0 < π/2, θ0 > π/2) of the fixed-point curves.
+    /// Samples of θ0 per half (θ0 < π/2, θ0 > π/2) of the fixed-point curves: written by
+    /// --out; with --json or the text, each branch's ranges of θ0, κ, ε and N are found over
+    /// them (the default is plenty there; more only costs time).
     #[arg(long, default_value_t = 2000, allow_hyphen_values = true)]
     pub samples: usize,
     #[command(flatten)]

@@ -38,10 +38,12 @@ pub struct ResonanceArgs {
     /// rows, but a closed curve that crosses no row is missed.
     #[arg(long, default_value_t = 48, allow_hyphen_values = true)]
     pub grid: usize,
-    /// Tolerance of the cell solver (N on the curve equals P/Q to this).
+    /// Tolerance of the cell solver (N on the curve equals P/Q to this; at most 1e-4).
     #[arg(value_parser = number, long, default_value_t = 1e-10, allow_hyphen_values = true)]
     pub tol: f64,
-    /// Print the fold of the curve of largest κ as JSON {"kappa_max": …, "energy": …}.
+    /// Print the top (largest κ) of the curve of largest κ as JSON {"kappa_max": …, "energy":
+    /// …, "fold": {"top": …}}: "fold" where ∂N/∂ε = 0 there, "corner" where the curve turns
+    /// sharply there (at a cusp) or ends (at a separatrix).
     #[arg(long)]
     pub fold: bool,
     /// Print the curves as JSON.
@@ -67,6 +69,17 @@ pub(super) fn parse_rotation_number(text: &str) -> Result<f64> {
             let q: i64 = q.trim().parse().map_err(|_| bad())?;
             if q == 0 {
                 return Err(bad().into());
+            }
+            // Up to 2^53 every whole number is a double, and p/q is rounded once.
+            const EXACT: u64 = 1 << 53;
+            if p.unsigned_abs() > EXACT || q.unsigned_abs() > EXACT {
+                return Err(AtlasError::Atlas {
+                    path: format!("--rotation-number {text}"),
+                    reason: "P and Q must be at most 2^53 = 9007199254740992 in size (beyond, \
+                             whole numbers are not all doubles)"
+                        .into(),
+                }
+                .into());
             }
             p as f64 / q as f64
         }
@@ -136,7 +149,8 @@ pub(super) fn resonance(args: ResonanceArgs) -> Result<()> {
                 value["energy"] = serde_json::Value::Null;
                 value["reason"] = serde_json::json!(
                     "no N = P/Q curve in the window, or the curve of largest kappa leaves it \
-                     through kappa_max (widen --kappa-max)"
+                     through kappa_max (widen --kappa-max), or that curve is a single point (it \
+                     could not be followed from its seed)"
                 );
             }
         }

@@ -177,10 +177,20 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
         }
     }
     // --threads, else RAYON_NUM_THREADS (as rayon itself reads it), else every core.
-    let from_env = std::env::var("RAYON_NUM_THREADS")
-        .ok()
-        .and_then(|v| v.trim().parse::<usize>().ok())
-        .filter(|&n| n > 0);
+    // (0, as for rayon, is every core; anything but a whole number is refused, not ignored.)
+    let from_env = match std::env::var("RAYON_NUM_THREADS") {
+        Ok(v) if !v.trim().is_empty() => match v.trim().parse::<usize>() {
+            Ok(n) => Some(n).filter(|&n| n > 0),
+            Err(_) => {
+                return Err(AtlasError::Atlas {
+                    path: format!("RAYON_NUM_THREADS = {v:?}"),
+                    reason: "must be a whole number of threads (0 or unset: every core)".into(),
+                }
+                .into())
+            }
+        },
+        _ => None,
+    };
     let threads = match args.threads.or(from_env) {
         Some(0) => {
             return Err(AtlasError::Atlas {
@@ -204,7 +214,7 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
             format!(
                 "the run has {:.3e} cells: {}use fewer kappa or energy points",
                 need.cells,
-                shards_to_fit(&scene, threads)
+                shards_to_fit(&scene, &out, threads)
             )
         },
     )?;
@@ -274,32 +284,41 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
     Ok(())
 }
 
-/// The smallest shard count that tiles the grid and whose shards each fit in half the
-/// available memory, as a phrase for the refusal (the general advice when no count up to
-/// 4096 does; "" when the machine's memory is unknown).
-pub(super) fn shards_to_fit(scene: &Scene, threads: usize) -> String {
-    let Some(free) = rubber_atlas::machine::available_memory() else {
-        return String::new();
-    };
+/// A shard count that tiles the grid and whose shards each fit in half the available memory
+/// and in the free disk beside `out` (a machine like this one), as a phrase for the refusal.
+/// The search starts where the whole run's need divided by what is there says and tries 256
+/// counts, then 256 from a count a quarter larger, and so on (a shard's memory has a floor,
+/// its threads' work units, so the first guess can be short). Where even the most shards
+/// do not fit, it says that a work unit is too large for the machine.
+pub(super) fn shards_to_fit(scene: &Scene, out: &std::path::Path, threads: usize) -> String {
+    let memory = rubber_atlas::machine::available_memory().map_or(f64::INFINITY, |m| 0.5 * m);
+    let disk = rubber_atlas::machine::free_disk(out).unwrap_or(f64::INFINITY);
     let shape = scene.shape();
     let most: usize = rubber_atlas::atlas::Region::positions(shape)
         .iter()
         .product();
-    (2..=most.min(1 << 12))
-        .map(|count| Shard { index: 1, count })
-        .find(|s| {
-            s.check_against(shape, scene.second_name()).is_ok()
-                && sweep::footprint(scene, *s, threads).memory_bytes <= 0.5 * free
-        })
-        .map_or_else(
-            || "split it with --shard I/N across machines, or ".to_string(),
-            |s| {
-                format!(
-                    "split it with --shard I/{} across machines (the fewest shards that fit), or ",
-                    s.count
-                )
-            },
-        )
+    let fits = |count: usize| {
+        let shard = Shard { index: 1, count };
+        let need = sweep::footprint(scene, shard, threads);
+        shard.check_against(shape, scene.second_name()).is_ok()
+            && need.memory_bytes <= memory
+            && need.disk_bytes <= disk
+    };
+    let whole = sweep::footprint(scene, Shard::WHOLE, threads);
+    let needed = (whole.memory_bytes / memory).max(whole.disk_bytes / disk);
+    // (as usize saturates; a count is at least 2.)
+    let mut from = (needed.ceil() as usize).clamp(2, most.max(2));
+    while from <= most {
+        if let Some(count) = (from..=most.min(from + 255)).find(|&c| fits(c)) {
+            return format!(
+                "split it with --shard I/{count} across machines (enough shards to fit), or "
+            );
+        }
+        from = from.saturating_add(256).max(from.saturating_add(from / 4));
+    }
+    "even a shard of one work unit (a block of kappa-rows, every energy) does not fit this \
+     machine: "
+        .to_string()
 }
 
 pub(super) fn print_summary(summary: &sweep::Summary, out: &std::path::Path, threads: usize) {

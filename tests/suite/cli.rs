@@ -506,6 +506,16 @@ fn edge_inputs_get_one_line_and_never_a_panic() {
     fold.extend(BODY);
     fold.extend(["--rotation-number", "0", "--fold", "--out", t_s]);
     assert_refused(&fold, "--fold", Some(&t));
+    // A tolerance so loose that the band N = P/Q ± tol holds other curves' points.
+    let mut loose: Vec<&str> = vec!["resonance"];
+    loose.extend(BODY);
+    loose.extend(["--rotation-number", "-1/7", "--tol", "0.1"]);
+    assert_refused(&loose, "invalid tol = 0.1", None);
+    // P or Q beyond 2^53 would be rounded before the division, silently.
+    let mut big: Vec<&str> = vec!["resonance"];
+    big.extend(BODY);
+    big.extend(["--rotation-number", "9007199254740993/1"]);
+    assert_refused(&big, "2^53", None);
     // Messages: -inf as a value, a huge θ̇(0), a missing merge input.
     let mut inf: Vec<&str> = vec!["cell", "--alpha", "-inf", "--beta", "3", "--nu", "0.5"];
     inf.extend(["--eta", "0.5", "--kappa", "1", "--energy", "2"]);
@@ -789,6 +799,32 @@ fn requests_beyond_any_machine_are_refused_within_a_second() {
             start.elapsed()
         );
     }
+    // The refusal names the shard count that fits memory and disk, also for grids that need
+    // more than 4096 shards or are short of disk alone (1e5 × 1e5 bodies of one cell each
+    // named none, or 2 for a 9.5 TB file: the disk was not counted).
+    let wide = d.join("wide.toml");
+    std::fs::write(
+        &wide,
+        "name = \"wide\"\n[body]\nnu = 0.5\neta = 0.5\n[axes]\n\
+         alpha = { start = 0.1, stop = 0.5, num = 100000 }\n\
+         beta = { start = 1.0, stop = 3.0, num = 100000 }\nkappa = [0.8]\nenergy = [2.5]\n",
+    )
+    .unwrap();
+    for scene in [&scene, &wide] {
+        let o = run(&[
+            "run",
+            scene.to_str().unwrap(),
+            "--out",
+            atlas.to_str().unwrap(),
+        ]);
+        let err = stderr(&o);
+        let count: usize = err
+            .split_once("--shard I/")
+            .and_then(|(_, rest)| rest.split(' ').next())
+            .and_then(|n| n.parse().ok())
+            .unwrap_or_else(|| panic!("no shard count in {err}"));
+        assert!(count > 2, "{err}");
+    }
 }
 
 #[test]
@@ -881,18 +917,30 @@ fn version_completions_manual_threads_and_names_follow_the_conventions() {
     let dir = tempfile::tempdir().unwrap();
     let scene = small_scene(dir.path(), 8);
     let out = dir.path().join("s.h5");
-    let o = Command::new(env!("CARGO_BIN_EXE_rubber-atlas"))
-        .args([
-            "run",
-            scene.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .env("RAYON_NUM_THREADS", "1")
-        .output()
-        .unwrap();
+    let with_threads = |value: &str| {
+        Command::new(env!("CARGO_BIN_EXE_rubber-atlas"))
+            .args([
+                "run",
+                scene.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ])
+            .arg("--force")
+            .env("RAYON_NUM_THREADS", value)
+            .output()
+            .unwrap()
+    };
+    let o = with_threads("1");
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(String::from_utf8_lossy(&o.stdout).contains("on 1 thread(s)"));
+    // One that is not a number is refused, not ignored.
+    let o = with_threads("abc");
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).starts_with("error: RAYON_NUM_THREADS = \"abc\""),
+        "{}",
+        stderr(&o)
+    );
 }
 
 #[test]

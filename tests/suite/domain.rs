@@ -183,6 +183,15 @@ fn the_cells_issue_22_found_answer_honestly() {
         refused.to_string().starts_with("invalid eta = 5e-324"),
         "{refused}"
     );
+    // A subnormal ν (zero to every sum, and slow): refused, naming ν; the least normal runs.
+    for nu in [5e-324, 1e-310] {
+        let refused = EllipsoidBody::ellipsoid(0.5, 3.0, nu, 0.5).unwrap_err();
+        assert!(
+            refused.to_string().starts_with("invalid nu = "),
+            "{refused}"
+        );
+    }
+    check_answer(0.5, 3.0, f64::MIN_POSITIVE, 0.5, 0.8, 2.5);
     check_answer(0.5, 3.0, 0.5, 0.5, 6.7e129, 4.4e299);
     for energy in [1e50, 1e100, 1e250, 1e300] {
         check_answer(0.5, 3.0, 0.5, 0.5, 0.8, energy);

@@ -4,7 +4,7 @@
 //! of the N = 0 curve agrees with a brute-force scan.
 
 use rubber_atlas::cell::{solve_cell, solve_level, CellOptions};
-use rubber_atlas::resonance::{fold, trace_curves, Curve, ResonanceOptions};
+use rubber_atlas::resonance::{fold, trace_curves, Curve, ResonanceOptions, Top};
 use rubber_atlas::torus::{CriticalKind, EffectivePotential};
 use rubber_atlas::EllipsoidBody;
 
@@ -25,6 +25,7 @@ fn options(target: f64) -> ResonanceOptions {
         },
         max_points: 20_000,
         max_point_error: 1e-6,
+        natural_scales: true,
     }
 }
 
@@ -199,4 +200,109 @@ fn the_fold_agrees_with_a_brute_force_scan() {
         "brute force {last_with_root}, fold {}",
         f.kappa_max
     );
+}
+
+/// Whether N − target changes sign along ε ∈ [e0, e1] (`steps` points) at κ, on the
+/// component holding θ = `well`.
+fn crosses(body: &EllipsoidBody, kappa: f64, (e0, e1): (f64, f64), well: f64, target: f64) -> bool {
+    let cell = CellOptions {
+        tol: 1e-10,
+        drift: false,
+        ..CellOptions::default()
+    };
+    let potential = EffectivePotential::new(body, kappa);
+    let signs: Vec<bool> = (0..=400)
+        .filter_map(|j| {
+            let energy = e0 + (e1 - e0) * j as f64 / 400.0;
+            let level = solve_level(&potential, energy, &cell).ok()?;
+            let c = level
+                .components
+                .iter()
+                .find(|c| c.theta_min <= well && well <= c.theta_max)?;
+            Some(c.rotation_number > target)
+        })
+        .collect();
+    signs.windows(2).any(|w| w[0] != w[1])
+}
+
+/// A window far wider than a curve finds the curve a narrow one finds, whole (adversary
+/// pass 4 of issue 22: the N = −1/7 curve came in 1, 2, 1, 2 and 0 pieces for ε up to 5, 50,
+/// 1e3, 1e6 and 1e300, and not at all for κ up to 1e150). In each window: one curve, with
+/// the same leftmost point (a fold in κ, checked by a brute-force scan), the same bottom (it
+/// ends at the separatrix) and the same turn at κ ≈ 1.1421, every tenth point N = −1/7 when
+/// solved again as a cell.
+#[test]
+fn a_wide_window_finds_the_curve_a_narrow_one_finds() {
+    let body = body();
+    let target = -1.0 / 7.0;
+    // The curve's leftmost κ, bracketed by brute force: rows just left of it do not reach
+    // N = −1/7 round the σ_s0 well (θ ≈ 0.63), rows just right of it do.
+    let (left, well) = (0.647_12, 0.629);
+    assert!(!crosses(&body, left - 5e-4, (3.9, 4.3), well, target));
+    assert!(crosses(&body, left + 5e-4, (3.9, 4.3), well, target));
+    for (kappa_max, energy_max) in [
+        (2.0, 5.0),
+        (2.0, 50.0),
+        (2.0, 1e3),
+        (2.0, 1e6),
+        (2.0, 1e300),
+        (1e150, 5.0),
+        (1e150, 1e300),
+    ] {
+        let options = ResonanceOptions::window(
+            &body,
+            target,
+            (0.01, kappa_max),
+            None,
+            energy_max,
+            48,
+            1e-10,
+        );
+        let curves = trace_curves(&body, &options).unwrap();
+        let window = format!("kappa <= {kappa_max:e}, energy <= {energy_max:e}");
+        assert_eq!(curves.len(), 1, "{window}: {} curves", curves.len());
+        let points = &curves[0].points;
+        let lowest = |f: fn(&&rubber_atlas::resonance::CurvePoint) -> f64| {
+            points.iter().map(|p| f(&p)).fold(f64::INFINITY, f64::min)
+        };
+        let (kappa_min, energy_min) = (lowest(|p| p.kappa), lowest(|p| p.energy));
+        assert!(
+            (kappa_min - left).abs() < 5e-4,
+            "{window}: leftmost {kappa_min}"
+        );
+        assert!(
+            (energy_min - 3.41).abs() < 0.01,
+            "{window}: bottom {energy_min}"
+        );
+        assert!(
+            points
+                .iter()
+                .any(|p| (p.kappa - 1.1421).abs() < 2e-3 && (p.energy - 3.775).abs() < 0.02),
+            "{window}: no point at the turn"
+        );
+        for p in points.iter().step_by(10) {
+            let cell = solve_cell(&body, p.kappa, p.energy, &options.cell).unwrap();
+            let got = &cell.components[p.component];
+            assert!(
+                (got.rotation_number - target).abs() <= options.cell.tol.max(got.error_estimate),
+                "{window}: N = {} at {p:?}",
+                got.rotation_number
+            );
+        }
+    }
+}
+
+/// The top of the N = 0 curve is a fold (∂N/∂ε = 0); those of N = 1 and N = 5 are corners
+/// at the cusp, where the separatrix they hug ends (pass 4 of issue 22: N = 5's was
+/// reported as a fold with ∂N/∂ε = −3.35e6).
+#[test]
+fn a_corner_is_not_called_a_fold() {
+    let body = body();
+    let top = |target: f64| fold(&body, &options(target)).unwrap().expect("a top");
+    assert_eq!(top(0.0).top, Top::Fold);
+    for target in [1.0, 5.0] {
+        let t = top(target);
+        assert_eq!(t.top, Top::Corner, "{t:?}");
+        assert!((t.kappa_max - KAPPA_CUSP).abs() < 2e-3, "{t:?}");
+    }
 }

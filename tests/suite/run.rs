@@ -1155,6 +1155,29 @@ fn edged_body_scenes_are_refused_where_the_shape_does_not_fit() {
     }
 }
 
+/// A `--force` run of `scene` over `reference` copied to `out`, stopped by SIGINT after its
+/// first unit: its stderr, or None if it finished before the signal landed.
+fn stop_a_forced_run(scene: &str, reference: &Path, out: &Path, journal: &Path) -> Option<String> {
+    std::fs::copy(reference, out).unwrap();
+    let mut child = Command::new(BIN)
+        .args([
+            "run",
+            scene,
+            "--out",
+            out.to_str().unwrap(),
+            "--force",
+            "--quiet",
+        ])
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    wait_for_units(&mut child, journal, 1);
+    // SAFETY: a signal to our own child process.
+    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    let output = child.wait_with_output().unwrap();
+    (!output.status.success()).then(|| String::from_utf8_lossy(&output.stderr).into_owned())
+}
+
 /// Adversary pass 4: a `--force` run over an existing output, stopped by SIGINT, said
 /// "continue with … --resume", and `--resume` then refused because the output existed. It
 /// continues the run now, and its output replaces the old one.
@@ -1162,28 +1185,41 @@ fn edged_body_scenes_are_refused_where_the_shape_does_not_fit() {
 fn a_forced_run_over_an_output_resumes_as_its_stop_message_says() {
     let (_dir, scene, reference, out, journal) = slow_run();
     let (s, o) = (scene.as_str(), out.to_str().unwrap());
-    std::fs::copy(&reference, &out).unwrap();
-    let before = std::fs::read(&out).unwrap();
-    let mut child = Command::new(BIN)
-        .args(["run", s, "--out", o, "--force", "--quiet"])
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    wait_for_units(&mut child, &journal, 1);
-    // SAFETY: a signal to our own child process.
-    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
-    let output = child.wait_with_output().unwrap();
-    if output.status.success() {
+    let Some(text) = stop_a_forced_run(s, &reference, &out, &journal) else {
         return; // finished before the signal landed: nothing to resume
-    }
-    let text = String::from_utf8_lossy(&output.stderr);
+    };
     assert!(
         text.contains(&format!("rubber-atlas run {s} --out {o} --resume")),
         "{text}"
     );
     // The old output is untouched until the run is done.
-    assert_eq!(std::fs::read(&out).unwrap(), before);
+    assert_eq!(
+        std::fs::read(&out).unwrap(),
+        std::fs::read(&reference).unwrap()
+    );
     ok(&run(&["run", s, "--out", o, "--resume", "--quiet"]));
     assert_same_arrays(&reference, &out);
     assert!(!journal.exists());
+}
+
+/// `--update` over a current output that a stopped `--force` run left its journal beside:
+/// nothing to do, and the journal (with its partial file) goes, rather than lingering for a
+/// later `--resume` to redo the run (adversary pass 4 of issue 22).
+#[test]
+fn an_update_over_a_current_output_clears_a_stopped_runs_journal() {
+    let (_dir, scene, reference, out, journal) = slow_run();
+    let (s, o) = (scene.as_str(), out.to_str().unwrap());
+    if stop_a_forced_run(s, &reference, &out, &journal).is_none() {
+        return; // finished before the signal landed: no journal left
+    }
+    assert!(journal.exists());
+    let done = run(&["run", s, "--out", o, "--update"]);
+    ok(&done);
+    assert!(String::from_utf8_lossy(&done.stdout).contains("complete and current"));
+    assert_eq!(
+        std::fs::read(&out).unwrap(),
+        std::fs::read(&reference).unwrap()
+    );
+    assert!(!journal.exists());
+    assert!(!Path::new(&format!("{o}.partial.h5")).exists());
 }
