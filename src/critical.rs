@@ -746,18 +746,24 @@ fn shared_point<S: Shape>(curve: &Curve<'_, S>, theta: f64, stable_side: f64) ->
     at
 }
 
-/// Whether the equator is a permanent rotation at every κ in doubles, from U′(π/2) =
+/// Whether the equator stands for the permanent rotations by it at every κ, from U′(π/2) =
 /// `slope` and U″(π/2) = `curvature`. V′(π/2) = U′(π/2) for every κ (the κ term's slope
 /// vanishes there), so it is one exactly where U′(π/2) = 0: a body symmetric about its
 /// equator, or a ball centred on its sphere's centre (α = 0) whose sphere holds π/2. Where
-/// U′(π/2) is not 0 but tiny, the permanent rotation lies |U′(π/2)|/|V″(π/2)| from π/2: below
-/// half an ulp of π/2 (1.1e-16) at every κ but in a window round κ_c of relative width
-/// |U′|/(2.2e-16 |U″|), which this keeps below 1e-3 (|α| ≲ 2e-19 for the disk). There the
-/// sampled curve cannot reach past κ_c (θ0 has no double between the rotation and π/2: the
-/// disk at α = 1e-300 had no branch at all for κ in (1, 3]); the equator branch stands for it.
+/// U′(π/2) is not 0 but tiny, the permanent rotation lies |U′(π/2)|/|V″(π/2)| from π/2, and
+/// its (κ, ε) is the equator's, ε = κ²/2 + U(π/2), to O(U′(π/2)). Where that distance is
+/// below 2²⁰ half-ulps of π/2 (5.8e-11) at every κ but in a window round κ_c of relative
+/// width 1e-3 (|α| ≲ 3e-13 for the ellipsoid of β = 3, 1.2e-13 for the disk), the sampled
+/// curve has too few doubles θ0 to climb on: at α = 1e-15, β = 3 its σ_sπ stopped at
+/// κ = 2.30 of 3, at 1e-18 at κ_c, and the disk at α = 1e-300 had no branch for κ in (1, 3].
+/// The equator branch stands for them there.
 fn equator_held(slope: f64, curvature: f64) -> bool {
-    slope == 0.0 || slope.abs() <= 1e-3 * 1.1e-16 * curvature.abs()
+    slope == 0.0 || slope.abs() <= 1e-3 * EQUATOR_BAND * 1.1e-16 * curvature.abs()
 }
+
+/// Half-ulps of π/2 within which a permanent rotation is drawn as the equator's
+/// ([`equator_held`]).
+const EQUATOR_BAND: f64 = (1u64 << 20) as f64;
 
 /// Whether a change of stability at θ0 is one at a kink of U (V″ jumping through 0, not a
 /// cusp): θ0 bisected to within 1e-9 of it.

@@ -1186,7 +1186,8 @@ fn an_edged_bodys_unstable_branch_reaches_its_inclined_equilibrium() {
 
 /// |α| so small that the permanent rotation by the equator lies within half an ulp of π/2
 /// (but in a window of relative width 1e-3 round κ_c): in doubles it is the equator, and
-/// the diagram is that of α = 0. The disk at α = ±1e-300 had no branch at all for κ in
+/// the diagram is that of α = 0; up to 2^20 half-ulps the equator stands beside the
+/// sampled curve. The disk at α = ±1e-300 had no branch at all for κ in
 /// (1, 3], where `cell` finds that rotation; the ellipsoid at 1e-300 none beyond κ_c.
 /// Checked against the cell solver: at κ = 2 and the row's energy, a fixed point at π/2.
 #[test]
@@ -1228,6 +1229,19 @@ fn a_body_within_rounding_of_symmetric_keeps_its_equator_branch() {
         let e = rubber_atlas::EllipsoidBody::ellipsoid(alpha, 3.0, 0.5, 0.5).unwrap();
         let set = CriticalSet::of(&e, 400, 3.0).unwrap();
         assert!(at_two(&set).stable, "α = {alpha}");
+    }
+    // Up to 2^20 half-ulps of π/2 the equator stands beside the sampled curve, which has too
+    // few doubles θ0 to climb on (at α = 1e-15 its σ_sπ stopped at κ = 2.30, at 1e-18 at
+    // κ_c = 1.633): a stable branch reaches κ_max, on a fixed point of the cell solver.
+    for alpha in [1e-18, 1e-15, -1e-15, 2e-13] {
+        let e = rubber_atlas::EllipsoidBody::ellipsoid(alpha, 3.0, 0.5, 0.5).unwrap();
+        let set = CriticalSet::of(&e, 400, 3.0).unwrap();
+        let p = at_two(&set);
+        assert!(p.stable, "α = {alpha}");
+        let cell = solve_cell(&e, p.kappa, p.energy, &CellOptions::default()).unwrap();
+        let c = &cell.components[0];
+        assert_eq!(c.status, Status::FixedPoint, "α = {alpha}: {cell:?}");
+        assert!((c.theta_min - FRAC_PI_2).abs() < 1e-9, "α = {alpha}: {c:?}");
     }
     // Beyond that, the sampled curve itself draws the imperfect bifurcation.
     let body = Body::new(EdgedShape::disk(1e-12).unwrap(), 2.0, 4.0).unwrap();
