@@ -8,7 +8,7 @@
 //! implementation of [`Shape`]; every derived quantity has a generic default built from χ1, χ2.
 
 use crate::dd::DoubleDouble;
-use crate::error::{check_range, AtlasError, Result};
+use crate::error::{check_range, AtlasError, Result, MAX_KAPPA};
 use nalgebra::Vector3;
 
 mod edged;
@@ -196,6 +196,14 @@ pub trait Shape: Send + Sync {
         1.0
     }
 
+    /// The θ in (0, π) where U = 0: where the centre of mass lies off the body (the disk with
+    /// α ≠ 0, a cut ball with its edge down and h + α < 0, …) it is at the plane's height
+    /// there. J² = (cos²θ + ν sin²θ)/η + U² is least there, and the integrands, ∝ 1/J, may
+    /// peak sharply ([`crate::torus::EffectivePotential::splits_inside`]). None where U > 0.
+    fn potential_zeros(&self) -> Vec<f64> {
+        Vec::new()
+    }
+
     /// U and |r|² together (shapes override this to share work between the two).
     #[inline]
     fn potential_and_contact_distance_sq_at(&self, a: Angle) -> (f64, f64) {
@@ -235,7 +243,15 @@ impl Ellipsoid {
             Some((1.0, false)),
             "must satisfy -1 < alpha < 1 (the centre of mass inside the body)",
         )?;
-        check_range("beta", beta, Some((0.0, false)), None, "must be > 0")?;
+        // β² enters U, B and the critical set: beyond 1.3e154 it overflows (a cell at
+        // β = 1e200 had "no motion" where it moves). The same bound as κ's.
+        check_range(
+            "beta",
+            beta,
+            Some((0.0, false)),
+            Some((MAX_KAPPA, true)),
+            "must satisfy 0 < beta <= 1e150 (beta^2 must be a double)",
+        )?;
         Ok(Self { alpha, beta })
     }
 

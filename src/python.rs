@@ -555,9 +555,8 @@ fn trajectory<'py>(
 ) -> PyResult<(Bound<'py, PyDict>, [f64; 5])> {
     let component = count("component", component, 0)?;
     let samples = count("samples", samples, 1)?;
-    // As the command measured it: 135 bytes per sample at the peak.
     check_memory(
-        160.0 * samples as f64,
+        crate::trajectory::MEMORY_PER_SAMPLE * samples as f64,
         allow_large,
         "use fewer samples, or allow_large=True",
     )?;

@@ -507,7 +507,11 @@ impl<'a, S: Shape> Tracer<'a, S> {
                 // The corrected point should be about a step away: much nearer, the corrector
                 // fell back onto the last point; much further, it jumped to another branch.
                 let moved = self.distance(&p, &q);
-                if moved < 0.25 * s || moved > 3.0 * s {
+                // … and on the same family of tori: where the followed well ends (at a cusp)
+                // the component around the nearest other well, whose turning points lie
+                // elsewhere, would glue another family's curve on (a wheel's N = −1 curve
+                // jumped from θ ∈ [2.28, 2.39] to [1.79, 2.23] in one step).
+                if moved < 0.25 * s || moved > 3.0 * s || !same_torus(&p, &q) {
                     s *= 0.5;
                     continue;
                 }
@@ -582,7 +586,7 @@ impl<'a, S: Shape> Tracer<'a, S> {
         rows.sort_by(f64::total_cmp);
         rows.dedup();
         let counts: Vec<usize> = rows.iter().map(|&k| count(k)).collect();
-        for i in 0..n {
+        for i in 0..rows.len() - 1 {
             if counts[i] == counts[i + 1] {
                 continue;
             }
@@ -596,8 +600,14 @@ impl<'a, S: Shape> Tracer<'a, S> {
                     b = m;
                 }
             }
+            // (On the change's own scale where the window is much wider.)
+            let local = if self.options.natural_scales {
+                step.min(2.0 * a.abs().max(1.0) / n as f64)
+            } else {
+                step
+            };
             for j in 1..=12 {
-                let d = step * 0.5f64.powi(j);
+                let d = local * 0.5f64.powi(j);
                 rows.extend([a - d, b + d].into_iter().filter(|k| *k > k0 && *k < k1));
             }
         }
@@ -650,18 +660,32 @@ impl<'a, S: Shape> Tracer<'a, S> {
                         if self.options.natural_scales {
                             xs.extend(natural_points(lo, hi, 4.0 * lo.abs().max(1.0), n));
                         }
-                        let mid = 0.5 * (lo + hi);
+                        // Halving towards each end from half the gap, or from the end's
+                        // own scale 4 max(1, |end|) where the gap is wider (a curve hugging
+                        // a separatrix of level 3 in a window up to 1e300).
+                        let half = 0.5 * (hi - lo);
+                        let reach = |end: f64| half.min(4.0 * end.abs().max(1.0));
+                        let (from_lo, from_hi) = (reach(lo), reach(hi));
                         for j in 1..=52 {
-                            xs.push(hi - (hi - mid) * 0.5f64.powi(j));
-                            xs.push(lo + (mid - lo) * 0.5f64.powi(j));
+                            xs.push(hi - from_hi * 0.5f64.powi(j));
+                            xs.push(lo + from_lo * 0.5f64.powi(j));
                         }
                         xs.retain(|&x| x > lo && x < hi);
                         xs.sort_by(f64::total_cmp);
                         xs.dedup();
-                        let values: Vec<(f64, Option<f64>)> =
-                            xs.iter().map(|&x| (x, f(x))).collect();
+                        // N − p/q with its sign, where the sign is certain: |N − p/q| above
+                        // N's error estimate (far out, where N tends to p/q = 0, it is below
+                        // it: its "sign changes" are rounding, and gave curves of noise).
+                        let signed = |x: f64| {
+                            evaluate(&potential, x, well, &self.options.cell).map(|p| {
+                                let value = p.rotation_number - target;
+                                (value, value.abs() > p.error_estimate)
+                            })
+                        };
+                        let values: Vec<(f64, Option<(f64, bool)>)> =
+                            xs.iter().map(|&x| (x, signed(x))).collect();
                         for w in values.windows(2) {
-                            if let [(xa, Some(fa)), (xb, Some(fb))] = w {
+                            if let [(xa, Some((fa, true))), (xb, Some((fb, true)))] = w {
                                 if (*fa > 0.0) != (*fb > 0.0) {
                                     if let Some(root) = bracketed_root(
                                         &f,
@@ -949,16 +973,37 @@ pub fn fold_until<S: Shape>(
                 .at(k, energy, top.well)
                 .map(|p| p.rotation_number - options.target)
         };
+        // (Probes on the top's own scale: in a window far wider, steps of the window's would
+        // step over a curve that hugs a separatrix near the cusp.)
         let k = nearest_root(
             f,
             options.kappa.0,
             options.kappa.1,
             start,
-            1e-7 * window,
+            1e-7 * tracer.scale(&top).0,
             tol,
         )?;
         Some((k, tracer.at(k, energy, top.well)?))
     };
+    // A top at an end of its curve (where it reaches the bottom of a well, or runs into a
+    // separatrix) is no fold: κ(ε) has no maximum inside to search for (the search found one
+    // on another branch, 0.93 below the top). It stands as traced, a corner, its error the
+    // curve's last step in κ (within which the continuation lost it).
+    let at_end = !curve.closed && (index == 0 || index + 1 == curve.points.len());
+    if at_end && curve.points.len() > 1 {
+        let neighbour = curve.points[if index == 0 { 1 } else { index - 1 }];
+        let (dn_dkappa, dn_denergy) = tracer.gradient(&top).unwrap_or((f64::NAN, f64::NAN));
+        return Ok(Some(Fold {
+            top: Top::Corner,
+            kappa_max: top.kappa,
+            energy: top.energy,
+            rotation_number: top.rotation_number,
+            dn_denergy,
+            dn_dkappa,
+            kappa_error: (top.kappa - neighbour.kappa).abs(),
+            well: top.well,
+        }));
+    }
     // Golden section for the largest κ(ε) between the top's neighbours on the curve.
     let neighbours: Vec<f64> = [index.checked_sub(1), Some(index + 1)]
         .into_iter()

@@ -228,6 +228,18 @@ fn temp_path(path: &Path) -> PathBuf {
     with_suffix(path, &format!(".partial-{}", std::process::id()))
 }
 
+/// Writes `bytes` to `path` by way of a temporary name beside it, renamed into place (a
+/// manual page; the path checked by [`check_output`] first).
+pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<()> {
+    let tmp = temp_path(path);
+    std::fs::write(&tmp, bytes)
+        .and_then(|()| std::fs::rename(&tmp, path))
+        .map_err(|e| {
+            let _ = std::fs::remove_file(&tmp);
+            output_error(path, e)
+        })
+}
+
 /// Writes `table` to `path`, as CSV (`# key: value` comment lines for the attributes, a
 /// header, then rows: shortest round-trip decimals) or HDF5 (one 1-D variable per column
 /// along the table's dimension, whose coordinate is a dimension scale; CF attributes).

@@ -174,12 +174,16 @@ def _numbers(name: str, value) -> np.ndarray:
     # Converted where the values are stored: a broadcast view stays a view.
     stored = array[tuple(slice(None) if stride else slice(0, 1) for stride in array.strides)]
     if kind == "f" and array.dtype.itemsize > 8:
-        # A long double beyond float64 would become inf (with numpy's overflow warning).
-        beyond = np.isfinite(stored) & (np.abs(stored) > np.finfo(np.float64).max)
-        if beyond.any():
-            index = tuple(int(i) for i in np.argwhere(beyond)[0]) if stored.ndim else ()
-            raise ValueError(f"invalid {name}{_at(index)} = {np.format_float_scientific(stored[index], precision=3, trim='-')}: beyond the largest float64 "
-                             f"({np.finfo(np.float64).max:.3g})")
+        # A long double beyond float64's range would become inf (with numpy's overflow
+        # warning), or 0 (another input: κ = 0 is the planar case).
+        with np.errstate(over="ignore", under="ignore"):
+            converted = stored.astype(np.float64)
+        for bad, why in ((np.isfinite(stored) & np.isinf(converted), "beyond the largest float64 (1.8e+308)"),
+                         ((stored != 0) & (converted == 0), "underflows to 0 in float64 (below 4.9e-324)")):
+            if bad.any():
+                index = tuple(int(i) for i in np.argwhere(bad)[0]) if stored.ndim else ()
+                shown = np.format_float_scientific(stored[index], precision=3, trim="-")
+                raise ValueError(f"invalid {name}{_at(index)} = {shown}: {why}")
     if stored.shape == array.shape:
         return array.astype(np.float64)
     return np.broadcast_to(stored.astype(np.float64), array.shape)

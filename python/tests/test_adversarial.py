@@ -153,6 +153,8 @@ print("peak MB", resource.getrusage(resource.RUSAGE_SELF).ru_maxrss // 1024)
     "ra.cells(0.5, 3.0, 0.5, 0.5, kappa=np.broadcast_to(np.int64(1), (10**5, 10**4)), energy=2.5)",
     "ra.cells(0.5, 3.0, 0.5, 0.5, kappa=np.linspace(0, 2, 10**5), energy=np.linspace(0.5, 4.5, 10**5 + 1))",
     "ra.cells(0.5, 3.0, 0.5, 0.5, lambda_=np.linspace(0.1, 1, 10**5), s=np.linspace(0.1, 1, 10**5 + 1))",
+    # The full model takes 210 bytes a sample: counted at 160, this ran and aborted (pass 5).
+    "ra.trajectory(0.5, 3.0, 0.5, 0.5, kappa=0.8, energy=2.5, periods=1, samples=14_000_000, model='full')",
 ])
 def test_a_request_beyond_memory_is_refused_before_its_inputs_are_materialised(call, tmp_path):
     out = subprocess.run([sys.executable, "-c", LIMITED.format(call=call)], cwd=tmp_path, capture_output=True,
@@ -566,6 +568,9 @@ def test_a_long_double_beyond_float64_is_refused_not_made_infinite():
                 "beyond the largest float64")
         refused(ValueError, lambda: ra.cells(*BODY, kappa=0.8, energy=np.array([2.5, -huge])),
                 "invalid energy[1] = -1e+400")
+        # Below float64's range it would be 0: κ = 0 is another input (the planar case).
+        refused(ValueError, lambda: ra.cells(*BODY, kappa=np.longdouble("1e-400"), energy=2.5),
+                "invalid kappa = 1e-400", "underflows")
         # Within float64's range a long double is taken as its nearest float64.
         assert ra.cells(*BODY, kappa=np.longdouble(0.8), energy=2.5).rotation_number.notnull().any()
 

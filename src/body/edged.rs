@@ -265,6 +265,25 @@ impl Shape for EdgedShape {
         &self.kinks[..self.kink_count]
     }
 
+    /// A part p sin θ + q cos θ (the disk's rim, an edge) vanishes where (cos θ, sin θ) ⊥
+    /// (q, p): at θ = atan2(|q|, −p sgn q) in (0, π), for q ≠ 0, where that part is the one
+    /// in contact. The sphere's 1 + α cos θ is positive.
+    fn potential_zeros(&self) -> Vec<f64> {
+        let (h, rho, alpha) = (self.cut, self.rho, self.alpha);
+        let edges = match self.kind {
+            EdgedKind::Disk => vec![(1.0, alpha)],
+            EdgedKind::TruncatedBall => vec![(rho, h + alpha)],
+            EdgedKind::Wheel => vec![(rho, h + alpha), (rho, alpha - h)],
+        };
+        edges
+            .into_iter()
+            .filter(|&(_, q)| q != 0.0)
+            .map(|(p, q)| (p, q, q.abs().atan2(-p * q.signum())))
+            .filter(|&(p, q, theta)| self.part(Angle::new(theta)) == Part { p, q, r: 0.0 })
+            .map(|(_, _, theta)| theta)
+            .collect()
+    }
+
     /// The disk lies flat at both poles, the truncated ball on its face at θ = 0, the wheel
     /// on either face.
     fn faces(&self) -> [bool; 2] {

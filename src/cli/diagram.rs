@@ -166,14 +166,16 @@ pub(super) fn print_diagram(set: &CriticalSet) {
     }
     if set.diagram_type == Some(rubber_atlas::critical::DiagramType::C) && cusps.is_empty() {
         // σ_u climbing to κ_max without meeting σ_s0: the cusp lies above κ_max.
+        // (Where the equator stands for the rotations by it, σ_π/2's unstable run does.)
         let above = set
             .branches
             .iter()
-            .any(|b| !b.stable && b.kappa_range[1] >= set.kappa_max * (1.0 - 1e-6));
-        if above {
+            .find(|b| !b.stable && b.kappa_range[1] >= set.kappa_max * (1.0 - 1e-6));
+        if let Some(branch) = above {
             println!(
-                "  cusp above kappa_max = {}: sigma_u reaches it without meeting sigma_s0",
-                digits(set.kappa_max, 12)
+                "  cusp above kappa_max = {}: {} reaches it without meeting sigma_s0",
+                digits(set.kappa_max, 12),
+                branch.name
             );
         } else {
             println!(

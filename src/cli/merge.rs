@@ -34,8 +34,9 @@ pub(super) fn merge(args: MergeArgs) -> Result<()> {
     )?;
     if !args.quiet {
         println!(
-            "merged {} shards into {} ({} cells, {} components) in {:.2} s",
+            "merged {} shard{} into {} ({} cells, {} components) in {:.2} s",
             args.shards.len(),
+            if args.shards.len() == 1 { "" } else { "s" },
             args.out.display(),
             summary.cells,
             summary.components,

@@ -90,6 +90,9 @@ pub enum Command {
         /// folder instead (e.g. /usr/local/share/man/man1).
         #[arg(long, value_name = "DIR", conflicts_with = "command")]
         dir: Option<std::path::PathBuf>,
+        /// Replace pages that exist in --dir (never a link, a folder or a device there).
+        #[arg(long, requires = "dir")]
+        force: bool,
     },
 }
 
@@ -349,13 +352,17 @@ pub fn run(cli: Cli) -> Result<()> {
             clap_complete::generate(shell, &mut command, "rubber-atlas", &mut std::io::stdout());
             Ok(())
         }
-        Command::Man { command, dir } => man(command.as_deref(), dir.as_deref()),
+        Command::Man {
+            command,
+            dir,
+            force,
+        } => man(command.as_deref(), dir.as_deref(), force),
     }
 }
 
 /// The manual pages: the program's (`rubber-atlas(1)`) and one per command
 /// (`rubber-atlas-run(1)`, …, which the program's page lists), printed or written to `dir`.
-fn man(name: Option<&str>, dir: Option<&std::path::Path>) -> Result<()> {
+fn man(name: Option<&str>, dir: Option<&std::path::Path>, force: bool) -> Result<()> {
     let mut program = <Cli as clap::CommandFactory>::command();
     program.build();
     // A command's page is named and titled as the program's page refers to it.
@@ -368,19 +375,33 @@ fn man(name: Option<&str>, dir: Option<&std::path::Path>) -> Result<()> {
     };
     let commands: Vec<&clap::Command> = program.get_subcommands().collect();
     if let Some(dir) = dir {
-        let write = |file: String, page: clap_mangen::Man| -> Result<()> {
-            let path = dir.join(file);
-            let mut out = std::fs::File::create(&path)
-                .with_context(|| format!("cannot write {}", path.display()))?;
-            page.render(&mut out)
-                .with_context(|| format!("cannot write {}", path.display()))
-        };
-        write(
-            "rubber-atlas.1".into(),
+        if !dir.is_dir() {
+            return Err(rubber_atlas::AtlasError::Atlas {
+                path: dir.display().to_string(),
+                reason: "is not an existing folder".into(),
+            }
+            .into());
+        }
+        let mut pages = vec![(
+            dir.join("rubber-atlas.1"),
             clap_mangen::Man::new(program.clone()),
-        )?;
-        for c in &commands {
-            write(format!("rubber-atlas-{}.1", c.get_name()), page_of(c))?;
+        )];
+        pages.extend(commands.iter().map(|c| {
+            (
+                dir.join(format!("rubber-atlas-{}.1", c.get_name())),
+                page_of(c),
+            )
+        }));
+        // Every page's path is checked before any is written, as any output is: a link, a
+        // folder or a device is refused, and an existing page needs --force.
+        for (path, _) in &pages {
+            rubber_atlas::store::check_output(path, force, &[], &["1"])?;
+        }
+        for (path, page) in pages {
+            let mut text = Vec::new();
+            page.render(&mut text)
+                .context("cannot render the manual page")?;
+            rubber_atlas::store::write_bytes(&path, &text)?;
         }
         return Ok(());
     }

@@ -188,8 +188,9 @@ pub(super) fn resonance(args: ResonanceArgs) -> Result<()> {
         );
         return Ok(());
     }
+    let shown = show(target);
     println!(
-        "N = {target} for {} nu={} eta={}: {} curve(s) in kappa [{}, {}], energy [{}, {}]",
+        "N = {shown} for {} nu={} eta={}: {} curve(s) in kappa [{}, {}], energy [{}, {}]",
         body_text(&body),
         show(args.nu),
         show(args.eta),
@@ -201,7 +202,7 @@ pub(super) fn resonance(args: ResonanceArgs) -> Result<()> {
     );
     if curves.is_empty() {
         println!(
-            "  (no component reaches N = {target} on the seed grid of this window: the curve may \
+            "  (no component reaches N = {shown} on the seed grid of this window: the curve may \
              lie beyond the window (widen it with --kappa-max and --energy-max), or between the \
              grid's rows (kappa step {}, energy step {}: raise --grid); see where N takes this \
              value with an atlas or `rubber-atlas verdict`)",

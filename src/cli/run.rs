@@ -118,6 +118,17 @@ fn output_current(args: &RunArgs, out: &std::path::Path) -> Result<bool> {
             }
             .into());
         }
+        // An atlas of another scene (by its name) is not an earlier version of this one.
+        Ok(status) if status.code() == Some(5) => {
+            return Err(AtlasError::Atlas {
+                path: out.display().to_string(),
+                reason: "is the atlas of another scene (its scene_name differs): --update \
+                         replaces only an earlier atlas of this scene (run with --force in its \
+                         place to replace it)"
+                    .into(),
+            }
+            .into());
+        }
         Ok(status) if status.code().is_none() && !args.quiet => {
             eprintln!(
                 "rubber-atlas: reading {} crashed HDF5 (a damaged file); it is computed afresh",
@@ -152,10 +163,13 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
         return Ok(());
     }
     if args.probe_current {
+        use rubber_atlas::store::atlas_file::AtlasFile;
         std::process::exit(if sweep::output_is_current(&out, &scene, shard) {
             0
-        } else if rubber_atlas::store::atlas_file::AtlasFile::is_foreign(&out) {
+        } else if AtlasFile::is_foreign(&out) {
             4
+        } else if AtlasFile::scene_name(&out).is_some_and(|name| name != scene.name) {
+            5
         } else {
             3
         });
@@ -184,7 +198,9 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
             Err(_) => {
                 return Err(AtlasError::Atlas {
                     path: format!("RAYON_NUM_THREADS = {v:?}"),
-                    reason: "must be a whole number of threads (0 or unset: every core)".into(),
+                    reason: "must be a whole number of threads, at most 18446744073709551615 \
+                             (0 or unset: every core)"
+                        .into(),
                 }
                 .into())
             }

@@ -58,12 +58,11 @@ pub(super) fn trajectory(args: TrajectoryArgs) -> Result<()> {
         }
         .into());
     }
-    // Measured (peak RSS over 3e6 samples, either file type): 160 bytes of memory per
-    // sample for the reduced model, 210 for the full one; a CSV row of 10 columns is under
-    // 250 bytes.
+    // A CSV row of 10 columns is under 250 bytes.
     let rows = args.samples as f64 + 1.0;
+    let memory = rubber_atlas::trajectory::MEMORY_PER_SAMPLE * rows;
     args.limits
-        .check(250.0 * rows, Some(250.0 * rows), Some(&args.out), &|| {
+        .check(memory, Some(250.0 * rows), Some(&args.out), &|| {
             "use fewer --samples".into()
         })?;
     let model = match args.model {

@@ -327,6 +327,18 @@ impl AtlasFile {
         })
     }
 
+    /// The `scene_name` attribute of the atlas at `path`, if it can be read.
+    pub fn scene_name(path: &Path) -> Option<String> {
+        let file = hdf5::File::open(path).ok()?;
+        let name = file.attr("scene_name").ok()?;
+        Some(
+            name.read_scalar::<VarLenUnicode>()
+                .ok()?
+                .as_str()
+                .to_string(),
+        )
+    }
+
     /// The component axis an atlas file at `path` was written with (its `component_layout`
     /// and `component` coordinate).
     pub fn read_axis(path: &Path) -> Result<ComponentAxis> {

@@ -1248,3 +1248,33 @@ fn a_body_within_rounding_of_symmetric_keeps_its_equator_branch() {
     let set = CriticalSet::of_edged(&body, 400, 3.0, &|| false).unwrap();
     assert!(set.branches.iter().all(|b| b.name != "sigma_pi2"));
 }
+
+/// The disk's centre of mass lies off the body: U = sin θ + α cos θ vanishes at θ_U, where
+/// J = √((cos²θ + ν sin²θ)/η + U²) is least and ψ̇ ∝ 1/J peaks over a width
+/// √((cos²θ_U + ν sin²θ_U)/η)/|U′(θ_U)|. At α = −72.7, η = 217 that is 5e-4 rad, far below the
+/// rules' steps: the libration from 2e-9 of one pole to 3e-9 of the other (seed 22 of the
+/// whole-domain sample) had N = 7.60e-10 ± 1.4e-11 at status ok, 4× its estimate off the
+/// 50-digit value 8.094210357992471e-10 (scripts/whole_domain.py's mpmath quadrature). The
+/// integrals are split at θ_U now: N within its estimate at every tolerance.
+#[test]
+fn a_narrow_peak_of_one_over_j_is_resolved() {
+    let body = Body::new(EdgedShape::disk(-72.7).unwrap(), 0.32, 217.0).unwrap();
+    let reference = 8.094210357992471e-10;
+    for tol in [1e-6, 1e-10, 1e-13] {
+        let options = CellOptions {
+            tol,
+            ..CellOptions::default()
+        };
+        let cell = solve_cell(&body, 4.8e-8, 221.9, &options).unwrap();
+        let c = &cell.components[0];
+        let error = (c.rotation_number - reference).abs();
+        assert!(
+            error <= c.error_estimate,
+            "tol {tol}: N = {} ± {:e} ({:?}), off by {error:e}",
+            c.rotation_number,
+            c.error_estimate,
+            c.status
+        );
+        assert_eq!(c.status, Status::Ok, "tol {tol}");
+    }
+}

@@ -1051,11 +1051,19 @@ fn the_diagram_of_an_edged_body_names_its_shape() {
 /// within 1e-18 of π/2) says so instead of a diagram that silently lacks it.
 #[test]
 fn an_unresolved_cusp_is_said() {
-    let o = run(&["diagram", "--alpha", "1e-15", "--beta", "1e3"]);
+    let o = run(&["diagram", "--alpha", "1e-9", "--beta", "1e3"]);
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success());
     assert!(
         text.contains("diagram type (c)") && text.contains("cusp not resolved"),
+        "{text}"
+    );
+    // Closer still to α = 0 the equator stands for the rotations by it (docs/model.md): its
+    // unstable run reaches κ_max, below κ_c = 31.6, where the cusp lies.
+    let o = run(&["diagram", "--alpha", "1e-15", "--beta", "1e3"]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("cusp above kappa_max = 3.000000000000: sigma_pi2 reaches it"),
         "{text}"
     );
     // A cusp above κ_max is said as such (it was "not resolved ... within the sampling").
@@ -1271,6 +1279,22 @@ fn update_replaces_only_its_own_files() {
     let remade = run(&["run", scene_s, "--out", ours, "--update", "--quiet"]);
     assert!(remade.status.success(), "{}", stderr(&remade));
     assert!(hdf5::File::open(&text).unwrap().dataset("drift").is_ok());
+    // The atlas of another scene (by name) is not an earlier version of this one (adversary
+    // pass 5: a shard of another scene was replaced).
+    let other = dir.path().join("other.toml");
+    let renamed = std::fs::read_to_string(&scene)
+        .unwrap()
+        .replace("name = \"s\"", "name = \"other\"");
+    std::fs::write(&other, renamed).unwrap();
+    let before = std::fs::read(&text).unwrap();
+    let o = run(&["run", other.to_str().unwrap(), "--out", ours, "--update"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("the atlas of another scene"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(std::fs::read(&text).unwrap(), before);
 }
 
 /// Adversary pass 4: a symbolic link at `<out>.lock` had its target overwritten with the
@@ -1352,4 +1376,34 @@ fn a_start_beyond_the_largest_energy_is_refused_like_the_energy() {
     let said = stderr(&o);
     assert_eq!(o.status.code(), Some(2), "{said}");
     assert!(said.contains("-1e301 is above 1e300 in size"), "{said}");
+}
+
+/// `man --dir` writes its pages as any output is written (adversary pass 5 of issue 22: it
+/// wrote through a symbolic link into the file it named, replaced pages without --force,
+/// hung on a FIFO and gave exit 1 for a missing folder).
+#[test]
+fn manual_pages_are_outputs_like_any_other() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let kept = d.join("scene.toml");
+    std::fs::write(&kept, "keep").unwrap();
+    std::os::unix::fs::symlink(&kept, d.join("rubber-atlas-cell.1")).unwrap();
+    let dir_arg = d.to_str().unwrap();
+    assert_refused(&["man", "--dir", dir_arg], "symbolic link", None);
+    assert_eq!(std::fs::read_to_string(&kept).unwrap(), "keep");
+    std::fs::remove_file(d.join("rubber-atlas-cell.1")).unwrap();
+    let fifo = std::ffi::CString::new(d.join("rubber-atlas-run.1").to_str().unwrap()).unwrap();
+    // SAFETY: mkfifo on a NUL-terminated path in our own temporary folder.
+    assert_eq!(unsafe { libc::mkfifo(fifo.as_ptr(), 0o600) }, 0);
+    assert_refused(&["man", "--dir", dir_arg], "FIFO", None);
+    std::fs::remove_file(d.join("rubber-atlas-run.1")).unwrap();
+    assert!(run(&["man", "--dir", dir_arg]).status.success());
+    assert!(d.join("rubber-atlas-cell.1").is_file());
+    assert_refused(&["man", "--dir", dir_arg], "--force", None);
+    assert!(run(&["man", "--dir", dir_arg, "--force"]).status.success());
+    assert_refused(
+        &["man", "--dir", "/nonexistent-folder"],
+        "not an existing folder",
+        None,
+    );
 }

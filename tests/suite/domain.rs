@@ -122,7 +122,7 @@ proptest! {
     #[test]
     fn every_cell_of_the_domain_answers_honestly(
         alpha in any_alpha(),
-        beta in prop_oneof![3 => decades(-3.0, 3.0), 1 => decades(-300.0, 300.0)],
+        beta in prop_oneof![3 => decades(-3.0, 3.0), 1 => decades(-300.0, 150.0)],
         nu in prop_oneof![3 => decades(-3.0, 0.301), 1 => decades(-300.0, 0.301)],
         eta in prop_oneof![3 => decades(-3.0, 3.0), 1 => decades(-308.0, 300.0), 1 => Just(5.6e-309)],
         kappa in prop_oneof![1 => Just(0.0), 3 => decades(-4.0, 4.0), 1 => decades(-300.0, 150.0), 1 => decades(-300.0, 150.0).prop_map(|k| -k)],
@@ -136,11 +136,13 @@ proptest! {
             .lowest_minimum()
             .unwrap_or(0.0);
         let energy = (bottom + lift * bottom.abs().max(1.0)).min(1e300);
-        // Not a benchmark: a guard against hangs, far above any cell's time (milliseconds).
+        // Not a benchmark: a guard against hangs, far above a cell's time (milliseconds; the
+        // slowest found, every parameter extreme — α = 0, β = 2e-155, η = 5.6e-309,
+        // κ = −4e-154, ε = 1.5e242 — took 9 s alone and 10.1 s beside the other tests).
         let started = std::time::Instant::now();
         check_answer(alpha, beta, nu, eta, kappa, energy);
         let seconds = started.elapsed().as_secs_f64();
-        prop_assert!(seconds < 10.0, "{seconds} s at {alpha:e} {beta:e} {nu:e} {eta:e} {kappa:e} {energy:e}");
+        prop_assert!(seconds < 30.0, "{seconds} s at {alpha:e} {beta:e} {nu:e} {eta:e} {kappa:e} {energy:e}");
     }
 
     /// Far out on ε (1e20 … 1e300) at fixed λ = κ/√ε the cell tends to N∞(λ), an integral
@@ -282,11 +284,17 @@ fn the_lightest_bodies_have_their_values() {
 #[test]
 fn extreme_bodies_are_undecided_with_the_reason() {
     let options = VerdictOptions::default();
+    // Beyond 1e150, β² would overflow (a cell at β = 1e200 said "no motion"): refused.
+    let refused = EllipsoidBody::ellipsoid(0.5, 1e300, 0.5, 0.5).unwrap_err();
+    assert!(
+        refused.to_string().starts_with("invalid beta = 1e300"),
+        "{refused}"
+    );
     for (alpha, beta, eta) in [
         (0.5, 1e10, 0.5),
         (0.5, 1e8, 0.5),
         (0.5, 1e7, 0.5),
-        (0.5, 1e300, 0.5),
+        (0.5, 1e150, 0.5),
         (0.5, 1e-10, 0.5),
         (0.5, 1e-300, 0.5),
         (0.5, 3.0, 1e-300),

@@ -29,6 +29,12 @@ fn options(target: f64) -> ResonanceOptions {
     }
 }
 
+/// The command's window for N = `target`: κ ∈ [0.01, `kappa_max`], ε from the bottom of V
+/// to `energy_max`, seed grid 48, tol 1e-10.
+fn window(body: &EllipsoidBody, target: f64, kappa_max: f64, energy_max: f64) -> ResonanceOptions {
+    ResonanceOptions::window(body, target, (0.01, kappa_max), None, energy_max, 48, 1e-10)
+}
+
 /// The level of the maximum of V (the separatrix through σ_u) at κ, if there is one.
 fn separatrix(body: &EllipsoidBody, kappa: f64) -> Option<f64> {
     EffectivePotential::new(body, kappa)
@@ -249,15 +255,7 @@ fn a_wide_window_finds_the_curve_a_narrow_one_finds() {
         (1e150, 5.0),
         (1e150, 1e300),
     ] {
-        let options = ResonanceOptions::window(
-            &body,
-            target,
-            (0.01, kappa_max),
-            None,
-            energy_max,
-            48,
-            1e-10,
-        );
+        let options = window(&body, target, kappa_max, energy_max);
         let curves = trace_curves(&body, &options).unwrap();
         let window = format!("kappa <= {kappa_max:e}, energy <= {energy_max:e}");
         assert_eq!(curves.len(), 1, "{window}: {} curves", curves.len());
@@ -304,5 +302,59 @@ fn a_corner_is_not_called_a_fold() {
         let t = top(target);
         assert_eq!(t.top, Top::Corner, "{t:?}");
         assert!((t.kappa_max - KAPPA_CUSP).abs() < 2e-3, "{t:?}");
+    }
+}
+
+/// Adversary pass 5 of issue 22, in wide windows: N = 0 far out in ε (where N tends to 0
+/// below its error estimate, and its "sign changes" are rounding) gave 23 curves of noise in
+/// 87 s; the real curve is one, from κ → 0 to the fold, as in the default window. A top that
+/// ends its curve (N = −1/7 reaches the bottom of a well at κ = 2.671) is that end, a corner,
+/// not a maximum of κ(ε) found on another branch (1.742 ± 0.93); and N = 3's top by the cusp
+/// is found in a window ten times wider, within the error bars of the narrow one's.
+#[test]
+fn wide_windows_give_no_curves_of_noise_and_the_same_tops() {
+    let body = body();
+    let window =
+        |target: f64, kappa_max: f64, energy_max: f64| window(&body, target, kappa_max, energy_max);
+    let curves = trace_curves(&body, &window(0.0, 2.0, 1e300)).unwrap();
+    assert_eq!(curves.len(), 1, "{} curves", curves.len());
+    let kappas: Vec<f64> = curves[0].points.iter().map(|p| p.kappa).collect();
+    let (low, high) = kappas
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(a, b), &k| (a.min(k), b.max(k)));
+    assert!(
+        low < 0.02 && (high - 1.10784).abs() < 1e-4,
+        "{low} … {high}"
+    );
+
+    let end = fold(&body, &window(-1.0 / 7.0, 1e6, 1e6)).unwrap().unwrap();
+    assert_eq!(end.top, Top::Corner, "{end:?}");
+    assert!((end.kappa_max - 2.6712).abs() < 1e-3, "{end:?}");
+
+    let narrow = fold(&body, &window(3.0, 2.0, 5.0)).unwrap().unwrap();
+    let wide = fold(&body, &window(3.0, 10.0, 5.0)).unwrap().unwrap();
+    assert!(
+        (narrow.kappa_max - wide.kappa_max).abs() <= narrow.kappa_error + wide.kappa_error,
+        "{narrow:?} {wide:?}"
+    );
+}
+
+/// A wheel's N = −1 curve (adversary pass 5): the default window glued the curve of another
+/// family on where its well ended (the turning points jumped by 0.49 in one step), a window
+/// to κ = 10 gave two pieces. Now one curve in both, its tori changing by little per step.
+#[test]
+fn a_curve_does_not_jump_to_another_family_of_tori() {
+    use rubber_atlas::body::{Body, EdgedShape};
+    let wheel = Body::new(EdgedShape::wheel(0.1, 0.5).unwrap(), 1.0, 2.0).unwrap();
+    for kappa_max in [2.0, 10.0] {
+        let options =
+            ResonanceOptions::window(&wheel, -1.0, (0.01, kappa_max), None, 5.0, 48, 1e-10);
+        let curves = trace_curves(&wheel, &options).unwrap();
+        assert_eq!(curves.len(), 1, "κ ≤ {kappa_max}: {} curves", curves.len());
+        for w in curves[0].points.windows(2) {
+            let jump =
+                (w[0].theta_min - w[1].theta_min).abs() + (w[0].theta_max - w[1].theta_max).abs();
+            assert!(jump < 0.2, "κ ≤ {kappa_max}: {:?} → {:?}", w[0], w[1]);
+        }
     }
 }
