@@ -136,6 +136,14 @@ fn first_intervals<S: Shape>(body: &Body<S>) -> usize {
 /// the value and a bound on its error: that last change (for a geometrically converging
 /// rule the error of the finer sum is far below it) plus the rounding of the sum.
 fn odd_part_integral<S: Shape>(body: &Body<S>, x0: f64, abs_tol: f64) -> Estimate {
+    // A body symmetric about its equator has H(x) = H(−x): the odd part vanishes, exactly.
+    // (The rule's first level alone, 8/β intervals, took 9 s at α = 0, β = 2e-155.)
+    if body.shape.symmetric_about_equator() {
+        return Estimate {
+            value: 0.0,
+            error: 0.0,
+        };
+    }
     let g = |u: f64| -> (f64, f64) {
         let s = u.sin();
         let (hp, ep) = excess_ratio(body, x0 * s);

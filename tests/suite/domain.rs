@@ -137,8 +137,10 @@ proptest! {
             .unwrap_or(0.0);
         let energy = (bottom + lift * bottom.abs().max(1.0)).min(1e300);
         // Not a benchmark: a guard against hangs, far above a cell's time (milliseconds; the
-        // slowest found, every parameter extreme — α = 0, β = 2e-155, η = 5.6e-309,
-        // κ = −4e-154, ε = 1.5e242 — took 9 s alone and 10.1 s beside the other tests).
+        // slowest found, every parameter extreme — β = 2e-155, η = 5.6e-309, κ = −4e-154,
+        // ε = 1.5e242 — took 9 s alone and 10.1 s beside the other tests at α = 0, where the
+        // high-energy limit is now 0 at once, and still 7.4 s at α = 1e-3: that limit's rule
+        // starts at 8/β intervals, at most 4 million).
         let started = std::time::Instant::now();
         check_answer(alpha, beta, nu, eta, kappa, energy);
         let seconds = started.elapsed().as_secs_f64();
