@@ -6,7 +6,7 @@
 //! Several of the paper's printed formulas carry misprints; the corrected forms used here are
 //! those of docs/model.md, and the tests check each against a direct numerical search.
 
-use crate::body::{Body, EdgedShape, EllipsoidBody, Shape};
+use crate::body::{Angle, Body, EdgedShape, EllipsoidBody, Shape};
 use crate::error::{AtlasError, Result};
 use crate::reduced::ReducedSystem;
 use crate::torus::bisect;
@@ -295,21 +295,30 @@ impl CriticalSet {
         let u = |t: f64| body.shape.potential(t);
         let upp = |t: f64| body.shape.potential_second(t);
 
+        // U and U″ at the poles themselves (sin π as a double, 1.2e-16, times β² gave
+        // U(π) = 1.2e84 at β = 1e100).
+        let (north, south) = (Angle::new(0.0), Angle::from_pi(0.0));
+        let at_pole = |a: Angle| {
+            let curvature = body.shape.potential_second_at(a);
+            (body.shape.potential_at(a), curvature > 0.0, curvature < 0.0)
+        };
+        let [(u0, stable0, isolated0), (upi, stable_pi, isolated_pi)] =
+            [at_pole(north), at_pole(south)];
         let mut equilibria = vec![
             Equilibrium {
                 name: "sigma_0",
                 theta: 0.0,
-                energy: u(0.0),
-                stable: upp(0.0) > 0.0,
-                isolated: upp(0.0) < 0.0,
+                energy: u0,
+                stable: stable0,
+                isolated: isolated0,
                 theta_end: None,
             },
             Equilibrium {
                 name: "sigma_pi",
                 theta: PI,
-                energy: u(PI),
-                stable: upp(PI) > 0.0,
-                isolated: upp(PI) < 0.0,
+                energy: upi,
+                stable: stable_pi,
+                isolated: isolated_pi,
                 theta_end: None,
             },
         ];

@@ -985,15 +985,18 @@ pub fn fold_until<S: Shape>(
         )?;
         Some((k, tracer.at(k, energy, top.well)?))
     };
-    // A top at an end of its curve (where it reaches the bottom of a well, or runs into a
-    // separatrix) is no fold: κ(ε) has no maximum inside to search for (the search found one
-    // on another branch, 0.93 below the top). It stands as traced, a corner, its error the
-    // curve's last step in κ (within which the continuation lost it).
+    // A top at an end of its curve: where it reaches the bottom of a well or runs into a
+    // separatrix, κ(ε) has no maximum beyond it; where the continuation lost it just before a
+    // fold (in a window far wider than the fold, adversary pass 6: 1.4291506 ± 1.4e-5 for
+    // 1.4291530), it does. So the search runs over one step either side of the end, and a
+    // fold found strictly inside, at least as high, stands; else the end does, a corner, its
+    // error the curve's last step in κ (a search between the end and its one neighbour found
+    // a maximum on another branch: 1.742 ± 0.93 for an end at 2.671).
     let at_end = !curve.closed && (index == 0 || index + 1 == curve.points.len());
-    if at_end && curve.points.len() > 1 {
+    let end_corner = || -> Option<Fold> {
         let neighbour = curve.points[if index == 0 { 1 } else { index - 1 }];
         let (dn_dkappa, dn_denergy) = tracer.gradient(&top).unwrap_or((f64::NAN, f64::NAN));
-        return Ok(Some(Fold {
+        Some(Fold {
             top: Top::Corner,
             kappa_max: top.kappa,
             energy: top.energy,
@@ -1002,13 +1005,22 @@ pub fn fold_until<S: Shape>(
             dn_dkappa,
             kappa_error: (top.kappa - neighbour.kappa).abs(),
             well: top.well,
-        }));
-    }
-    // Golden section for the largest κ(ε) between the top's neighbours on the curve.
+        })
+    };
+    // Golden section for the largest κ(ε) between the top's neighbours on the curve (or one
+    // step either side of an end).
     let neighbours: Vec<f64> = [index.checked_sub(1), Some(index + 1)]
         .into_iter()
         .flatten()
         .filter_map(|i| curve.points.get(i).map(|p| p.energy))
+        .chain(at_end.then(|| {
+            let n = curve.points[if index == 0 {
+                1.min(curve.points.len() - 1)
+            } else {
+                index - 1
+            }];
+            2.0 * top.energy - n.energy
+        }))
         .collect();
     let (mut a, mut b) = neighbours
         .iter()
@@ -1018,6 +1030,7 @@ pub fn fold_until<S: Shape>(
     if a == b {
         return Ok(None);
     }
+    let bracket = (a, b);
     let ratio = 0.5 * (5f64.sqrt() - 1.0);
     let mut start = top.kappa;
     let value = |e: f64, start: &mut f64| -> f64 {
@@ -1051,7 +1064,7 @@ pub fn fold_until<S: Shape>(
     }
     let energy = 0.5 * (a + b);
     let Some((kappa, point)) = kappa_at(energy, start) else {
-        return Ok(None);
+        return Ok(if at_end { end_corner() } else { None });
     };
     let (dn_dkappa, dn_denergy) = tracer.gradient(&point).unwrap_or((f64::NAN, f64::NAN));
     // The solver's tolerance through ∂N/∂κ, plus the spread of κ over the final bracket.
@@ -1061,12 +1074,15 @@ pub fn fold_until<S: Shape>(
     // the top lies inside its curve.
     let scale = tracer.scale(&point);
     let (gk, ge) = (dn_dkappa * scale.0, dn_denergy * scale.1);
-    let inside = curve.closed || (index > 0 && index + 1 < curve.points.len());
-    let top = if inside && ge.abs() <= 0.05 * gk.hypot(ge) {
-        Top::Fold
-    } else {
-        Top::Corner
-    };
+    let smooth = ge.abs() <= 0.05 * gk.hypot(ge);
+    if at_end {
+        let margin = 1e-3 * (bracket.1 - bracket.0);
+        let within = energy > bracket.0 + margin && energy < bracket.1 - margin;
+        if !(smooth && within && kappa >= top.kappa) {
+            return Ok(end_corner());
+        }
+    }
+    let top = if smooth { Top::Fold } else { Top::Corner };
     Ok(Some(Fold {
         top,
         kappa_max: kappa,

@@ -381,6 +381,19 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
     }
     let journal = if journal_dir.exists() {
         let matching = || Journal::open(&journal_dir, fingerprint);
+        // `--update` starts over from the journal of an earlier version of this scene, never
+        // from another scene's (adversary pass 5: its stopped run's 20,020 cells were lost).
+        if request.update && !request.force && matching().is_err() {
+            if let Some(name) = Journal::scene_name_in(&journal_dir).filter(|n| *n != scene.name) {
+                return Err(AtlasError::atlas(
+                    &journal_dir,
+                    format!(
+                        "holds the journal of a stopped run of another scene ({name:?}): \
+                         --update does not discard it (resume that run, or use --force)"
+                    ),
+                ));
+            }
+        }
         if request.force || (request.update && matching().is_err()) {
             std::fs::remove_dir_all(&journal_dir)
                 .map_err(|e| AtlasError::atlas(&journal_dir, e))?;

@@ -157,6 +157,8 @@ def _numbers(name: str, value) -> np.ndarray:
         for index, x in np.ndenumerate(array):
             if isinstance(x, (bool, np.bool_)) or not isinstance(x, numbers.Real):
                 raise TypeError(f"{name}{_at(index)} is {x!r}: give real numbers")
+            if isinstance(x, np.floating) and x.dtype.itemsize > 8:
+                _numbers(f"{name}{_at(index)}", np.asarray(x))  # a long double: its range
             try:
                 float(x)
             except OverflowError:

@@ -571,6 +571,9 @@ def test_a_long_double_beyond_float64_is_refused_not_made_infinite():
         # Below float64's range it would be 0: κ = 0 is another input (the planar case).
         refused(ValueError, lambda: ra.cells(*BODY, kappa=np.longdouble("1e-400"), energy=2.5),
                 "invalid kappa = 1e-400", "underflows")
+        # Inside an object array too (pass 6: it became 0, or inf).
+        mixed = np.array([0.5, np.longdouble("1e-400")], dtype=object)
+        refused(ValueError, lambda: ra.cells(*BODY, kappa=mixed, energy=2.5), "invalid kappa[1] = 1e-400")
         # Within float64's range a long double is taken as its nearest float64.
         assert ra.cells(*BODY, kappa=np.longdouble(0.8), energy=2.5).rotation_number.notnull().any()
 

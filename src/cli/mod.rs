@@ -373,6 +373,7 @@ fn man(name: Option<&str>, dir: Option<&std::path::Path>, force: bool) -> Result
         let usage = format!("rubber-atlas {}", c.get_name());
         clap_mangen::Man::new(c.clone().name(title).bin_name(usage)).title(title)
     };
+    // (clap's `help` too: the program's page refers to rubber-atlas-help(1).)
     let commands: Vec<&clap::Command> = program.get_subcommands().collect();
     if let Some(dir) = dir {
         if !dir.is_dir() {

@@ -42,6 +42,13 @@ impl Journal {
         })
     }
 
+    /// The `name` of the scene whose run made the journal in `dir`, if its scene can be read.
+    pub fn scene_name_in(dir: &Path) -> Option<String> {
+        let text = std::fs::read_to_string(dir.join("scene.toml")).ok()?;
+        let table = text.parse::<toml::Table>().ok()?;
+        table.get("name")?.as_str().map(str::to_string)
+    }
+
     /// Whether `dir` holds what [`Journal::create`] writes (its fingerprint file, or its
     /// scene before the fingerprint landed, or nothing yet when a run was killed just after
     /// making it): a directory the program may resume or remove.

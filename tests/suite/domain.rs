@@ -292,6 +292,20 @@ fn extreme_bodies_are_undecided_with_the_reason() {
         refused.to_string().starts_with("invalid beta = 1e300"),
         "{refused}"
     );
+    // The diagram's σπ at the pole itself (it was 1.2e84 at β = 1e100: sin π as a double).
+    let needle = EllipsoidBody::ellipsoid(0.5, 1e100, 0.5, 0.5).unwrap();
+    let set = rubber_atlas::critical::CriticalSet::of(&needle, 64, 3.0).unwrap();
+    assert_eq!(set.equilibria[1].energy, 0.5, "{:?}", set.equilibria[1]);
+    // The ODE method at β or 1/β below 1e-6: refused (at β = 1e-20 its N was 3e7 times
+    // beyond its estimate), the quadrature answers.
+    for beta in [1e-20, 1e7] {
+        let body = EllipsoidBody::ellipsoid(0.5, beta, 0.5, 0.5).unwrap();
+        let ode = rubber_atlas::cell::CellOptions {
+            method: rubber_atlas::cell::Method::Ode,
+            ..rubber_atlas::cell::CellOptions::default()
+        };
+        assert!(ode.check_for(&body).is_err(), "beta {beta}");
+    }
     for (alpha, beta, eta) in [
         (0.5, 1e10, 0.5),
         (0.5, 1e8, 0.5),

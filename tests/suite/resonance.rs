@@ -331,6 +331,26 @@ fn wide_windows_give_no_curves_of_noise_and_the_same_tops() {
     assert_eq!(end.top, Top::Corner, "{end:?}");
     assert!((end.kappa_max - 2.6712).abs() < 1e-3, "{end:?}");
 
+    // A fold the continuation lost just before, in a window far wider (adversary pass 6:
+    // 1.4291506 ± 1.4e-5 called a corner): found one step beyond the curve's end, as in a
+    // window round it.
+    let other = EllipsoidBody::ellipsoid(0.99, 5.0, 1.0, 2.0).unwrap();
+    let far = |kappa_max: f64, energy_max: f64| {
+        let options =
+            ResonanceOptions::window(&other, 0.0, (0.01, kappa_max), None, energy_max, 48, 1e-10);
+        fold(&other, &options).unwrap().unwrap()
+    };
+    let (near, wide_fold) = (far(3.0, 10.0), far(10.0, 100.0));
+    assert_eq!(
+        (near.top, wide_fold.top),
+        (Top::Fold, Top::Fold),
+        "{near:?} {wide_fold:?}"
+    );
+    assert!(
+        (near.kappa_max - wide_fold.kappa_max).abs() < 1e-9,
+        "{near:?} {wide_fold:?}"
+    );
+
     let narrow = fold(&body, &window(3.0, 2.0, 5.0)).unwrap().unwrap();
     let wide = fold(&body, &window(3.0, 10.0, 5.0)).unwrap().unwrap();
     assert!(

@@ -1223,3 +1223,39 @@ fn an_update_over_a_current_output_clears_a_stopped_runs_journal() {
     assert!(!journal.exists());
     assert!(!Path::new(&format!("{o}.partial.h5")).exists());
 }
+
+/// `--update` with another scene at the output where a stopped run left its journal
+/// (adversary pass 6: the journal, 20,020 cells, was discarded and the other scene started
+/// from nothing): refused in one line, the journal kept for its own run to resume.
+#[test]
+fn an_update_never_discards_another_scenes_journal() {
+    let (dir, scene, _reference, out, journal) = slow_run();
+    let o = out.to_str().unwrap();
+    std::fs::remove_file(&out).ok();
+    let mut child = Command::new(BIN)
+        .args(["run", &scene, "--out", o, "--quiet"])
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    wait_for_units(&mut child, &journal, 1);
+    // SAFETY: a signal to our own child process.
+    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    if child.wait_with_output().unwrap().status.success() {
+        return; // finished before the signal landed: no journal left
+    }
+    let kept = unit_files(&journal);
+    let text = std::fs::read_to_string(&scene).unwrap();
+    let name_line = text.lines().find(|l| l.starts_with("name")).unwrap();
+    let other = dir.path().join("other.toml");
+    std::fs::write(&other, text.replace(name_line, "name = \"other\"")).unwrap();
+    let refused = run(&["run", other.to_str().unwrap(), "--out", o, "--update"]);
+    assert_eq!(
+        refused.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&refused.stderr)
+    );
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("another scene"));
+    assert_eq!(unit_files(&journal), kept);
+    ok(&run(&["run", &scene, "--out", o, "--resume", "--quiet"]));
+}
