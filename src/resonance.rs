@@ -658,6 +658,13 @@ impl<'a, S: Shape> Tracer<'a, S> {
                             .filter(|&x| x > lo && x < hi)
                             .collect();
                         if self.options.natural_scales {
+                            // A gap far narrower than the window (a well's, below its
+                            // separatrix) holding fewer than 4 of the window's energies gets
+                            // `grid` of its own: a disk's N = 1 curve in a well 0.74 deep
+                            // was missed from --energy-max 20 on (1 or 2 energies in it).
+                            if xs.len() < 4 {
+                                xs.extend((1..n).map(|j| lo + (hi - lo) * j as f64 / n as f64));
+                            }
                             xs.extend(natural_points(lo, hi, 4.0 * lo.abs().max(1.0), n));
                         }
                         // Halving towards each end from half the gap, or from the end's

@@ -359,6 +359,26 @@ fn wide_windows_give_no_curves_of_noise_and_the_same_tops() {
     );
 }
 
+/// A curve in a well far shallower than the window (adversary pass 6): the disk's N = 1
+/// curve round its face well (κ 0.01 … 0.056, ε 0.517 … 0.595, the well 0.74 deep) was lost
+/// from --energy-max 20 on, where 1 or 2 of the seed scan's energies fell in the well.
+#[test]
+fn a_curve_in_a_shallow_well_is_found_in_a_tall_window() {
+    use rubber_atlas::body::{Body, EdgedShape};
+    let disk = Body::new(EdgedShape::disk(0.3).unwrap(), 2.0, 4.0).unwrap();
+    for energy_max in [5.0, 20.0, 1e6] {
+        let options =
+            ResonanceOptions::window(&disk, 1.0, (0.01, 2.0), None, energy_max, 48, 1e-10);
+        let curves = trace_curves(&disk, &options).unwrap();
+        let low = curves.iter().any(|c| {
+            c.points
+                .iter()
+                .all(|p| p.kappa < 0.06 && p.energy > 0.5 && p.energy < 0.6)
+        });
+        assert!(low, "energy <= {energy_max}: {} curves", curves.len());
+    }
+}
+
 /// A wheel's N = −1 curve (adversary pass 5): the default window glued the curve of another
 /// family on where its well ended (the turning points jumped by 0.49 in one step), a window
 /// to κ = 10 gave two pieces. Now one curve in both, its tori changing by little per step.
