@@ -1155,19 +1155,12 @@ fn edged_body_scenes_are_refused_where_the_shape_does_not_fit() {
     }
 }
 
-/// A `--force` run of `scene` over `reference` copied to `out`, stopped by SIGINT after its
-/// first unit: its stderr, or None if it finished before the signal landed.
-fn stop_a_forced_run(scene: &str, reference: &Path, out: &Path, journal: &Path) -> Option<String> {
-    std::fs::copy(reference, out).unwrap();
+/// A run of `scene` into `out` with `extra` flags, stopped by SIGINT after its first unit:
+/// its stderr, or None if it finished before the signal landed.
+fn stop_a_run(scene: &str, out: &Path, journal: &Path, extra: &[&str]) -> Option<String> {
     let mut child = Command::new(BIN)
-        .args([
-            "run",
-            scene,
-            "--out",
-            out.to_str().unwrap(),
-            "--force",
-            "--quiet",
-        ])
+        .args(["run", scene, "--out", out.to_str().unwrap(), "--quiet"])
+        .args(extra)
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
@@ -1176,6 +1169,12 @@ fn stop_a_forced_run(scene: &str, reference: &Path, out: &Path, journal: &Path) 
     unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
     let output = child.wait_with_output().unwrap();
     (!output.status.success()).then(|| String::from_utf8_lossy(&output.stderr).into_owned())
+}
+
+/// A `--force` run of `scene` over `reference` copied to `out`, stopped after its first unit.
+fn stop_a_forced_run(scene: &str, reference: &Path, out: &Path, journal: &Path) -> Option<String> {
+    std::fs::copy(reference, out).unwrap();
+    stop_a_run(scene, out, journal, &["--force"])
 }
 
 /// Adversary pass 4: a `--force` run over an existing output, stopped by SIGINT, said
@@ -1232,15 +1231,7 @@ fn an_update_never_discards_another_scenes_journal() {
     let (dir, scene, _reference, out, journal) = slow_run();
     let o = out.to_str().unwrap();
     std::fs::remove_file(&out).ok();
-    let mut child = Command::new(BIN)
-        .args(["run", &scene, "--out", o, "--quiet"])
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    wait_for_units(&mut child, &journal, 1);
-    // SAFETY: a signal to our own child process.
-    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
-    if child.wait_with_output().unwrap().status.success() {
+    if stop_a_run(&scene, &out, &journal, &[]).is_none() {
         return; // finished before the signal landed: no journal left
     }
     let kept = unit_files(&journal);
