@@ -13,7 +13,7 @@ wrote):
 - res:   resonance curves N = p/q over the type (c) diagram (`resonance`), and the centre of
          mass and contact point at N = 0, κ = 0.5 (`trajectory`);
 - xy:    the trajectories of Fig. xy: N = −1/7 (κ = 0.8) and quasi-periodic (κ = 1, θ(0) = 2.1);
-- bodies: N over (κ, ε) of the disk, the truncated ball and the wheel (docs/bodies.md), with
+- bodies: N over (κ, ε) of the disk, the truncated ball, the wheel and a profile (docs/bodies.md), with
          their resonance curves N = 0, ±1/4, ±1/7 (`cells` and `resonance` with `shape=`).
 
     .venv/bin/python scripts/figures.py all --out docs/figures
@@ -240,31 +240,36 @@ def fig_xy(out: Path) -> Path:
     return save(fig, out / "xy.png")
 
 
-# The edged bodies of docs/bodies.md: (title, shape, α, cut, ν, η, κ window, ε window).
+# The egg with a sharp rim of atlas/egg.toml: (ρ, z[, edge]) from the bottom pole.
+EGG = [[0, -1], [0.45, -0.92], [0.8, -0.62], [0.98, -0.2], [0.97, 0.25], [0.8, 0.62, 1], [0.4, 0.8], [0, 0.86]]
+
+# The bodies of docs/bodies.md: (title, shape, α, cut, ν, η, κ window, ε window, keywords).
 EDGED = [
-    ("disk, α = 0.3 (ν = 2, η = 4)", "disk", 0.3, None, 2.0, 4.0, (0.02, 1.5), (0.35, 2.5)),
+    ("disk, α = 0.3 (ν = 2, η = 4)", "disk", 0.3, None, 2.0, 4.0, (0.02, 1.5), (0.35, 2.5), {}),
     ("truncated ball, α = 0.2, h = 0.4 (ν = 0.7, η = 1.3)", "truncated_ball", 0.2, 0.4, 0.7, 1.3,
-     (0.02, 1.5), (0.65, 3.0)),
-    ("wheel, α = 0.25, h = 0.7 (ν = 0.7, η = 1.3)", "wheel", 0.25, 0.7, 0.7, 1.3, (0.02, 1.5), (0.7, 3.0)),
+     (0.02, 1.5), (0.65, 3.0), {}),
+    ("wheel, α = 0.25, h = 0.7 (ν = 0.7, η = 1.3)", "wheel", 0.25, 0.7, 0.7, 1.3, (0.02, 1.5), (0.7, 3.0), {}),
+    ("profile: the egg of atlas/egg.toml, α = −0.1 (ν = 0.8, η = 1.7)", "profile", -0.1, None, 0.8, 1.7,
+     (0.02, 1.5), (0.9, 3.0), {"profile": EGG}),
 ]
 
 
 def fig_bodies(out: Path, n: int = 121, targets=("0", "1/4", "-1/4", "1/7", "-1/7"), grid: int = 32) -> Path:
-    """N of the torus of lowest θ_min over (κ, ε) for each edged body, with the resonance
+    """N of the torus of lowest θ_min over (κ, ε) for each body beyond the ellipsoid, with the resonance
     curves N = p/q traced by continuation (each point on N = p/q within its estimate)."""
-    fig, axes = plt.subplots(1, len(EDGED), figsize=(6 * len(EDGED), 5), layout="constrained")
-    for ax, (title, shape, alpha, cut, nu, eta, (k0, k1), (e0, e1)) in zip(axes, EDGED):
+    fig, axes = plt.subplots(2, 2, figsize=(12, 10), layout="constrained")
+    for ax, (title, shape, alpha, cut, nu, eta, (k0, k1), (e0, e1), extra) in zip(axes.flat, EDGED):
         kappa, energy = np.linspace(k0, k1, n), np.linspace(e0, e1, n)
         cells = ra.cells(alpha, None, nu, eta, kappa=xr.DataArray(kappa, dims="kappa"),
                          energy=xr.DataArray(energy, dims="energy"), shape=shape, cut=cut,
-                         fields=["rotation_number"], layout="theta_min", progress=False)
+                         fields=["rotation_number"], layout="theta_min", progress=False, **extra)
         n_low = cells.rotation_number.isel(component=0).transpose("energy", "kappa")
         cmap = plt.get_cmap("RdBu_r").copy()
         cmap.set_bad("0.8")
         mesh = ax.pcolormesh(kappa, energy, n_low, cmap=cmap, vmin=-1.0, vmax=1.0, shading="nearest")
         for i, t in enumerate(targets):
             curves = ra.resonance(alpha, None, nu, eta, t, shape=shape, cut=cut, kappa_min=k0, kappa_max=k1,
-                                  energy_max=e1, grid=grid)
+                                  energy_max=e1, grid=grid, **extra)
             for j in np.unique(curves.curve.values):
                 c = curves.where(curves.curve == j, drop=True)
                 ax.plot(c.kappa, c.energy, color=f"C{i + 1}", lw=1.2, label=f"N = {t}" if j == 0 else None)

@@ -362,6 +362,130 @@ class EdgedCell(Cell):
             return kinks
 
 
+class ProfileCell(EdgedCell):
+    """V of one (body, κ) of a profile (docs/bodies.md, "Your own body"): the arc spline through
+    a table of meridian points, fitted here anew at `digits` digits by the rules that page
+    states (the tangent of the circle through each smooth point and its neighbours, 0 and π at
+    smooth poles; two arcs between smooth points with the joint's tangent in the middle of the
+    range where both turn one way; one arc beside an edge; the normal turning round an edge;
+    a flat end of the table a face). On an arc of centre (ρ_c, z_c) and radius r,
+    U = ρ_c sinθ − (z_c − α) cosθ + r. κ ≠ 0 only."""
+
+    def __init__(self, rows, alpha, nu, eta, kappa, digits: int = DIGITS):
+        EdgedCell.__init__(self, "disk", alpha, None, nu, eta, kappa, digits)
+        self.kind = "profile"
+        with mpmath.workdps(digits):
+            self.arcs = _profile_arcs([[mpmath.mpf(x) for x in r] for r in rows])
+
+    def _arc(self, s, c):
+        theta = mpmath.atan2(s, c)
+        for arc in self.arcs:
+            if theta <= arc[1]:
+                return arc
+        return self.arcs[-1]
+
+    def _u(self, s, c):
+        _, _, r, rho_c, z_c = self._arc(s, c)
+        return rho_c * s - (z_c - self.alpha) * c + r
+
+    def _u_prime(self, s, c):
+        _, _, _, rho_c, z_c = self._arc(s, c)
+        return rho_c * c + (z_c - self.alpha) * s
+
+    def kinks(self) -> list[Point]:
+        with mpmath.workdps(self.digits):
+            return [at(arc[1]) for arc in self.arcs[:-1]]
+
+
+def _same(x, y) -> bool:
+    """Equal to within the working precision (a tangent taken from this chord)."""
+    return abs(x - y) <= mpmath.mpf(10) ** (-mpmath.mp.dps + 8)
+
+
+def _profile_arcs(rows):
+    """The arcs (θ_start, θ_end, r, ρ_c, z_c) of the arc spline through `rows` (ρ, z[, edge]),
+    in order of the normal angle θ from 0 to π (r = 0 round an edge)."""
+    if rows[0][1] > rows[-1][1]:
+        rows = rows[::-1]
+    n = len(rows)
+    pi = mpmath.pi
+    faces = (rows[1][1] == rows[0][1], rows[n - 2][1] == rows[n - 1][1])
+    first, last = (1 if faces[0] else 0), (n - 2 if faces[1] else n - 1)
+
+    def edge(i):
+        return (len(rows[i]) > 2 and rows[i][2] == 1) or (i == first and faces[0]) or (i == last and faces[1])
+
+    def chord(a, b):
+        return mpmath.atan2(b[1] - a[1], b[0] - a[0]), mpmath.hypot(b[0] - a[0], b[1] - a[1])
+
+    tangent = {}
+    for i in range(first, last + 1):
+        if edge(i):
+            continue
+        if i == 0:
+            tangent[i] = mpmath.mpf(0)
+        elif i == n - 1:
+            tangent[i] = pi
+        else:
+            (psi1, l1), (psi2, l2) = chord(rows[i - 1], rows[i]), chord(rows[i], rows[i + 1])
+            turn = psi2 - psi1
+            assert 0 < turn < pi, f"not convex at point {i}"
+            tangent[i] = psi1 + mpmath.atan2(l1 * mpmath.sin(turn), l2 + l1 * mpmath.cos(turn))
+
+    def arc(t0, t1, r, anchor_theta, anchor):
+        # The centre: the anchor less r times the outward normal (sin θ_a, −cos θ_a).
+        return (t0, t1, r, anchor[0] - r * mpmath.sin(anchor_theta), anchor[1] + r * mpmath.cos(anchor_theta))
+
+    # The tangents where the meridian arrives at and leaves each edge; one between the chords
+    # where the one-arc tangents would overshoot.
+    arrive, leave = {}, {}
+    for i in range(first, last + 1):
+        if not edge(i):
+            continue
+        bottom = i == 0 or (i == first and faces[0])
+        top = i == n - 1 or (i == last and faces[1])
+        arrive[i] = mpmath.mpf(0) if bottom else 2 * chord(rows[i - 1], rows[i])[0] - tangent[i - 1]
+        leave[i] = pi if top else 2 * chord(rows[i], rows[i + 1])[0] - tangent[i + 1]
+        if arrive[i] > leave[i]:
+            if bottom:
+                common = arrive[i]
+            elif top:
+                common = leave[i]
+            else:
+                before, after = chord(rows[i - 1], rows[i])[0], chord(rows[i], rows[i + 1])[0]
+                margin = (after - before) / 4
+                common = min(max((arrive[i] + leave[i]) / 2, before + margin), after - margin)
+            arrive[i] = leave[i] = common
+
+    arcs = []
+    for i in range(first, last):
+        a, b = rows[i], rows[i + 1]
+        psi, length = chord(a, b)
+        if edge(i):
+            arcs.append(arc(arrive[i], leave[i], 0, arrive[i], a))
+        t0 = leave[i] if edge(i) else tangent[i]
+        t1 = arrive[i + 1] if edge(i + 1) else tangent[i + 1]
+        assert t0 < psi < t1, f"not convex between points {i} and {i + 1}"
+        # One arc beside an edge whose tangent was taken from this chord, else a biarc.
+        one_arc = _same(t1, 2 * psi - t0) or _same(t0, 2 * psi - t1)
+        if one_arc:
+            r = length / (2 * mpmath.sin((t1 - t0) / 2))
+            arcs.append(arc(t0, t1, r, *((t0, a) if edge(i + 1) else (t1, b))))
+            continue
+        lo, hi = max(t0, 2 * psi - t1), min(t1, 2 * psi - t0)
+        tj = (lo + hi) / 2
+        m1, m2 = (t0 + tj) / 2, (tj + t1) / 2
+        det = mpmath.sin(m2 - m1)
+        c1, c2 = length * mpmath.sin(m2 - psi) / det, length * mpmath.sin(psi - m1) / det
+        arcs.append(arc(t0, tj, c1 / (2 * mpmath.sin((tj - t0) / 2)), t0, a))
+        arcs.append(arc(tj, t1, c2 / (2 * mpmath.sin((t1 - tj) / 2)), t1, b))
+    if edge(last):
+        arcs.append(arc(arrive[last], leave[last], 0, arrive[last], rows[last]))
+    arcs = [a for a in arcs if a[1] > a[0]]
+    assert arcs[0][0] == 0 and abs(arcs[-1][1] - pi) < mpmath.mpf(10) ** (-mpmath.mp.dps + 5)
+    return arcs
+
+
 def edged_reference(kind, alpha, cut, nu, eta, kappa, energy, digits: int = DIGITS) -> list[Component]:
     """The components of a cell of an edged body with T and N at `digits` digits."""
     return EdgedCell(kind, alpha, cut, nu, eta, kappa, digits).components(energy)

@@ -8,10 +8,13 @@ within rounding of a critical level.
 
     python scripts/whole_domain.py --cells 300 --seed 12 [--out summary.csv]
     python scripts/whole_domain.py --bodies --cells 120 --seed 21
+    python scripts/whole_domain.py --profiles --cells 80 --seed 2
 
 `--bodies` samples the edged bodies instead (docs/bodies.md): the disk (|α| ≤ 100), the
 truncated ball and the wheel (|α| < 1, every cut), κ ≠ 0, with a fifth of the energies putting
 a turning point within 1e-15 … 1e-3 of a kink; their references are computed afresh.
+`--profiles` samples bodies of random profiles (tables of points of superellipses, some cut
+flat: `sample_profiles`), likewise.
 
 The references take about a second of CPU each: those of the reproductions, of the first
 300 cells of seed 12 and of the tiny-κ cells of the tests are kept in `whole_domain_references.json` (the test suite checks
@@ -30,6 +33,7 @@ import multiprocessing
 import os
 import random
 import subprocess
+import tempfile
 import sys
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -58,16 +62,18 @@ def stored() -> dict:
     return _stored
 
 
-def _edged(shape: str, alpha, cut, nu, eta, kappa) -> "_reference.EdgedCell":
+def _edged(shape: str, alpha, cut, nu, eta, kappa, profile=None) -> "_reference.EdgedCell":
+    if shape == "profile":
+        return _reference.ProfileCell(profile, alpha, nu, eta, kappa)
     return _reference.EdgedCell(shape, alpha, cut, nu, eta, kappa)
 
 
-def critical_levels(alpha, beta, nu, eta, kappa, shape: str = "ellipsoid", cut: float = 0.0
+def critical_levels(alpha, beta, nu, eta, kappa, shape: str = "ellipsoid", cut: float = 0.0, profile=None
                     ) -> list[tuple[float, float]]:
-    """reference.critical_levels (of an edged body: computed afresh), from the stored
-    references when they hold this ellipsoid."""
+    """reference.critical_levels (of an edged body or a profile: computed afresh), from the
+    stored references when they hold this ellipsoid."""
     if shape != "ellipsoid":
-        cell = _edged(shape, alpha, cut, nu, eta, kappa)
+        cell = _edged(shape, alpha, cut, nu, eta, kappa, profile)
         with _reference.mpmath.workdps(_reference.DIGITS):
             return [(float(p.theta), float(cell.potential(p))) for p in cell.critical_points()]
     got = stored()["levels"].get(_key(alpha, beta, nu, eta, kappa))
@@ -76,12 +82,12 @@ def critical_levels(alpha, beta, nu, eta, kappa, shape: str = "ellipsoid", cut: 
     return _reference.critical_levels(alpha, beta, nu, eta, kappa)
 
 
-def reference(alpha, beta, nu, eta, kappa, energy, shape: str = "ellipsoid", cut: float = 0.0
+def reference(alpha, beta, nu, eta, kappa, energy, shape: str = "ellipsoid", cut: float = 0.0, profile=None
               ) -> list[Component]:
-    """reference.reference (of an edged body: computed afresh), from the stored references
-    when they hold this cell."""
+    """reference.reference (of an edged body or a profile: computed afresh), from the stored
+    references when they hold this cell."""
     if shape != "ellipsoid":
-        return _edged(shape, alpha, cut, nu, eta, kappa).components(energy)
+        return _edged(shape, alpha, cut, nu, eta, kappa, profile).components(energy)
     got = stored()["components"].get(_key(alpha, beta, nu, eta, kappa, energy))
     if got is not None:
         return [Component(**c) for c in got]
@@ -138,12 +144,16 @@ class Case:
     # The body's shape (docs/bodies.md) and, for the cut balls, its cut; β is unused then.
     shape: str = "ellipsoid"
     cut: float = 0.0
+    # For shape "profile": the table, rows (ρ, z[, edge]) (docs/bodies.md, "Your own body").
+    profile: tuple | None = None
 
     def levels(self) -> list[tuple[float, float]]:
-        return critical_levels(self.alpha, self.beta, self.nu, self.eta, self.kappa, self.shape, self.cut)
+        return critical_levels(self.alpha, self.beta, self.nu, self.eta, self.kappa, self.shape, self.cut,
+                               self.profile)
 
     def reference(self) -> list[Component]:
-        return reference(self.alpha, self.beta, self.nu, self.eta, self.kappa, self.energy, self.shape, self.cut)
+        return reference(self.alpha, self.beta, self.nu, self.eta, self.kappa, self.energy, self.shape, self.cut,
+                         self.profile)
 
 
 def resolve(case: Case) -> Case:
@@ -154,7 +164,7 @@ def resolve(case: Case) -> Case:
         return case
     if len(case.recipe) == 3:
         which, side, distance = case.recipe
-        cell = _edged(case.shape, case.alpha, case.cut, case.nu, case.eta, case.kappa)
+        cell = _edged(case.shape, case.alpha, case.cut, case.nu, case.eta, case.kappa, case.profile)
         with _reference.mpmath.workdps(_reference.DIGITS):
             kinks = cell.kinks()
             theta = kinks[int(which * len(kinks))].theta + side * _reference.mpmath.mpf(10) ** distance
@@ -318,14 +328,66 @@ def reproductions() -> list[Case]:
     return issue + [Case(*r, origin=label) for label, r in FOUND]
 
 
+def sample_profiles(seed: int, count: int) -> list[Case]:
+    """`count` seeded random cells of bodies of your own (docs/bodies.md): tables of 4 … 24
+    points of a superellipse |ρ/a|^p + |z|^p = 1 (a ∈ [0.1, 10], p ∈ [2, 6]) at random
+    places, a third of them cut flat at the bottom, the top or both (faces, their ends edges),
+    the centre of mass anywhere strictly between the poles (also 1e-6 from one); ν, η, κ and
+    the energies as for the edged bodies, turning points next to joints among them."""
+    rng = random.Random(seed)
+    cases = []
+    while len(cases) < count:
+        a, p = _loguniform(rng, 0.1, 10), rng.uniform(2, 6)
+        n = rng.randint(4, 24)
+        ts = sorted(rng.uniform(0.02, math.pi - 0.02) for _ in range(n - 2))
+        if min(b - a_ for a_, b in zip([0.0, *ts], [*ts, math.pi])) < 1e-3:
+            continue
+
+        def point(t):
+            s, c = math.sin(t), math.cos(t)
+            return [a * abs(s) ** (2 / p), -math.copysign(abs(c) ** (2 / p), c)]
+
+        rows = [[0.0, -1.0]] + [point(t) for t in ts] + [[0.0, 1.0]]
+        # Faces: the first (last) inner point's height becomes the pole's.
+        cut = rng.random()
+        if cut < 0.15 or 0.3 <= cut < 0.35:
+            rows[0][1] = rows[1][1]
+        if 0.15 <= cut < 0.35:
+            rows[-1][1] = rows[-2][1]
+        if len(rows) - sum(1 for r in rows if r[0] == 0) < 2:
+            continue
+        bottom, top = rows[0][1], rows[-1][1]
+        alpha = rng.choice([rng.uniform(bottom, top), bottom + 1e-6 * (top - bottom), top - 1e-6 * (top - bottom)])
+        nu = rng.uniform(1e-3, 2)
+        eta = _loguniform(rng, 1e-3, 1e3)
+        kappa = rng.choice([-1, 1]) * _loguniform(rng, 1e-8, 1e4)
+        if rng.random() < 0.2:
+            recipe = (rng.random(), rng.choice([-1, 1]), rng.uniform(-15, -3))
+        else:
+            recipe = (rng.random(), rng.random(), rng.choice([-1, 1]), rng.uniform(-15, -3), rng.uniform(-12, 6))
+        table = tuple(tuple(r) for r in rows)
+        cases.append(Case(alpha, 1.0, nu, eta, kappa, math.nan, "random", recipe, "profile", 0.0, table))
+    return cases
+
+
 def run_cell(case: Case, method: str = "quadrature", tol: float = 1e-10) -> dict:
     body = [f"--beta={case.beta!r}"] if case.shape == "ellipsoid" else [f"--shape={case.shape}"]
     if case.shape in ("truncated_ball", "wheel"):
         body.append(f"--cut={case.cut!r}")
+    table = None
+    if case.shape == "profile":
+        with tempfile.NamedTemporaryFile("w", suffix=".txt", delete=False) as f:
+            f.write("\n".join(" ".join(repr(float(x)) for x in row) for row in case.profile) + "\n")
+            table = f.name
+        body.append(f"--profile={table}")
     args = [BIN, "cell", f"--alpha={case.alpha!r}", *body, f"--nu={case.nu!r}",
             f"--eta={case.eta!r}", f"--kappa={case.kappa!r}", f"--energy={case.energy!r}", "--method", method,
             f"--tol={tol!r}", "--json"]
-    out = subprocess.run(args, capture_output=True, text=True)
+    try:
+        out = subprocess.run(args, capture_output=True, text=True)
+    finally:
+        if table:
+            os.unlink(table)
     if out.returncode != 0:
         return {"error": out.stderr.strip()}
     return json.loads(out.stdout)
@@ -441,12 +503,18 @@ def main():
     parser.add_argument("--seed", type=int, default=12)
     parser.add_argument("--method", default="quadrature")
     parser.add_argument("--bodies", action="store_true", help="sample the edged bodies instead of the ellipsoid")
+    parser.add_argument("--profiles", action="store_true", help="sample bodies of random profiles instead")
     parser.add_argument("--tol", type=float, default=1e-10, help="the cells' tolerance (default 1e-10)")
     parser.add_argument("--out", type=Path)
     parser.add_argument("--write-references", action="store_true", help=f"compute the references afresh into {REFERENCES.name}")
     args = parser.parse_args()
-    cases = sample_bodies(args.seed, args.cells) if args.bodies else reproductions() + sample(args.seed, args.cells)
-    if args.write_references and not args.bodies:
+    if args.profiles:
+        cases = sample_profiles(args.seed, args.cells)
+    elif args.bodies:
+        cases = sample_bodies(args.seed, args.cells)
+    else:
+        cases = reproductions() + sample(args.seed, args.cells)
+    if args.write_references and not (args.bodies or args.profiles):
         cases += tiny_kappa()
         global _stored
         _stored = {"levels": {}, "components": {}}

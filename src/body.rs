@@ -11,8 +11,55 @@ use crate::dd::DoubleDouble;
 use crate::error::{check_range, AtlasError, Result, MAX_KAPPA};
 use nalgebra::Vector3;
 
+/// `fn name(&self, theta) -> f64 { self.name_at(Angle::new(theta)) }` for each `name =>
+/// name_at` pair: a shape whose formulas take the angle's sine and cosine gives its θ forms so.
+macro_rules! theta_forms {
+    ($($name:ident => $at:ident),* $(,)?) => {
+        $(
+            #[inline]
+            fn $name(&self, theta: f64) -> f64 {
+                self.$at(Angle::new(theta))
+            }
+        )*
+    };
+}
+
+/// d/dt of γ⊥/|γ⊥|, γ⊥ = (γ1, γ2, 0), when γ moves at γ̇: the rate of the horizontal unit
+/// vector towards which an edge's or an arc's contact point lies (0 on the axis).
+pub(crate) fn horizontal_direction_rate(
+    gamma: &Vector3<f64>,
+    gamma_dot: &Vector3<f64>,
+) -> Vector3<f64> {
+    let h = Vector3::new(gamma.x, gamma.y, 0.0);
+    let h_dot = Vector3::new(gamma_dot.x, gamma_dot.y, 0.0);
+    let s2 = h.norm_squared();
+    if s2 == 0.0 {
+        return Vector3::zeros();
+    }
+    let s = s2.sqrt();
+    h_dot / s - h * (h.dot(&h_dot) / (s2 * s))
+}
+
+/// (U(x) − U(y)) / sin(x − y) by subtracting U, with its rounding scale
+/// (|U(x)| + |U(y)|)/|sin(x − y)| ([`Shape::potential_divided_difference`]'s default, and the
+/// fallback of the shapes that override it across a kink).
+#[inline]
+pub(crate) fn subtracted_divided_difference<S: Shape + ?Sized>(
+    shape: &S,
+    x: Angle,
+    y: Angle,
+    sin_diff: f64,
+) -> (f64, f64) {
+    let (ux, uy) = (shape.potential_at(x), shape.potential_at(y));
+    ((ux - uy) / sin_diff, (ux.abs() + uy.abs()) / sin_diff.abs())
+}
+
 mod edged;
+mod profile;
 pub use edged::{EdgedKind, EdgedShape};
+pub use profile::{
+    parse_table as parse_profile_table, Profile, ProfileArc, ProfileShape, MAX_PROFILE_POINTS,
+};
 
 /// An angle θ given by its sine and cosine, both to full relative precision. Near θ = π a
 /// double holds θ only to an absolute 4e-16, so callers build the pair from π − θ there
@@ -146,8 +193,7 @@ pub trait Shape: Send + Sync {
         cos_diff: f64,
     ) -> (f64, f64) {
         let _ = cos_diff;
-        let (ux, uy) = (self.potential_at(x), self.potential_at(y));
-        ((ux - uy) / sin_diff, (ux.abs() + uy.abs()) / sin_diff.abs())
+        subtracted_divided_difference(self, x, y, sin_diff)
     }
 
     /// U′(θ) / sinθ = χ2 − χ1 cosθ: the horizontal offset of the contact point per unit
@@ -352,12 +398,6 @@ impl Shape for Ellipsoid {
         -bgd / s + bg * (gamma.dot(&bgd) / (s2 * s))
     }
 
-    /// U(θ) = Z(θ) + α cosθ.
-    #[inline]
-    fn potential(&self, theta: f64) -> f64 {
-        self.potential_at(Angle::new(theta))
-    }
-
     /// U′(θ) = −α sinθ + (β² − 1) sinθ cosθ / Z.
     #[inline]
     fn potential_prime(&self, theta: f64) -> f64 {
@@ -365,18 +405,14 @@ impl Shape for Ellipsoid {
         -self.alpha * s + (self.beta * self.beta - 1.0) * s * c / self.centre_height(theta)
     }
 
-    /// U″(θ) = −α cosθ + (β² − 1) [cos 2θ / Z − sinθ cosθ Z′ / Z²].
-    #[inline]
-    fn potential_second(&self, theta: f64) -> f64 {
-        self.potential_second_at(Angle::new(theta))
-    }
-
-    /// |r|² = (β⁴ sin²θ + (cosθ + αZ)²) / Z² (docs/model.md; the paper's `eqsysell` prints
-    /// (αZ − cosθ)², a misprint).
-    #[inline]
-    fn contact_distance_sq(&self, theta: f64) -> f64 {
-        self.contact_distance_sq_at(Angle::new(theta))
-    }
+    // U(θ) = Z(θ) + α cosθ; U″(θ) = −α cosθ + (β² − 1) [cos 2θ / Z − sinθ cosθ Z′ / Z²];
+    // |r|² = (β⁴ sin²θ + (cosθ + αZ)²) / Z² (docs/model.md; the paper's `eqsysell` prints
+    // (αZ − cosθ)², a misprint): from their forms at (sinθ, cosθ) below.
+    theta_forms!(
+        potential => potential_at,
+        potential_second => potential_second_at,
+        contact_distance_sq => contact_distance_sq_at,
+    );
 
     #[inline]
     fn potential_at(&self, a: Angle) -> f64 {
@@ -608,6 +644,8 @@ pub enum AnyBody {
     Ellipsoid(EllipsoidBody),
     /// A disk, a truncated ball or a wheel (α and the cut h).
     Edged(Body<EdgedShape>),
+    /// A body of the user's own profile (α, the height of the centre of mass on the axis).
+    Profile(Body<ProfileShape>),
 }
 
 impl AnyBody {
@@ -623,6 +661,9 @@ impl AnyBody {
     ) -> Result<Self> {
         Ok(match kind {
             None => AnyBody::Ellipsoid(EllipsoidBody::ellipsoid(alpha, second, nu, eta)?),
+            Some(EdgedKind::Profile(p)) => {
+                AnyBody::Profile(Body::new(ProfileShape::new(p, alpha)?, nu, eta)?)
+            }
             Some(kind) => AnyBody::Edged(Body::new(EdgedShape::of(kind, alpha, second)?, nu, eta)?),
         })
     }
@@ -632,6 +673,7 @@ impl AnyBody {
         match self {
             AnyBody::Ellipsoid(_) => None,
             AnyBody::Edged(b) => Some(b.shape.kind),
+            AnyBody::Profile(b) => Some(EdgedKind::Profile(b.shape.profile)),
         }
     }
 
@@ -646,6 +688,7 @@ impl AnyBody {
         let (alpha, second) = match self {
             AnyBody::Ellipsoid(b) => (b.shape.alpha, b.shape.beta),
             AnyBody::Edged(b) => (b.shape.alpha, b.shape.cut),
+            AnyBody::Profile(b) => (b.shape.alpha, 0.0),
         };
         std::iter::once(("alpha", alpha))
             .chain(second_parameter(self.kind()).map(|name| (name, second)))
@@ -654,7 +697,7 @@ impl AnyBody {
 }
 
 /// Every shape's name, the ellipsoid first (scenes, the package and the command line).
-pub const SHAPE_NAMES: [&str; 4] = ["ellipsoid", "disk", "truncated_ball", "wheel"];
+pub const SHAPE_NAMES: [&str; 5] = ["ellipsoid", "disk", "truncated_ball", "wheel", "profile"];
 
 /// The shape of that name: Some(None) for the ellipsoid, Some(kind) for an edged body, None
 /// for an unknown name.
@@ -676,7 +719,7 @@ pub fn shape_name(kind: Option<EdgedKind>) -> &'static str {
 pub fn second_parameter(kind: Option<EdgedKind>) -> Option<&'static str> {
     match kind {
         None => Some("beta"),
-        Some(EdgedKind::Disk) => None,
+        Some(EdgedKind::Disk) | Some(EdgedKind::Profile(_)) => None,
         Some(_) => Some("cut"),
     }
 }
@@ -689,6 +732,7 @@ macro_rules! with_body {
         match $body {
             $crate::body::AnyBody::Ellipsoid($b) => $e,
             $crate::body::AnyBody::Edged($b) => $e,
+            $crate::body::AnyBody::Profile($b) => $e,
         }
     };
 }

@@ -6,7 +6,7 @@
 //! Several of the paper's printed formulas carry misprints; the corrected forms used here are
 //! those of docs/model.md, and the tests check each against a direct numerical search.
 
-use crate::body::{Angle, Body, EdgedShape, EllipsoidBody, Shape};
+use crate::body::{Angle, AnyBody, Body, EdgedShape, EllipsoidBody, Shape};
 use crate::error::{AtlasError, Result};
 use crate::reduced::ReducedSystem;
 use crate::torus::bisect;
@@ -834,7 +834,7 @@ pub fn general_fixed_point<S: Shape>(body: &Body<S>, theta0: f64) -> FixedPoint 
 /// stable where U rises from it), and the inclined ones (`inclined`), the roots of U′ inside,
 /// found by a scan of 4096 cells and bisection. Where U′ vanishes on a whole arc (α = 0 on a
 /// ball's sphere), every inclination there is a neutral equilibrium: one `neutral_arc`.
-fn edged_equilibria(body: &Body<EdgedShape>) -> Vec<Equilibrium> {
+fn edged_equilibria<S: Shape>(body: &Body<S>) -> Vec<Equilibrium> {
     let shape = &body.shape;
     let faces = shape.faces();
     let mut out = Vec::new();
@@ -942,6 +942,46 @@ impl CriticalSet {
         kappa_max: f64,
         stop: &dyn Fn() -> bool,
     ) -> Result<Self> {
+        let disk = body.shape.kind == crate::body::EdgedKind::Disk;
+        let (alpha, cut) = (body.shape.alpha, (!disk).then_some(body.shape.cut));
+        Self::of_shape(
+            body,
+            (body.shape.kind.name(), alpha, cut),
+            samples,
+            kappa_max,
+            stop,
+        )
+    }
+
+    /// The critical set of any body ([`CriticalSet::of_until`] for the ellipsoid,
+    /// [`CriticalSet::of_edged`]'s for every other).
+    pub fn of_any(
+        body: &AnyBody,
+        samples: usize,
+        kappa_max: f64,
+        stop: &dyn Fn() -> bool,
+    ) -> Result<Self> {
+        match body {
+            AnyBody::Ellipsoid(b) => Self::of_until(b, samples, kappa_max, stop),
+            AnyBody::Edged(b) => Self::of_edged(b, samples, kappa_max, stop),
+            AnyBody::Profile(b) => Self::of_shape(
+                b,
+                ("profile", b.shape.alpha, None),
+                samples,
+                kappa_max,
+                stop,
+            ),
+        }
+    }
+
+    /// [`CriticalSet::of_edged`] for any shape, named (shape, α, cut) in the output.
+    fn of_shape<S: Shape>(
+        body: &Body<S>,
+        (name, alpha, cut): (&'static str, f64, Option<f64>),
+        samples: usize,
+        kappa_max: f64,
+        stop: &dyn Fn() -> bool,
+    ) -> Result<Self> {
         let stopped = |i: usize| asked_to_stop(i, stop);
         check_kappa_max(kappa_max)?;
         crate::error::check_samples(samples)?;
@@ -1012,12 +1052,11 @@ impl CriticalSet {
             .iter()
             .map(|e| e.energy)
             .fold(f64::NEG_INFINITY, f64::max);
-        let disk = body.shape.kind == crate::body::EdgedKind::Disk;
         Ok(Self {
-            shape: Some(body.shape.kind.name()),
-            alpha: body.shape.alpha,
+            shape: Some(name),
+            alpha,
             beta: None,
-            cut: (!disk).then_some(body.shape.cut),
+            cut,
             nu: body.nu,
             eta: body.eta,
             diagram_type: None,

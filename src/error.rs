@@ -63,6 +63,10 @@ pub enum AtlasError {
     /// A computation given up because its caller asked it to stop (Ctrl-C in Python).
     #[error("stopped on request")]
     Stopped,
+    /// A table of a meridian (a body of the user's own) that is not a convex profile the
+    /// program can follow: the point and the reason.
+    #[error("invalid profile: the table {reason}")]
+    Profile { reason: String },
 }
 
 impl AtlasError {

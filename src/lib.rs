@@ -67,5 +67,8 @@ pub mod verdict;
 #[cfg(feature = "python")]
 mod python;
 
-pub use body::{Angle, AnyBody, Body, EdgedKind, EdgedShape, Ellipsoid, EllipsoidBody, Shape};
+pub use body::{
+    Angle, AnyBody, Body, EdgedKind, EdgedShape, Ellipsoid, EllipsoidBody, Profile, ProfileShape,
+    Shape,
+};
 pub use error::{AtlasError, Result};

@@ -246,7 +246,7 @@ fn point(slices: &[&[f64]], i: usize) -> CellPoint {
 /// fastest); `component`, the labels of the slots (the families present, or the ranks in
 /// θ_min up to the most components of a cell: no slot is empty in every cell); `layout`.
 #[pyfunction]
-#[pyo3(signature = (alpha, beta, nu, eta, kappa, energy, tol, method, resonance_tol, fields=None, threads=None, allow_large=false, layout="family", shape="ellipsoid"))]
+#[pyo3(signature = (alpha, beta, nu, eta, kappa, energy, tol, method, resonance_tol, fields=None, threads=None, allow_large=false, layout="family", shape="ellipsoid", profile=None))]
 #[allow(clippy::too_many_arguments)]
 fn cells<'py>(
     py: Python<'py>,
@@ -264,8 +264,9 @@ fn cells<'py>(
     allow_large: bool,
     layout: &str,
     shape: &str,
+    profile: Option<Vec<Vec<f64>>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let kind = shape_kind(shape)?;
+    let kind = shape_kind(shape, profile.as_deref())?;
     let layout = Layout::from_name(layout)
         .ok_or_else(|| bad(format!("layout {layout:?}: use {}", Layout::NAMES)))?;
     let slices = equal_length(
@@ -305,6 +306,10 @@ fn cells<'py>(
     let block = match kind {
         None => {
             let bodies = atlas::cell_bodies(&points).map_err(value_error)?;
+            solve_cells(py, &pool, &points, &bodies, &vars, &room, &options)?
+        }
+        Some(crate::EdgedKind::Profile(profile)) => {
+            let bodies = profile_bodies(&points, profile)?;
             solve_cells(py, &pool, &points, &bodies, &vars, &room, &options)?
         }
         Some(kind) => {
@@ -354,8 +359,28 @@ fn cells<'py>(
     Ok(out)
 }
 
-/// The shape named `name`: None for the ellipsoid, else the edged kind.
-fn shape_kind(name: &str) -> PyResult<Option<crate::EdgedKind>> {
+/// The shape named `name`: None for the ellipsoid, else the edged kind, or the profile of
+/// `profile`'s rows (which only the shape "profile" takes, and needs).
+fn shape_kind(name: &str, profile: Option<&[Vec<f64>]>) -> PyResult<Option<crate::EdgedKind>> {
+    match (name, profile) {
+        ("profile", Some(rows)) => {
+            return crate::Profile::from_points(rows)
+                .map(|p| Some(crate::EdgedKind::Profile(p)))
+                .map_err(value_error)
+        }
+        ("profile", None) => {
+            return Err(bad(
+                "shape \"profile\" needs profile=, the meridian's points as rows (rho, z) or (rho, z, edge)"
+                    .into(),
+            ))
+        }
+        (_, Some(_)) => {
+            return Err(bad(format!(
+                "shape {name:?} takes no profile (only shape=\"profile\" does)"
+            )))
+        }
+        _ => {}
+    }
     crate::body::shape_kind(name).ok_or_else(|| {
         let names: Vec<String> = crate::body::SHAPE_NAMES
             .iter()
@@ -370,8 +395,26 @@ fn shape_kind(name: &str) -> PyResult<Option<crate::EdgedKind>> {
 }
 
 /// The body of `shape` (`ellipsoid`, or an edged one whose cut is given in `beta`).
-fn any_body(shape: &str, alpha: f64, beta: f64, nu: f64, eta: f64) -> PyResult<AnyBody> {
-    AnyBody::new(shape_kind(shape)?, alpha, beta, nu, eta).map_err(value_error)
+fn any_body(
+    shape: &str,
+    profile: Option<&[Vec<f64>]>,
+    alpha: f64,
+    beta: f64,
+    nu: f64,
+    eta: f64,
+) -> PyResult<AnyBody> {
+    AnyBody::new(shape_kind(shape, profile)?, alpha, beta, nu, eta).map_err(value_error)
+}
+
+/// The bodies of `points` of one profile (α varies).
+fn profile_bodies(
+    points: &[CellPoint],
+    profile: &'static crate::Profile,
+) -> PyResult<Vec<crate::Body<crate::ProfileShape>>> {
+    atlas::bodies_of(points, |p| {
+        crate::Body::new(crate::ProfileShape::new(profile, p.alpha)?, p.nu, p.eta)
+    })
+    .map_err(value_error)
 }
 
 /// The edged bodies of `points`, each with its cut in `beta` (ignored by the disk).
@@ -408,7 +451,7 @@ fn solve_cells<S: crate::Shape>(
 /// arrays, in parallel with the GIL released: the origin of the `excess_energy` axis, as an
 /// atlas's `kappa`/`excess_energy` plane measures it. A bad cell is refused, naming its index.
 #[pyfunction]
-#[pyo3(signature = (alpha, beta, nu, eta, kappa, threads=None, shape="ellipsoid"))]
+#[pyo3(signature = (alpha, beta, nu, eta, kappa, threads=None, shape="ellipsoid", profile=None))]
 #[allow(clippy::too_many_arguments)]
 fn bottoms<'py>(
     py: Python<'py>,
@@ -419,8 +462,9 @@ fn bottoms<'py>(
     kappa: PyReadonlyArray1<'py, f64>,
     threads: Option<i64>,
     shape: &str,
+    profile: Option<Vec<Vec<f64>>>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let kind = shape_kind(shape)?;
+    let kind = shape_kind(shape, profile.as_deref())?;
     let slices = equal_length(
         &[&alpha, &beta, &nu, &eta, &kappa],
         "alpha, beta, nu, eta and kappa",
@@ -430,6 +474,10 @@ fn bottoms<'py>(
     let values = match kind {
         None => {
             let bodies = atlas::cell_bodies(&points).map_err(value_error)?;
+            in_pool(py, &pool, || lowest_minima(&points, &bodies))
+        }
+        Some(crate::EdgedKind::Profile(profile)) => {
+            let bodies = profile_bodies(&points, profile)?;
             in_pool(py, &pool, || lowest_minima(&points, &bodies))
         }
         Some(kind) => {
@@ -494,7 +542,7 @@ fn table_dict<'py>(py: Python<'py>, table: Table) -> PyResult<Bound<'py, PyDict>
 /// The critical set of one body (paper §4): its fixed-point curves as a table, and its
 /// summary as JSON.
 #[pyfunction]
-#[pyo3(signature = (alpha, beta, nu, eta, samples, kappa_max, allow_large=false, shape="ellipsoid"))]
+#[pyo3(signature = (alpha, beta, nu, eta, samples, kappa_max, allow_large=false, shape="ellipsoid", profile=None))]
 #[allow(clippy::too_many_arguments)]
 fn diagram<'py>(
     py: Python<'py>,
@@ -506,6 +554,7 @@ fn diagram<'py>(
     kappa_max: f64,
     allow_large: bool,
     shape: &str,
+    profile: Option<Vec<Vec<f64>>>,
 ) -> PyResult<(Bound<'py, PyDict>, String)> {
     let samples = count("samples", samples, 1)?;
     // As the command measured it: 245 bytes per sample at the peak.
@@ -514,12 +563,11 @@ fn diagram<'py>(
         allow_large,
         "use fewer samples, or allow_large=True",
     )?;
-    let body = any_body(shape, alpha, beta, nu, eta)?;
+    let body = any_body(shape, profile.as_deref(), alpha, beta, nu, eta)?;
     // Ctrl-C is heard every 65,536 samples (it used to wait for the whole set, and a
     // KeyboardInterrupt pending at the first NumPy call became a panic).
-    let set = interruptible(py, &None, |stop| match &body {
-        AnyBody::Ellipsoid(b) => CriticalSet::of_until(b, samples, kappa_max, stop),
-        AnyBody::Edged(b) => CriticalSet::of_edged(b, samples, kappa_max, stop),
+    let set = interruptible(py, &None, |stop| {
+        CriticalSet::of_any(&body, samples, kappa_max, stop)
     })?
     .map_err(value_error)?;
     let summary = serde_json::to_string(&set).map_err(|e| bad(e.to_string()))?;
@@ -532,7 +580,7 @@ fn diagram<'py>(
 /// A trajectory (the reduced model or the full one) as a table along `t`, with its start
 /// (κ, ε, θ(0), θ̇(0)).
 #[pyfunction]
-#[pyo3(signature = (alpha, beta, nu, eta, kappa, energy, component, theta0, theta_dot0, periods, t_end, samples, model, tol, allow_large=false, shape="ellipsoid"))]
+#[pyo3(signature = (alpha, beta, nu, eta, kappa, energy, component, theta0, theta_dot0, periods, t_end, samples, model, tol, allow_large=false, shape="ellipsoid", profile=None))]
 #[allow(clippy::too_many_arguments)]
 fn trajectory<'py>(
     py: Python<'py>,
@@ -552,6 +600,7 @@ fn trajectory<'py>(
     tol: f64,
     allow_large: bool,
     shape: &str,
+    profile: Option<Vec<Vec<f64>>>,
 ) -> PyResult<(Bound<'py, PyDict>, [f64; 5])> {
     let component = count("component", component, 0)?;
     let samples = count("samples", samples, 1)?;
@@ -560,7 +609,7 @@ fn trajectory<'py>(
         allow_large,
         "use fewer samples, or allow_large=True",
     )?;
-    let body = any_body(shape, alpha, beta, nu, eta)?;
+    let body = any_body(shape, profile.as_deref(), alpha, beta, nu, eta)?;
     let start = match (energy, theta0) {
         (Some(energy), None) => StartAt::Energy { energy, component },
         (None, Some(theta0)) => StartAt::Angle { theta0, theta_dot0 },
@@ -605,7 +654,7 @@ fn trajectory<'py>(
 /// The resonance curves N = `rotation_number` in a window of the (κ, ε) plane, as a table
 /// along `sample`, and the window's smallest energy.
 #[pyfunction]
-#[pyo3(signature = (alpha, beta, nu, eta, rotation_number, kappa_min, kappa_max, energy_min, energy_max, grid, tol, shape="ellipsoid"))]
+#[pyo3(signature = (alpha, beta, nu, eta, rotation_number, kappa_min, kappa_max, energy_min, energy_max, grid, tol, shape="ellipsoid", profile=None))]
 #[allow(clippy::too_many_arguments)]
 fn resonance<'py>(
     py: Python<'py>,
@@ -621,9 +670,10 @@ fn resonance<'py>(
     grid: i64,
     tol: f64,
     shape: &str,
+    profile: Option<Vec<Vec<f64>>>,
 ) -> PyResult<(Bound<'py, PyDict>, f64)> {
     let grid = count("grid", grid, 1)?;
-    let body = any_body(shape, alpha, beta, nu, eta)?;
+    let body = any_body(shape, profile.as_deref(), alpha, beta, nu, eta)?;
     let options = crate::with_body!(&body, b => ResonanceOptions::window(
         b,
         rotation_number,

@@ -251,6 +251,45 @@ impl Reader<'_> {
         }
     }
 
+    /// `[body] profile`: the meridian's table, a list of [rho, z] or [rho, z, edge] rows.
+    fn profile(&self, body: &Table) -> Result<&'static crate::body::Profile> {
+        let key = "body.profile";
+        let rows = match body.get("profile") {
+            None => {
+                return Err(self.error(
+                    key,
+                    "missing: shape = \"profile\" needs the meridian's points, [[rho, z], ...]",
+                ))
+            }
+            Some(Value::Array(rows)) => rows,
+            Some(v) => {
+                return Err(self.error(
+                    key,
+                    format!("expected a list of [rho, z] rows, found {}", v.type_str()),
+                ))
+            }
+        };
+        let rows = rows
+            .iter()
+            .enumerate()
+            .map(|(i, row)| match row {
+                Value::Array(values) => values
+                    .iter()
+                    .enumerate()
+                    .map(|(j, v)| self.number(v, &format!("{key}[{i}][{j}]")))
+                    .collect::<Result<Vec<f64>>>(),
+                v => Err(self.error(
+                    &format!("{key}[{i}]"),
+                    format!(
+                        "expected a row [rho, z] or [rho, z, edge], found {}",
+                        v.type_str()
+                    ),
+                )),
+            })
+            .collect::<Result<Vec<_>>>()?;
+        crate::body::Profile::from_points(&rows).map_err(|e| self.error(key, e.to_string()))
+    }
+
     fn axis(&self, axes: &Table, key: &str) -> Result<Axis> {
         let full = join("axes", key);
         let values = match axes.get(key) {
@@ -446,9 +485,12 @@ impl Scene {
         }
 
         let body = reader.table(&root, "", "body")?;
-        reader.only_keys(body, "body", &["shape", "nu", "eta"])?;
+        reader.only_keys(body, "body", &["shape", "nu", "eta", "profile"])?;
         let shape = match body.get("shape") {
             None => None,
+            Some(Value::String(name)) if name == "profile" => {
+                Some(EdgedKind::Profile(reader.profile(body)?))
+            }
             Some(Value::String(name)) => crate::body::shape_kind(name).ok_or_else(|| {
                 reader.error(
                     "body.shape",
@@ -462,6 +504,15 @@ impl Scene {
                 ))
             }
         };
+        if body.contains_key("profile") && !matches!(shape, Some(EdgedKind::Profile(_))) {
+            return Err(reader.error(
+                "body.profile",
+                format!(
+                    "the shape {} takes no profile (only shape = \"profile\" does)",
+                    shape_name(shape)
+                ),
+            ));
+        }
         let nu = reader.required_number(body, "body", "nu")?;
         let eta = reader.required_number(body, "body", "eta")?;
 
@@ -644,7 +695,7 @@ impl Scene {
                 "axes.s",
                 format!(
                     "s = 0 (energy = infinity) is the high-energy limit, derived for the \
-                     ellipsoid only; the {} has sharp edges: start s above 0",
+                     ellipsoid only (its U is smooth at the poles); for the {} start s above 0",
                     shape_name(shape)
                 ),
             ));

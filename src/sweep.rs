@@ -168,6 +168,10 @@ fn scene_attributes(scene: &Scene, shard: Shard, units: usize) -> Vec<(String, A
     if scene.shape.is_some() {
         attributes.push(("shape".into(), text(scene.shape_name())));
     }
+    // A profile's table, one `rho z edge` row a line (it is in the scene's text too).
+    if let Some(crate::EdgedKind::Profile(profile)) = scene.shape {
+        attributes.push(("profile".into(), text(&profile.text())));
+    }
     attributes.extend([
         ("nu".into(), AttrValue::Number(scene.nu)),
         ("eta".into(), AttrValue::Number(scene.eta)),

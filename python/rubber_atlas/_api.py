@@ -69,10 +69,13 @@ _BATCH_CELLS = 16_384
 
 def _call(name: str, arguments: dict) -> str:
     """`name(arguments)` as text, for the `history` attribute."""
-    shown = ", ".join(
-        f"{k}={v!r}" if np.ndim(v) == 0 else f"{k}=<{np.shape(v)} array>"
-        for k, v in arguments.items()
-    )
+    def show(v) -> str:
+        try:
+            return repr(v) if np.ndim(v) == 0 else f"<{np.shape(v)} array>"
+        except ValueError:  # rows of unequal lengths (a profile's)
+            return f"<{len(v)} rows>"
+
+    shown = ", ".join(f"{k}={show(v)}" for k, v in arguments.items())
     return f"python {sys.version.split()[0]}: rubber_atlas.{name}({shown})"
 
 
@@ -450,13 +453,13 @@ def _derived(full: np.ndarray, dims: tuple, coords: dict, sources: Iterable[str]
 
 
 def _excess_to_energy(alpha: np.ndarray, beta: np.ndarray, nu: np.ndarray, eta: np.ndarray, kappa: np.ndarray,
-                      excess_energy: np.ndarray, shape: str = "ellipsoid") -> np.ndarray:
+                      excess_energy: np.ndarray, core: dict | None = None) -> np.ndarray:
     """ε = V_min(κ) + `excess_energy` per cell (flat float64 arrays of one length), V_min the
     bottom (deepest minimum) of V(θ) = κ²/(2 sin²θ) + U(θ) at each body and κ, as the atlas's
     `kappa`/`excess_energy` plane computes it (the Rust core, in parallel)."""
     _first_bad("excess_energy", excess_energy, ~np.isfinite(excess_energy), "must be a finite number")
     arrays = (np.ascontiguousarray(a, dtype=np.float64) for a in (alpha, beta, nu, eta, kappa))
-    bottom = _core.bottoms(*arrays, shape=shape)
+    bottom = _core.bottoms(*arrays, **(core or {}))
     return bottom + excess_energy
 
 
@@ -467,17 +470,57 @@ def _first_bad(name: str, values: np.ndarray, bad: np.ndarray, why: str) -> None
         raise ValueError(f"cell {i}: invalid {name} = {'NaN' if np.isnan(value) else repr(value)}: {why}")
 
 
-def _shape_inputs(shape: str, beta, cut) -> dict:
+def _profile_rows(profile) -> list[list[float]]:
+    """The rows (ρ, z) or (ρ, z, edge) of a profile's table as lists of floats; a table of
+    another form is refused naming `profile` (the core checks the meridian itself)."""
+    what = "profile must be rows (rho, z) or (rho, z, edge) of numbers"
+    if isinstance(profile, (str, bytes)):
+        raise TypeError(f"{what}, not {type(profile).__name__}")
+    try:
+        array = np.asarray(profile)
+    except (ValueError, TypeError):
+        # Rows of both lengths (an edge marked on some): each row on its own.
+        try:
+            return [r for row in profile for r in _profile_rows([row])]
+        except TypeError:
+            raise TypeError(f"{what}, each of 2 or 3 values") from None
+    if array.dtype.kind not in "fiu" or array.dtype.itemsize > 8:
+        raise TypeError(f"{what}, not of {array.dtype}")
+    if array.ndim != 2 or array.shape[1] not in (2, 3):
+        raise ValueError(f"{what}: an array of shape (n, 2) or (n, 3), not {array.shape}")
+    return array.astype(np.float64).tolist()
+
+
+def _profile_text(rows: list[list[float]]) -> str:
+    """A profile's table as the files hold it: one `rho z edge` row a line."""
+    return "\n".join(f"{r[0]!r} {r[1]!r} {int(r[2]) if len(r) > 2 else 0}" for r in rows)
+
+
+def _shape_attrs(core: dict) -> dict:
+    """The core's keywords for the shape as a result's attributes (a profile as its text)."""
+    return {k: _profile_text(v) if k == "profile" else v for k, v in core.items()}
+
+
+def _shape_inputs(shape: str, beta, cut, profile=None) -> dict:
     """The inputs that give the shape beside α: β of the ellipsoid, the cut of a cut ball,
-    nothing for the disk; a parameter the shape does not take, or one it lacks, is refused."""
+    nothing for the disk and a profile; a parameter the shape does not take, or one it lacks,
+    is refused."""
+    if shape != "profile" and profile is not None:
+        raise ValueError(f"shape {shape!r} takes no profile (only shape=\"profile\" does)")
     if shape == "ellipsoid":
         if cut is not None:
             raise ValueError("cut is a parameter of shape=\"truncated_ball\" and \"wheel\", not of the ellipsoid")
         return {"beta": beta}
-    if shape not in ("disk", "truncated_ball", "wheel"):
-        raise ValueError(f"shape {shape!r}: use \"ellipsoid\", \"disk\", \"truncated_ball\" or \"wheel\"")
+    if shape not in ("disk", "truncated_ball", "wheel", "profile"):
+        raise ValueError(f"shape {shape!r}: use \"ellipsoid\", \"disk\", \"truncated_ball\", \"wheel\" or \"profile\"")
     if beta is not None:
         raise ValueError(f"shape {shape!r} takes no beta (only the ellipsoid does); give None")
+    if shape == "profile":
+        if cut is not None:
+            raise ValueError("shape 'profile' takes no cut (only truncated_ball and wheel do)")
+        if profile is None:
+            raise TypeError("shape 'profile' needs profile=, its meridian's points: rows (rho, z) or (rho, z, edge)")
+        return {}
     if shape == "disk":
         if cut is not None:
             raise ValueError("shape 'disk' takes no cut (only truncated_ball and wheel do)")
@@ -487,22 +530,33 @@ def _shape_inputs(shape: str, beta, cut) -> dict:
     return {"cut": cut}
 
 
-def _one_body(shape, alpha, beta, nu, eta, cut) -> tuple[dict, str, dict, list, dict]:
+def _core_shape(shape: str, profile) -> dict:
+    """The keywords the core takes for the shape: none for the ellipsoid, its name, and a
+    profile's rows."""
+    if shape == "ellipsoid":
+        return {}
+    return {"shape": shape, "profile": _profile_rows(profile)} if shape == "profile" else {"shape": shape}
+
+
+def _one_body(shape, alpha, beta, nu, eta, cut, profile=None) -> tuple[dict, str, dict, list, dict]:
     """The checked numbers of one body, the shape's name, the keywords the core takes, the
-    core's positional numbers (the ellipsoid's alpha, beta, nu, eta, or an edged body's with
-    its cut in beta's place), and the call's own keywords for the body beside alpha (beta, or
-    shape and cut) as the caller gave them."""
-    shape = _text("shape", shape, '"ellipsoid", "disk", "truncated_ball" or "wheel"')
-    second = _shape_inputs(shape, beta, cut)
+    core's positional numbers (the ellipsoid's alpha, beta, nu, eta, or another body's with
+    its cut, or 0, in beta's place), and the call's own keywords for the body beside alpha
+    (beta, or shape and cut or profile) as the caller gave them."""
+    shape = _text("shape", shape, '"ellipsoid", "disk", "truncated_ball", "wheel" or "profile"')
+    second = _shape_inputs(shape, beta, cut, profile)
     body = _reals(alpha=alpha, **second, nu=nu, eta=eta)
     values = list(body.values())
-    if shape == "disk":
+    if shape in ("disk", "profile"):
         values.insert(1, 0.0)
-    extra = {"shape": shape} if shape != "ellipsoid" else {}
-    return body, shape, extra, values, {**extra, **second}
+    extra = _core_shape(shape, profile)
+    named = {"shape": shape, **second} if shape != "ellipsoid" else second
+    if shape == "profile":
+        named["profile"] = profile
+    return body, shape, extra, values, named
 
 
-def _to_kappa_energy(plane: tuple[str, str], flat: list[np.ndarray], shape: str = "ellipsoid") -> list[np.ndarray]:
+def _to_kappa_energy(plane: tuple[str, str], flat: list[np.ndarray], core: dict | None = None) -> list[np.ndarray]:
     """The six flat inputs (α, β or the cut, ν, η and the plane's two) as α, β, ν, η, κ, ε."""
     a, b = flat[4], flat[5]
     if plane == ("kappa", "energy"):
@@ -522,7 +576,7 @@ def _to_kappa_energy(plane: tuple[str, str], flat: list[np.ndarray], shape: str 
             _first_bad("lambda", a, (a > 0) & (kappa < 2.2250738585072014e-308),
                        "lambda / s is below 2.2250738585072014e-308 (subnormal, or 0 by underflow): keep it at least that")
             return flat[:4] + [kappa, 1.0 / (b * b)]
-    return flat[:4] + [a, _excess_to_energy(*flat[:4], a, b, shape=shape)]
+    return flat[:4] + [a, _excess_to_energy(*flat[:4], a, b, core)]
 
 
 def _show_bytes(n: float) -> str:
@@ -621,12 +675,12 @@ def _fill(dtype: np.dtype):
     return -1
 
 
-def _solve_batch(flat: list[np.ndarray], start: int, options: tuple, layout: str, shape: str = "ellipsoid") -> dict:
+def _solve_batch(flat: list[np.ndarray], start: int, options: tuple, layout: str, core: dict | None = None) -> dict:
     """One call of the core: {"columns": [(name, flat array)], "component": [labels],
     "layout": …, and for the family layout possibly the component's "flag_values" and
     "flag_meanings"}."""
     try:
-        result = _core.cells(*flat, *options, layout=layout, shape=shape)
+        result = _core.cells(*flat, *options, layout=layout, **(core or {}))
     except ValueError as e:
         if start == 0:
             raise
@@ -641,21 +695,21 @@ def _solve_batch(flat: list[np.ndarray], start: int, options: tuple, layout: str
 
 
 def _solve(flat: list[np.ndarray], options: tuple, layout: str, meta: dict, progress: bool,
-           shape: str = "ellipsoid") -> dict:
+           core: dict | None = None) -> dict:
     """Solves the flat cells, in batches when `progress` shows how far it got; returns what
     one call of the core over all of them would (see `_solve_batch`): per-component arrays
     with the component fastest, over the union of the batches' components less those empty
     in every cell."""
     n = len(flat[0])
     if not progress:
-        return _solve_batch(flat, 0, options, layout, shape)
+        return _solve_batch(flat, 0, options, layout, core)
     size = max(_BATCH_CELLS, -(-n // _PROGRESS_STEPS))
     parts = []
     bar = _progress_bar(n)
     try:
         for start in range(0, max(n, 1), size):
             stop = min(n, start + size)
-            parts.append((stop - start, _solve_batch([a[start:stop] for a in flat], start, options, layout, shape)))
+            parts.append((stop - start, _solve_batch([a[start:stop] for a in flat], start, options, layout, core)))
             bar.update(stop - start)
     finally:
         bar.close()
@@ -746,6 +800,7 @@ def cells(
     progress: bool | None = None,
     shape: str = "ellipsoid",
     cut=None,
+    profile=None,
 ) -> xr.Dataset:
     """Solve cells (α, β, ν, η and a point of the (κ, ε) plane) in parallel.
 
@@ -813,7 +868,7 @@ def cells(
         Show a progress bar (tqdm's if it is installed: a widget in Jupyter, text in a
         terminal; else a text bar on standard error). By default shown when there are more
         than 200,000 cells and standard error is a terminal or the call runs in Jupyter.
-    shape : {"ellipsoid", "disk", "truncated_ball", "wheel"}, default "ellipsoid"
+    shape : {"ellipsoid", "disk", "truncated_ball", "wheel", "profile"}, default "ellipsoid"
         The body (docs/bodies.md). For any but the ellipsoid, `beta` is None; α places the
         centre of mass at α e3 from the ball's (disk's) centre in units of its radius, and
         the method "ode" is refused for the cut balls (their U has kinks).
@@ -821,6 +876,12 @@ def cells(
         h of the cut balls, in units of the ball's radius: the plane z = -h
         (``truncated_ball``, -1 < h < 1) or the planes z = ±h (``wheel``, 0 < h < 1); a
         coordinate of the result as ``beta`` is for the ellipsoid.
+    profile : array_like, optional
+        With ``shape="profile"``, a body of your own (docs/bodies.md): rows (ρ, z) or
+        (ρ, z, edge) of its meridian from one pole (ρ = 0) to the other, edge 1 at a sharp
+        edge; the points are joined by circular arcs tangent where they meet, and `alpha` is
+        the height of the centre of mass on the axis, strictly between the poles (the method "ode"
+        is refused for a profile: its U has kinks where the arcs meet).
 
     Inputs broadcast together. DataArrays broadcast by their dimension names (then every
     array input must be a DataArray; numbers mix with either). Other arrays broadcast by
@@ -907,8 +968,9 @@ def cells(
     (0.4, [[0.040354], [0.050904]])
     """
     plane = _plane(kappa, energy, excess_energy, lambda_, s)
-    shape = _text("shape", shape, '"ellipsoid", "disk", "truncated_ball" or "wheel"')
-    given = {"alpha": alpha, **_shape_inputs(shape, beta, cut), "nu": nu, "eta": eta, **plane}
+    shape = _text("shape", shape, '"ellipsoid", "disk", "truncated_ball", "wheel" or "profile"')
+    given = {"alpha": alpha, **_shape_inputs(shape, beta, cut, profile), "nu": nu, "eta": eta, **plane}
+    core = _core_shape(shape, profile)
     names = tuple(plane)
     if layout not in _LAYOUTS:
         raise ValueError(f"layout {layout!r}: use \"family\" or \"theta_min\"")
@@ -928,7 +990,7 @@ def cells(
         raise ValueError(f"the dimension 'beta' is named after the ellipsoid's beta, which shape={shape_name!r} "
                          "does not take: rename the dimension")
     # The input beside α: β, the cut, or none (the disk).
-    second = {"ellipsoid": "beta", "disk": None}.get(shape_name, "cut")
+    second = {"ellipsoid": "beta", "disk": None, "profile": None}.get(shape_name, "cut")
     no_second = second is None
     derived = {name: tuple(second if src == "beta" else src for src in sources if src != "beta" or second)
                for name, sources in _DERIVED.get(names[1], {}).items()}
@@ -943,8 +1005,8 @@ def cells(
     show = (n > _PROGRESS_CELLS and (_stderr_is_terminal() or _in_jupyter())) if progress is None else progress
     meta = {m["name"]: m for m in _core.variables(field_list)}
     try:
-        flat = _to_kappa_energy(names, flat, shape_name)
-        solved = _solve(flat, options, layout, meta, show, shape_name)
+        flat = _to_kappa_energy(names, flat, core)
+        solved = _solve(flat, options, layout, meta, show, core)
     except ValueError as e:
         raise _located(e, shape, places, derived) from None
     for name, sources in derived.items():
@@ -971,9 +1033,12 @@ def cells(
                      resonance_tol=resonance_tol, layout=layout)
     if shape_name != "ellipsoid":
         arguments["shape"] = shape_name
+    if shape_name == "profile":
+        arguments["profile"] = profile
     attrs = _root_attrs(
         "cells",
         arguments,
+        **({"shape": "profile", "profile": _profile_text(core["profile"])} if shape_name == "profile" else {}),
         title="rubber-atlas cells",
         tolerance=options[0],
         method=str(method),
@@ -1622,7 +1687,7 @@ def _typed_columns(path: Path, frame, types: dict):
 def diagram(alpha: float, beta: float | None, nu: float | None = None, eta: float | None = None, *,
             samples: int = 2000,
             kappa_max: float = 3.0, allow_large: bool = False, shape: str = "ellipsoid",
-            cut: float | None = None) -> xr.Dataset:
+            cut: float | None = None, profile=None) -> xr.Dataset:
     """The critical set of one body: its fixed-point curves (the paper's bifurcation diagram).
 
     Parameters
@@ -1641,11 +1706,16 @@ def diagram(alpha: float, beta: float | None, nu: float | None = None, eta: floa
         The largest |κ| the curves are drawn to, from 1e-20 to 1e150.
     allow_large : bool, default False
         Allow `samples` beyond 80 % of the available memory.
-    shape : {"ellipsoid", "disk", "truncated_ball", "wheel"}, default "ellipsoid"
+    shape : {"ellipsoid", "disk", "truncated_ball", "wheel", "profile"}, default "ellipsoid"
         The body (docs/bodies.md); for any but the ellipsoid `beta` is None, and the cut
         balls take `cut`.
     cut : float, optional
         h of a cut ball: -1 < h < 1 (``truncated_ball``), 0 < h < 1 (``wheel``).
+    profile : array_like, optional
+        With ``shape="profile"``, a body of your own (docs/bodies.md): rows (ρ, z) or
+        (ρ, z, edge) of its meridian from one pole (ρ = 0) to the other, edge 1 at a sharp
+        edge; the points are joined by circular arcs tangent where they meet, and `alpha` is
+        the height of the centre of mass on the axis, strictly between the poles.
 
     Returns
     -------
@@ -1681,11 +1751,11 @@ def diagram(alpha: float, beta: float | None, nu: float | None = None, eta: floa
                          "only the record) or neither (0.5 each)")
     if nu is None:
         nu = eta = 0.5
-    body, shape, extra, values, named = _one_body(shape, alpha, beta, nu, eta, cut)
+    body, shape, extra, values, named = _one_body(shape, alpha, beta, nu, eta, cut, profile)
     table, summary = _core.diagram(*values, _count("samples", samples), _real("kappa_max", kappa_max),
                                    _switch("allow_large", allow_large), **extra)
     arguments = dict(alpha=alpha, **named, nu=nu, eta=eta, samples=samples, kappa_max=kappa_max)
-    attrs = _root_attrs("diagram", arguments, **extra, **body, critical_set_json=summary)
+    attrs = _root_attrs("diagram", arguments, **_shape_attrs(extra), **body, critical_set_json=summary)
     return _table(table, attrs)
 
 
@@ -1693,7 +1763,7 @@ def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, e
                component: int | None = None, theta0: float | None = None, theta_dot0: float | None = None,
                periods: float | None = None, t_end: float | None = None, samples: int = 2000,
                model: str = "reduced", tol: float = 1e-12, allow_large: bool = False, shape: str = "ellipsoid",
-               cut: float | None = None) -> xr.Dataset:
+               cut: float | None = None, profile=None) -> xr.Dataset:
     """A trajectory of the body over time, as ``rubber-atlas trajectory`` writes it.
 
     Parameters
@@ -1726,11 +1796,16 @@ def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, e
     allow_large : bool, default False
         Allow `samples` beyond 80 % of the available memory, and a length that needs more
         than 1e9 integrator steps (some 40 minutes; estimated from the first θ-period).
-    shape : {"ellipsoid", "disk", "truncated_ball", "wheel"}, default "ellipsoid"
+    shape : {"ellipsoid", "disk", "truncated_ball", "wheel", "profile"}, default "ellipsoid"
         The body (docs/bodies.md); for any but the ellipsoid `beta` is None, and the cut
         balls take `cut`. A planar start (κ = 0) whose motion reaches a face is refused.
     cut : float, optional
         h of a cut ball: -1 < h < 1 (``truncated_ball``), 0 < h < 1 (``wheel``).
+    profile : array_like, optional
+        With ``shape="profile"``, a body of your own (docs/bodies.md): rows (ρ, z) or
+        (ρ, z, edge) of its meridian from one pole (ρ = 0) to the other, edge 1 at a sharp
+        edge; the points are joined by circular arcs tangent where they meet, and `alpha` is
+        the height of the centre of mass on the axis, strictly between the poles.
 
     Returns
     -------
@@ -1767,7 +1842,7 @@ def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, e
     >>> round(float(t.theta[0]), 4) == round(float(t.attrs["theta0"]), 4)
     True
     """
-    body, shape, extra, values, named = _one_body(shape, alpha, beta, nu, eta, cut)
+    body, shape, extra, values, named = _one_body(shape, alpha, beta, nu, eta, cut, profile)
     tol = _real("tol", tol)
     # As the command: each start option goes with its start (it used to be ignored silently).
     if energy is not None and theta_dot0 is not None:
@@ -1784,7 +1859,7 @@ def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, e
     arguments = dict(alpha=alpha, **named, nu=nu, eta=eta, kappa=kappa, energy=energy, component=component,
                      theta0=theta0, theta_dot0=theta_dot0, periods=periods, t_end=t_end, samples=samples,
                      model=model, tol=tol)
-    attrs = _root_attrs("trajectory", arguments, model=str(model), **extra, **body,
+    attrs = _root_attrs("trajectory", arguments, model=str(model), **_shape_attrs(extra), **body,
                         kappa=k, energy=e, theta0=t0, theta_dot0=td0, tolerance=tol, energy_drift=drift)
     return _table(table, attrs)
 
@@ -1803,7 +1878,8 @@ def _rotation_number(value) -> float:
 
 def resonance(alpha: float, beta: float, nu: float, eta: float, rotation_number, *, kappa_min: float = 0.01,
               kappa_max: float = 2.0, energy_min: float | None = None, energy_max: float = 5.0,
-              grid: int = 48, tol: float = 1e-10, shape: str = "ellipsoid", cut: float | None = None) -> xr.Dataset:
+              grid: int = 48, tol: float = 1e-10, shape: str = "ellipsoid", cut: float | None = None,
+              profile=None) -> xr.Dataset:
     """The curves N = p/q of the (κ, ε) plane in a window, traced by continuation.
 
     Parameters
@@ -1822,11 +1898,16 @@ def resonance(alpha: float, beta: float, nu: float, eta: float, rotation_number,
         Cells per side of the coarse grid on which the curves are first bracketed, ≥ 4.
     tol : float, default 1e-10
         Solver tolerance (1e-15 … 0.1); points are located to it.
-    shape : {"ellipsoid", "disk", "truncated_ball", "wheel"}, default "ellipsoid"
+    shape : {"ellipsoid", "disk", "truncated_ball", "wheel", "profile"}, default "ellipsoid"
         The body (docs/bodies.md). The edged bodies take no `beta` (give None): the disk has
         α alone, the cut balls α and `cut`.
     cut : float, optional
         h of the cut balls (required for them, refused for the others).
+    profile : array_like, optional
+        With ``shape="profile"``, a body of your own (docs/bodies.md): rows (ρ, z) or
+        (ρ, z, edge) of its meridian from one pole (ρ = 0) to the other, edge 1 at a sharp
+        edge; the points are joined by circular arcs tangent where they meet, and `alpha` is
+        the height of the centre of mass on the axis, strictly between the poles.
 
     Returns
     -------
@@ -1861,7 +1942,7 @@ def resonance(alpha: float, beta: float, nu: float, eta: float, rotation_number,
     ('truncated_ball', True)
     """
     target = _rotation_number(rotation_number)
-    body, shape, extra, values, named = _one_body(shape, alpha, beta, nu, eta, cut)
+    body, shape, extra, values, named = _one_body(shape, alpha, beta, nu, eta, cut, profile)
     window = _reals(kappa_min=kappa_min, kappa_max=kappa_max, energy_max=energy_max)
     tol = _real("tol", tol)
     table, e_min = _core.resonance(*values, target, window["kappa_min"], window["kappa_max"],
@@ -1870,7 +1951,7 @@ def resonance(alpha: float, beta: float, nu: float, eta: float, rotation_number,
     arguments = dict(alpha=alpha, **named, nu=nu, eta=eta, rotation_number=rotation_number,
                      kappa_min=kappa_min, kappa_max=kappa_max, energy_min=energy_min, energy_max=energy_max,
                      grid=grid, tol=tol)
-    attrs = _root_attrs("resonance", arguments, **extra, **body, rotation_number=target, tolerance=tol,
+    attrs = _root_attrs("resonance", arguments, **_shape_attrs(extra), **body, rotation_number=target, tolerance=tol,
                         kappa_window=np.array([window["kappa_min"], window["kappa_max"]], dtype=float),
                         energy_window=np.array([e_min, window["energy_max"]], dtype=float))
     return _table(table, attrs)

@@ -15,19 +15,29 @@ KEYS = ["theta_min", "theta_max", "period", "omega_theta", "omega_psi", "rotatio
         "drift_radius", "error_estimate"]
 
 
-@pytest.mark.parametrize("shape", ["disk", "truncated_ball", "wheel"])
-def test_cells_of_each_shape_equal_the_cell_command_bit_for_bit(shape):
+# A body of your own (docs/bodies.md): an egg with a sharp rim round its top (atlas/egg.toml).
+EGG = [[0.0, -1.0], [0.45, -0.92], [0.8, -0.62], [0.98, -0.2], [0.97, 0.25], [0.8, 0.62, 1], [0.4, 0.8],
+       [0.0, 0.86]]
+
+
+@pytest.mark.parametrize("shape", ["disk", "truncated_ball", "wheel", "profile"])
+def test_cells_of_each_shape_equal_the_cell_command_bit_for_bit(shape, tmp_path):
     rng = np.random.default_rng(20261124)
     n = 12
     alpha = rng.uniform(-0.8, 0.8, n)
-    cut = rng.uniform(0.05, 0.95, n) if shape != "disk" else None
+    cut = rng.uniform(0.05, 0.95, n) if shape in ("truncated_ball", "wheel") else None
+    # The egg's table, rows (ρ, z, edge) of one length, and as a file for the command.
+    profile = np.array([r + [0.0] * (3 - len(r)) for r in EGG]) if shape == "profile" else None
+    if profile is not None:
+        table = tmp_path / "egg.txt"
+        table.write_text("\n".join(" ".join(repr(float(x)) for x in row) for row in profile) + "\n")
     nu = rng.uniform(0.2, 2.0, n)
     eta = rng.uniform(0.3, 4.0, n)
     kappa = rng.uniform(0.05, 2.0, n)
     energy = rng.uniform(0.5, 5.0, n)
-    ds = ra.cells(alpha, None, nu, eta, kappa, energy, shape=shape, cut=cut, layout="theta_min")
+    ds = ra.cells(alpha, None, nu, eta, kappa, energy, shape=shape, cut=cut, profile=profile, layout="theta_min")
     assert "beta" not in ds.coords
-    assert ("cut" in ds.coords) == (shape != "disk")
+    assert ("cut" in ds.coords) == (cut is not None)
     with_motion = 0
     for i in range(n):
         args = ["cell", "--shape", shape, "--alpha", repr(float(alpha[i])), "--nu", repr(float(nu[i])),
@@ -35,6 +45,8 @@ def test_cells_of_each_shape_equal_the_cell_command_bit_for_bit(shape):
                 "--json"]
         if cut is not None:
             args += ["--cut", repr(float(cut[i]))]
+        if profile is not None:
+            args += ["--profile", table]
         out = json.loads(run(*args))
         assert out["shape"] == shape
         expected = out["components"]
@@ -166,3 +178,42 @@ def test_an_atlas_of_an_edged_body_opens_with_its_own_dimensions_and_equals_cell
         # A dimension the atlas lacks is named as missing, not as having one value.
         with pytest.raises(ValueError, match="beta_index = 1: the dataset has no dimension beta"):
             atlas.rubber.plot_slice(beta_index=1)
+
+
+def test_diagram_trajectory_and_resonance_take_a_profile():
+    body = dict(alpha=-0.1, beta=None, nu=0.8, eta=1.7, shape="profile", profile=EGG)
+    d = ra.diagram(**body, samples=300)
+    summary = json.loads(d.attrs["critical_set_json"])
+    assert summary["shape"] == "profile" and d.attrs["shape"] == "profile"
+    assert [e["name"] for e in summary["equilibria"]] == ["sigma_0", "inclined", "sigma_pi"]
+    # The full model runs one θ-period back to its start's θ.
+    cell = ra.cells(**body, kappa=0.5, energy=1.2, fields=["period", "theta_min"])
+    period = float(cell.period.isel(component=0))
+    t = ra.trajectory(**body, kappa=0.5, energy=1.2, t_end=period, model="full", samples=400)
+    assert abs(float(t.theta[-1]) - float(t.theta[0])) < 1e-6
+    assert abs(float(t.theta[0]) - float(cell.theta_min.isel(component=0))) < 1e-9
+    r = ra.resonance(**body, rotation_number=0, grid=24)
+    assert r.sizes["sample"] > 10 and r.attrs["shape"] == "profile"
+    assert bool((abs(r.rotation_number) <= r.error_estimate + 1e-10).all())
+
+
+@pytest.mark.parametrize("call, error, words", [
+    (lambda: ra.cells(0.0, None, 1, 1, 0.5, 1.5, shape="profile"), TypeError, "needs profile="),
+    (lambda: ra.cells(0.0, None, 1, 1, 0.5, 1.5, shape="disk", profile=EGG), ValueError, "takes no profile"),
+    (lambda: ra.cells(0.0, None, 1, 1, 0.5, 1.5, shape="profile", profile="0 -1\n1 0\n0 1"), TypeError, "rows"),
+    (lambda: ra.cells(0.0, None, 1, 1, 0.5, 1.5, shape="profile", profile=[[0, -1], [1, 0, 0, 1], [0, 1]]),
+     ValueError, "(n, 2) or (n, 3)"),
+    (lambda: ra.cells(0.0, None, 1, 1, 0.5, 1.5, shape="profile", profile=[0, -1, 1, 0, 0, 1]), ValueError,
+     "(n, 2) or (n, 3)"),
+    (lambda: ra.cells(0.0, None, 1, 1, 0.5, 1.5, shape="profile",
+                      profile=[[0, -1], [1, -0.5], [0.5, 0], [1, 0.5], [0, 1]]), ValueError, "not convex"),
+    (lambda: ra.cells(0.0, 1.0, 1, 1, 0.5, 1.5, shape="profile", profile=EGG), ValueError, "no beta"),
+    (lambda: ra.cells(0.9, None, 1, 1, 0.5, 1.5, shape="profile", profile=EGG), ValueError, "between the profile's poles"),
+    (lambda: ra.diagram(0.0, None, shape="profile", profile=[[0, -1], [1, -1], [1, 1], [0, 1]]), ValueError,
+     "straight side"),
+    (lambda: ra.cells(0.0, None, 1, 1, 0.5, 1.5, shape="profile", profile=EGG, method="ode"), ValueError, "ode"),
+])
+def test_a_profile_is_refused_where_it_does_not_fit(call, error, words):
+    with pytest.raises(error) as e:
+        call()
+    assert words in str(e.value) and "\n" not in str(e.value), str(e.value)

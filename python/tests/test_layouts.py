@@ -170,8 +170,9 @@ def test_a_dimension_named_after_a_computed_coordinate_is_refused():
 def test_excess_energy_lays_out_like_the_atlas_plane(monkeypatch):
     """The plumbing of excess_energy, with a stand-in for the bottom of V."""
 
-    def bottom(alpha, beta, nu, eta, kappa, excess, shape):
-        assert all(len(a) == len(excess) for a in (alpha, beta, nu, eta, kappa)) and shape == "ellipsoid"
+    def bottom(alpha, beta, nu, eta, kappa, excess, core):
+        # The ellipsoid's: no shape keywords for the core.
+        assert all(len(a) == len(excess) for a in (alpha, beta, nu, eta, kappa)) and not core
         return 1.0 + kappa**2 + excess
 
     monkeypatch.setattr(ra._api, "_excess_to_energy", bottom)

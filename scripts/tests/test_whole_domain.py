@@ -126,3 +126,17 @@ def test_whole_domain_of_the_edged_bodies_is_honest():
     assert not any(o.problems for o in outcomes), report
     components = sum(o.components for o in outcomes)
     assert sum(o.ok_components for o in outcomes) >= 0.5 * components, report
+
+
+def test_whole_domain_of_profiles_is_honest():
+    """A seeded sample of bodies of your own (`whole_domain.sample_profiles`: tables of 4 … 24
+    points of random superellipses, a third with faces, the centre of mass anywhere between the
+    poles, references fitted and computed afresh at 50 digits), a fifth of the cells with a
+    turning point 1e-15 … 1e-3 from a joint of the arcs."""
+    cases = whole_domain.sample_profiles(1, int(os.environ.get("WHOLE_DOMAIN_PROFILE_CELLS", "30")))
+    outcomes = whole_domain.check_all(cases)
+    report = whole_domain.summary(outcomes)
+    print(report)
+    assert not any(o.problems for o in outcomes), report
+    components = sum(o.components for o in outcomes)
+    assert components >= len(cases) and sum(o.ok_components for o in outcomes) >= 0.8 * components, report

@@ -7,12 +7,13 @@
 //! other (θ_c = arccos h) U and U′ are continuous and U″ jumps: a kink, at which the cell
 //! solver splits its integrals.
 
-use super::{check_range, Angle, Shape};
+use super::{check_range, Angle, Profile, Shape};
 use crate::error::Result;
 use nalgebra::Vector3;
 use serde::Serialize;
 
-/// The kinds of edged body.
+/// The kinds of body beyond the ellipsoid: the edged bodies of this module, and a body of the
+/// user's own profile ([`super::profile`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum EdgedKind {
@@ -24,6 +25,8 @@ pub enum EdgedKind {
     /// A ball of radius 1 cut by z = ±h: on the lower edge for θ < θ_c, the sphere between,
     /// the upper edge for θ > π − θ_c.
     Wheel,
+    /// A body of revolution given by a table of its meridian's points (docs/bodies.md).
+    Profile(&'static Profile),
 }
 
 impl EdgedKind {
@@ -36,10 +39,11 @@ impl EdgedKind {
             Self::Disk => "disk",
             Self::TruncatedBall => "truncated_ball",
             Self::Wheel => "wheel",
+            Self::Profile(_) => "profile",
         }
     }
 
-    /// The kind of that name.
+    /// The kind of that name (a profile needs its table: not by name).
     pub fn from_name(name: &str) -> Option<Self> {
         Self::ALL.into_iter().find(|k| k.name() == name)
     }
@@ -148,6 +152,10 @@ impl EdgedShape {
             EdgedKind::Disk => Self::disk(alpha),
             EdgedKind::TruncatedBall => Self::truncated_ball(alpha, cut),
             EdgedKind::Wheel => Self::wheel(alpha, cut),
+            EdgedKind::Profile(_) => Err(crate::error::AtlasError::Unsupported {
+                what: "profile",
+                reason: "a body of a profile is a ProfileShape, not an EdgedShape",
+            }),
         }
     }
 
@@ -218,6 +226,7 @@ impl EdgedShape {
                 r: 0.0,
             },
             EdgedKind::Wheel => sphere,
+            EdgedKind::Profile(_) => unreachable!("an EdgedShape is never a profile"),
         }
     }
 
@@ -274,6 +283,7 @@ impl Shape for EdgedShape {
             EdgedKind::Disk => vec![(1.0, alpha)],
             EdgedKind::TruncatedBall => vec![(rho, h + alpha)],
             EdgedKind::Wheel => vec![(rho, h + alpha), (rho, alpha - h)],
+            EdgedKind::Profile(_) => vec![],
         };
         edges
             .into_iter()
@@ -290,6 +300,7 @@ impl Shape for EdgedShape {
         match self.kind {
             EdgedKind::Disk | EdgedKind::Wheel => [true, true],
             EdgedKind::TruncatedBall => [true, false],
+            EdgedKind::Profile(p) => p.faces(),
         }
     }
 
@@ -325,32 +336,15 @@ impl Shape for EdgedShape {
     /// ṙ = −r γ̇ − p (ḣ/s − h (h, ḣ)/s³) with h = (γ1, γ2, 0), s = |h|.
     fn contact_point_rate(&self, gamma: &Vector3<f64>, gamma_dot: &Vector3<f64>) -> Vector3<f64> {
         let part = self.part_at_cos(gamma.z);
-        let h = Vector3::new(gamma.x, gamma.y, 0.0);
-        let h_dot = Vector3::new(gamma_dot.x, gamma_dot.y, 0.0);
-        let s2 = h.norm_squared();
-        let s = s2.sqrt();
-        -gamma_dot * part.r - (h_dot / s - h * (h.dot(&h_dot) / (s2 * s))) * part.p
+        -gamma_dot * part.r - super::horizontal_direction_rate(gamma, gamma_dot) * part.p
     }
 
-    #[inline]
-    fn potential(&self, theta: f64) -> f64 {
-        self.potential_at(Angle::new(theta))
-    }
-
-    #[inline]
-    fn potential_prime(&self, theta: f64) -> f64 {
-        self.potential_prime_at(Angle::new(theta))
-    }
-
-    #[inline]
-    fn potential_second(&self, theta: f64) -> f64 {
-        self.potential_second_at(Angle::new(theta))
-    }
-
-    #[inline]
-    fn contact_distance_sq(&self, theta: f64) -> f64 {
-        self.contact_distance_sq_at(Angle::new(theta))
-    }
+    theta_forms!(
+        potential => potential_at,
+        potential_prime => potential_prime_at,
+        potential_second => potential_second_at,
+        contact_distance_sq => contact_distance_sq_at,
+    );
 
     /// d|r|²/dθ = 2U′(U + U″) = 2 r U′.
     fn contact_distance_sq_prime(&self, theta: f64) -> f64 {
@@ -416,8 +410,7 @@ impl Shape for EdgedShape {
             _ => None,
         };
         let Some(part) = part.filter(|_| x.sin * y.sin > 0.0 && cos_diff > -0.5) else {
-            let (ux, uy) = (self.potential_at(x), self.potential_at(y));
-            return ((ux - uy) / sin_diff, (ux.abs() + uy.abs()) / sin_diff.abs());
+            return super::subtracted_divided_difference(self, x, y, sin_diff);
         };
         let t = sin_diff / (1.0 + cos_diff);
         let sin_dd = y.cos - y.sin * t;

@@ -66,14 +66,8 @@ pub(super) fn diagram(args: DiagramArgs) -> Result<()> {
         args.out.as_deref(),
         &|| "use fewer --samples".into(),
     )?;
-    let set = match args.shape.body(args.nu, args.eta)? {
-        AnyBody::Ellipsoid(body) => {
-            CriticalSet::of_until(&body, args.samples, args.kappa_max, &crate::stop::requested)?
-        }
-        AnyBody::Edged(body) => {
-            CriticalSet::of_edged(&body, args.samples, args.kappa_max, &crate::stop::requested)?
-        }
-    };
+    let body = args.shape.body(args.nu, args.eta)?;
+    let set = CriticalSet::of_any(&body, args.samples, args.kappa_max, &crate::stop::requested)?;
     if args.json {
         let text = serde_json::to_string_pretty(&set)?;
         if crate::stop::requested() {

@@ -199,6 +199,9 @@ pub enum ShapeKindArg {
     TruncatedBall,
     /// A ball cut by z = ±h, rolling on its sphere or on either edge (α, cut).
     Wheel,
+    /// A body of your own: the arc spline through a table of its meridian's points
+    /// (--profile FILE, α the centre of mass's height on the axis).
+    Profile,
 }
 
 /// The shape of the body of `cell` and `trajectory`: the ellipsoid (the default) or an edged
@@ -206,11 +209,12 @@ pub enum ShapeKindArg {
 #[derive(Debug, Args)]
 pub struct BodyShapeArgs {
     /// The body: ellipsoid (--alpha, --beta), disk (--alpha), truncated_ball or wheel
-    /// (--alpha, --cut); docs/bodies.md.
+    /// (--alpha, --cut), profile (--alpha, --profile); docs/bodies.md.
     #[arg(long, value_enum, default_value_t = ShapeKindArg::Ellipsoid)]
     pub shape: ShapeKindArg,
     /// α: the centre of mass at α e3 from the body's centre (the ellipsoid's, in units of
-    /// b3; the ball's or the disk's, in units of its radius); -1 < α < 1 but for the disk.
+    /// b3; the ball's or the disk's, in units of its radius); -1 < α < 1 but for the disk; a
+    /// profile's: the height z = α on the axis, strictly between its poles.
     #[arg(value_parser = number, long, allow_hyphen_values = true)]
     pub alpha: f64,
     /// β = b1/b3 of the ellipsoid (required for it): < 1 prolate, > 1 oblate, 1 sphere.
@@ -220,40 +224,85 @@ pub struct BodyShapeArgs {
     /// -1 < h < 1) or the planes z = ±h (wheel, 0 < h < 1).
     #[arg(value_parser = number, long, allow_hyphen_values = true)]
     pub cut: Option<f64>,
+    /// The meridian of --shape profile: a text file of points `rho z` or `rho z edge` (edge 1
+    /// at a sharp edge), one a line, from one pole (rho = 0) to the other; docs/bodies.md.
+    #[arg(long, value_name = "FILE")]
+    pub profile: Option<std::path::PathBuf>,
 }
 
 impl BodyShapeArgs {
     /// The validated body with mass parameters ν, η; a parameter the shape does not take,
     /// or one it needs and was not given, is refused in one line.
     pub fn body(&self, nu: f64, eta: f64) -> Result<AnyBody> {
-        let kind = match self.shape {
-            ShapeKindArg::Ellipsoid => None,
-            ShapeKindArg::Disk => Some(EdgedKind::Disk),
-            ShapeKindArg::TruncatedBall => Some(EdgedKind::TruncatedBall),
-            ShapeKindArg::Wheel => Some(EdgedKind::Wheel),
-        };
-        let shape = kind.map_or("ellipsoid", |k| k.name());
-        let refuse = |what: &str| -> Result<AnyBody> {
+        let refuse = |shape: &str, what: &str| -> Result<AnyBody> {
             Err(AtlasError::Atlas {
                 path: "options".into(),
                 reason: format!("--shape {shape}: {what}"),
             }
             .into())
         };
+        let kind = match (self.shape, &self.profile) {
+            (ShapeKindArg::Profile, None) => {
+                return refuse(
+                    "profile",
+                    "--profile FILE is required (the meridian's points)",
+                )
+            }
+            (ShapeKindArg::Profile, Some(path)) => Some(EdgedKind::Profile(read_profile(path)?)),
+            (other, Some(_)) => {
+                let name = other.to_possible_value().map(|v| v.get_name().to_string());
+                return refuse(
+                    &name.unwrap_or_default(),
+                    "takes no --profile (only --shape profile does)",
+                );
+            }
+            (ShapeKindArg::Ellipsoid, None) => None,
+            (ShapeKindArg::Disk, None) => Some(EdgedKind::Disk),
+            (ShapeKindArg::TruncatedBall, None) => Some(EdgedKind::TruncatedBall),
+            (ShapeKindArg::Wheel, None) => Some(EdgedKind::Wheel),
+        };
+        let shape = kind.map_or("ellipsoid", |k| k.name());
+        let refuse = |what: &str| refuse(shape, what);
         // β for the ellipsoid, the cut for the cut balls, nothing for the disk.
         let second = match (kind, self.beta, self.cut) {
             (None, None, _) => return refuse("--beta is required"),
-            (None, Some(_), Some(_)) | (Some(EdgedKind::Disk), _, Some(_)) => {
+            (None, Some(_), Some(_))
+            | (Some(EdgedKind::Disk | EdgedKind::Profile(_)), _, Some(_)) => {
                 return refuse("takes no --cut (only truncated_ball and wheel do)")
             }
             (None, Some(beta), None) => beta,
             (Some(_), Some(_), _) => return refuse("takes no --beta (only the ellipsoid does)"),
-            (Some(EdgedKind::Disk), None, None) => 0.0,
+            (Some(EdgedKind::Disk | EdgedKind::Profile(_)), None, None) => 0.0,
             (Some(_), None, None) => return refuse("--cut is required"),
             (Some(_), None, Some(cut)) => cut,
         };
         Ok(AnyBody::new(kind, self.alpha, second, nu, eta)?)
     }
+}
+
+/// The profile in the table file `path` (--profile), refused in one line naming the file.
+fn read_profile(path: &std::path::Path) -> Result<&'static rubber_atlas::Profile> {
+    let fail = |reason: String| AtlasError::Atlas {
+        path: path.display().to_string(),
+        reason,
+    };
+    if path.is_dir() {
+        return Err(fail("is a directory, not a table of points".into()).into());
+    }
+    let meta = std::fs::metadata(path).map_err(|e| fail(e.to_string()))?;
+    if !meta.is_file() {
+        return Err(fail("is not a regular file (a table of points)".into()).into());
+    }
+    if meta.len() > 1 << 20 {
+        return Err(fail(format!(
+            "has {} bytes; a table of at most 2000 points is far smaller (1 MiB at most)",
+            meta.len()
+        ))
+        .into());
+    }
+    let text = std::fs::read_to_string(path).map_err(|e| fail(e.to_string()))?;
+    let rows = rubber_atlas::body::parse_profile_table(&text).map_err(|e| fail(e.to_string()))?;
+    Ok(rubber_atlas::Profile::from_points(&rows).map_err(|e| fail(e.to_string()))?)
 }
 
 /// The body (shape, ν, η) and κ: what a level set of the reduced system needs besides ε.
@@ -299,6 +348,9 @@ fn body_fields(body: &AnyBody) -> Vec<(&'static str, AttrValue)> {
             .into_iter()
             .map(|(name, x)| (name, AttrValue::Number(x))),
     );
+    if let AnyBody::Profile(b) = body {
+        fields.push(("profile", AttrValue::Text(b.shape.profile.text())));
+    }
     fields
 }
 
@@ -310,6 +362,12 @@ fn body_json(body: &AnyBody) -> serde_json::Map<String, serde_json::Value> {
     }
     for (name, x) in body.shape_parameters() {
         value.insert(name.into(), x.into());
+    }
+    if let AnyBody::Profile(b) = body {
+        value.insert(
+            "profile".into(),
+            serde_json::json!(b.shape.profile.points()),
+        );
     }
     value
 }

@@ -50,6 +50,7 @@ fn section(shape: &EdgedShape) -> Section {
             sphere: Some((-h, h)),
             faces: vec![(-h, rho), (h, rho)],
         },
+        rubber_atlas::body::EdgedKind::Profile(_) => unreachable!("an EdgedShape"),
     }
 }
 
@@ -869,45 +870,10 @@ fn the_upright_disk_at_rest_is_an_equilibrium() {
 /// on the sphere and on the cut's edge, carry the centre of mass n·|Δζ| away after n periods.
 #[test]
 fn a_resonant_truncated_ball_runs_away_in_the_full_equations() {
-    use rubber_atlas::resonance::{trace_curves, ResonanceOptions};
     let body = Body::new(EdgedShape::truncated_ball(0.2, 0.4).unwrap(), 0.7, 1.3).unwrap();
-    let options = ResonanceOptions::window(&body, 0.0, (0.01, 2.0), None, 5.0, 24, 1e-12);
-    let curves = trace_curves(&body, &options).unwrap();
-    let point = curves
-        .iter()
-        .flat_map(|c| c.points.iter())
-        .find(|p| p.kappa > 0.8 && p.kappa < 1.2)
-        .expect("a point of the N = 0 curve at kappa about 1");
-    let cell = solve_cell(
-        &body,
-        point.kappa,
-        point.energy,
-        &CellOptions {
-            tol: 1e-12,
-            drift: true,
-            ..CellOptions::default()
-        },
-    )
-    .unwrap();
-    let comp = &cell.components[point.component];
-    assert!(comp.rotation_number.abs() <= 1e-9, "{comp:?}");
-    assert_eq!(comp.bounded, Some(false), "{comp:?}");
     // The torus crosses the kink: the full model is tested on both parts of the surface.
     let kink = body.shape.kinks()[0];
-    assert!(comp.theta_min < kink && kink < comp.theta_max, "{comp:?}");
-    let start = Start {
-        kappa: point.kappa,
-        theta0: comp.theta_min,
-        theta_dot0: 0.0,
-    };
-    for periods in [5.0, 10.0] {
-        let away = crate::full_model_distance(&body, &start, periods * comp.period);
-        assert!(
-            (away - periods * comp.drift).abs() <= 1e-6 * periods * comp.drift,
-            "after {periods} periods the full model is {away} away, expected {}",
-            periods * comp.drift
-        );
-    }
+    crate::assert_a_resonant_cell_runs_away(&body, (0.01, 2.0), 5.0, (0.8, 1.2), kink);
 }
 
 /// A ball centred on its sphere's centre (α = 0) has U′(π/2) = 0 where its sphere holds the

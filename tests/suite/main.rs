@@ -10,6 +10,7 @@ mod family;
 mod limits;
 mod model;
 mod plane;
+mod profile;
 mod resonance;
 mod run;
 mod units;
@@ -26,4 +27,57 @@ pub fn full_model_distance<S: rubber_atlas::Shape>(
     let t = integrate(body, start, Model::Full, t_end, 4, 1e-12, &|| false).unwrap();
     let n = t.t.len() - 1;
     (t.x_c[n] - t.x_c[0]).hypot(t.y_c[n] - t.y_c[0])
+}
+
+/// On the N = 0 resonance curve of `body` in the window κ ∈ `kappa_window`, ε up to
+/// `energy_max`, the cell at the curve's first point with κ in `near` has N = 0, is unbounded,
+/// its torus crosses `kink`, and the full equations carry the centre of mass n·|Δζ| from its
+/// start in n = 5 and 10 periods, to 1e-6.
+pub fn assert_a_resonant_cell_runs_away<S: rubber_atlas::Shape>(
+    body: &rubber_atlas::Body<S>,
+    kappa_window: (f64, f64),
+    energy_max: f64,
+    near: (f64, f64),
+    kink: f64,
+) {
+    use rubber_atlas::cell::{solve_cell, CellOptions};
+    use rubber_atlas::resonance::{trace_curves, ResonanceOptions};
+    let options = ResonanceOptions::window(body, 0.0, kappa_window, None, energy_max, 24, 1e-12);
+    let curves = trace_curves(body, &options).unwrap();
+    let point = curves
+        .iter()
+        .flat_map(|c| c.points.iter())
+        .find(|p| p.kappa > near.0 && p.kappa < near.1)
+        .expect("a point of the N = 0 curve in the range of kappa");
+    let cell = solve_cell(
+        body,
+        point.kappa,
+        point.energy,
+        &CellOptions {
+            tol: 1e-12,
+            drift: true,
+            ..CellOptions::default()
+        },
+    )
+    .unwrap();
+    let comp = &cell.components[point.component];
+    assert!(comp.rotation_number.abs() <= 1e-9, "{comp:?}");
+    assert_eq!(comp.bounded, Some(false), "{comp:?}");
+    assert!(
+        comp.theta_min < kink && kink < comp.theta_max,
+        "{comp:?}: kink {kink}"
+    );
+    let start = rubber_atlas::trajectory::Start {
+        kappa: point.kappa,
+        theta0: comp.theta_min,
+        theta_dot0: 0.0,
+    };
+    for periods in [5.0, 10.0] {
+        let away = full_model_distance(body, &start, periods * comp.period);
+        assert!(
+            (away - periods * comp.drift).abs() <= 1e-6 * periods * comp.drift,
+            "after {periods} periods the full model is {away} away, expected {}",
+            periods * comp.drift
+        );
+    }
 }

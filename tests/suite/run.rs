@@ -1250,3 +1250,118 @@ fn an_update_never_discards_another_scenes_journal() {
     assert_eq!(unit_files(&journal), kept);
     ok(&run(&["run", &scene, "--out", o, "--resume", "--quiet"]));
 }
+
+/// A body of your own (docs/bodies.md): a scene with `shape = "profile"` and the table inline
+/// writes an atlas over (α, κ, ε) whose cells are those of `cell --shape profile --profile
+/// FILE` bit for bit, with the table in the attribute `profile`; a bad table is refused in
+/// one line naming the key.
+#[test]
+fn a_profile_atlas_equals_the_cell_command() {
+    let dir = tempfile::tempdir().unwrap();
+    let rows = "[[0.0, -1.0], [0.45, -0.92], [0.8, -0.62], [0.98, -0.2], [0.97, 0.25], \
+                [0.8, 0.62, 1], [0.4, 0.8], [0.0, 0.86]]";
+    let scene = dir.path().join("egg.toml");
+    let write = |profile: &str| {
+        std::fs::write(
+            &scene,
+            format!(
+                "name = \"egg\"\n[body]\nshape = \"profile\"\nprofile = {profile}\nnu = 0.8\n\
+                 eta = 1.7\n[axes]\nalpha = [-0.1, 0.2]\n\
+                 kappa = {{ start = 0.0, stop = 1.5, num = 7 }}\n\
+                 energy = {{ start = 0.9, stop = 3.0, num = 9 }}\n[solver]\ntolerance = 1e-10\n"
+            ),
+        )
+        .unwrap()
+    };
+    write(rows);
+    let out = dir.path().join("egg.h5");
+    ok(&run(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    let file = hdf5::File::open(&out).unwrap();
+    let text = |name: &str| {
+        file.attr(name)
+            .unwrap()
+            .read_scalar::<hdf5::types::VarLenUnicode>()
+            .unwrap()
+            .to_string()
+    };
+    assert_eq!(text("shape"), "profile");
+    let table = text("profile");
+    assert_eq!(table.lines().count(), 8);
+    assert_eq!(table.lines().nth(5), Some("0.8 0.62 1"));
+    assert_eq!(file.dataset("cell_status").unwrap().shape(), [2, 7, 9]);
+    assert!(file.dataset("beta").is_err() && file.dataset("cut").is_err());
+    let flags = |name: &str| file.dataset(name).unwrap().read_raw::<u8>().unwrap();
+    let n = file
+        .dataset("rotation_number")
+        .unwrap()
+        .read_raw::<f64>()
+        .unwrap();
+    let (count, family) = (flags("n_components"), flags("family"));
+    let slots = n.len() / count.len();
+    let table_file = dir.path().join("egg.txt");
+    std::fs::write(&table_file, &table).unwrap();
+    let mut compared = 0;
+    for (ia, alpha) in ["-0.1", "0.2"].into_iter().enumerate() {
+        for (ik, ie) in [(1, 2), (3, 4), (5, 8), (6, 1)] {
+            let cell = (ia * 7 + ik) * 9 + ie;
+            let (k, e) = (
+                format!("{:?}", axis_value(0.0, 1.5, 7, ik)),
+                format!("{:?}", axis_value(0.9, 3.0, 9, ie)),
+            );
+            let args = [
+                "cell",
+                "--shape",
+                "profile",
+                "--profile",
+                table_file.to_str().unwrap(),
+                "--alpha",
+                alpha,
+                "--nu",
+                "0.8",
+                "--eta",
+                "1.7",
+                "--kappa",
+                &k,
+                "--energy",
+                &e,
+                "--json",
+            ];
+            let json: serde_json::Value = serde_json::from_str(&ok(&run(&args))).unwrap();
+            let components = json["components"].as_array().unwrap();
+            assert_eq!(components.len(), count[cell] as usize, "cell {cell}");
+            for c in components {
+                let want = c["rotation_number"].as_f64().unwrap();
+                let stored = (0..slots)
+                    .filter(|&s| family[cell * slots + s] != 255)
+                    .map(|s| n[cell * slots + s]);
+                assert!(
+                    stored.into_iter().any(|x| x.to_bits() == want.to_bits()),
+                    "cell {cell}: N {want} not stored"
+                );
+                compared += 1;
+            }
+        }
+    }
+    assert!(compared >= 6, "{compared}");
+    // A table that is no convex meridian: one line, naming the key.
+    write("[[0.0, -1.0], [1.0, -0.5], [0.5, 0.0], [1.0, 0.5], [0.0, 1.0]]");
+    let refused = run(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--force",
+    ]);
+    let text = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(refused.status.code(), Some(2), "{text}");
+    assert!(
+        text.contains("body.profile") && text.contains("not convex"),
+        "{text}"
+    );
+    assert_eq!(text.trim().lines().count(), 1, "{text}");
+}
