@@ -909,6 +909,7 @@ pub fn component_axis(scene: &Scene, stop: &(dyn Fn() -> bool + Sync)) -> Compon
 /// several-fold in cost), into the slots of `axis`; `progress` is called with the number of cells after each row. Every
 /// cell is computed on its own, so the values do not depend on the number of threads or on
 /// which rows are computed together.
+#[allow(clippy::too_many_arguments)]
 pub fn compute_rows(
     scene: &Scene,
     variables: &[Variable],
@@ -917,7 +918,8 @@ pub fn compute_rows(
     betas: Range<usize>,
     rows: &[usize],
     progress: &(dyn Fn(usize) + Sync),
-) -> Block {
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Option<Block> {
     let bodies: Vec<_> = betas.map(|ib| scene.body(alpha_index, ib)).collect();
     let columns = scene.energy.values.len();
     let options = &scene.options;
@@ -930,6 +932,11 @@ pub fn compute_rows(
         .map(|&(b, row)| {
             let mut block = Block::empty(variables, columns, axis.len());
             crate::with_body!(&bodies[b], body => visit_row(scene, body, row, |j, point, level| {
+                // Asked to stop: the rest of the unit is skipped (and the unit dropped), so
+                // that slow cells (a profile of many points: 30 ms each) do not hold the run.
+                if stop() {
+                    return;
+                }
                 fill_cell(&mut block, variables, axis, j, point, || match level {
                     CellLevel::Level(potential, energy) => solve_level(potential, energy, options),
                     CellLevel::HighEnergy(lambda) => solve_high_energy_limit(body, lambda, options),
@@ -939,7 +946,7 @@ pub fn compute_rows(
             block
         })
         .collect();
-    Block::concat(variables, axis.len(), blocks)
+    (!stop()).then(|| Block::concat(variables, axis.len(), blocks))
 }
 
 /// One cell given by all its numbers: the body (α, β, ν, η) and the level (κ, ε).

@@ -641,7 +641,12 @@ impl<'a, S: Shape> Tracer<'a, S> {
                     .collect();
                 let mut found = Vec::new();
                 for well in wells {
+                    // Asked to stop: no more cells (a profile of many points takes 30 ms a
+                    // cell, and a row's scan ran on for 20 s after Ctrl-C).
                     let f = |e: f64| {
+                        if (self.stop)() {
+                            return None;
+                        }
                         evaluate(&potential, e, well, &self.options.cell)
                             .map(|p| p.rotation_number - target)
                     };
@@ -684,6 +689,9 @@ impl<'a, S: Shape> Tracer<'a, S> {
                         // N's error estimate (far out, where N tends to p/q = 0, it is below
                         // it: its "sign changes" are rounding, and gave curves of noise).
                         let signed = |x: f64| {
+                            if (self.stop)() {
+                                return None;
+                            }
                             evaluate(&potential, x, well, &self.options.cell).map(|p| {
                                 let value = p.rotation_number - target;
                                 (value, value.abs() > p.error_estimate)

@@ -30,8 +30,8 @@ pub trait Progress: Sync {
     fn laying_out(&self) {}
     /// Every unit is computed; the HDF5 file is being written.
     fn writing(&self) {}
-    /// Whether the run should stop (the caller got SIGINT or SIGTERM): units in flight are
-    /// finished and kept in the journal, no new one is started.
+    /// Whether the run should stop (the caller got SIGINT or SIGTERM): no new unit is started,
+    /// and those in flight are dropped between two cells (a resumed run computes them again).
     fn interrupted(&self) -> bool {
         false
     }
@@ -471,7 +471,8 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
                         return Ok(None);
                     }
                     let rows: Vec<usize> = u.rows.clone().collect();
-                    let block = compute_rows(
+                    // A unit stopped part way is dropped: a resumed run computes it again.
+                    let Some(block) = compute_rows(
                         scene,
                         &variables,
                         &axis,
@@ -479,7 +480,10 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
                         u.betas.clone(),
                         &rows,
                         &advance,
-                    );
+                        &|| progress.interrupted(),
+                    ) else {
+                        return Ok(None);
+                    };
                     let mut part = Summary::default();
                     part.count(&variables, &block);
                     let chunks = encode_unit(&variables, &block, chunk_cells);

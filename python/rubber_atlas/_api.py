@@ -476,24 +476,40 @@ def _profile_rows(profile) -> list[list[float]]:
     what = "profile must be rows (rho, z) or (rho, z, edge) of numbers"
     if isinstance(profile, (str, bytes)):
         raise TypeError(f"{what}, not {type(profile).__name__}")
+    if np.ma.isMaskedArray(profile):
+        if np.ma.getmaskarray(profile).any():
+            raise ValueError("profile has masked values: give the points themselves (np.ma.filled)")
+        profile = np.ma.getdata(profile)
+    if isinstance(profile, (list, tuple)) and any(
+            isinstance(x, (bool, np.bool_)) for row in profile if isinstance(row, (list, tuple)) for x in row):
+        raise TypeError(f"{what}, not True or False")
     try:
         array = np.asarray(profile)
     except (ValueError, TypeError):
         # Rows of both lengths (an edge marked on some): each row on its own.
-        try:
-            return [r for row in profile for r in _profile_rows([row])]
-        except TypeError:
-            raise TypeError(f"{what}, each of 2 or 3 values") from None
-    if array.dtype.kind not in "fiu" or array.dtype.itemsize > 8:
+        rows = []
+        for i, row in enumerate(profile):
+            values = np.asarray(row)
+            if values.ndim != 1 or len(values) not in (2, 3):
+                count = f"{values.size} value" + ("" if values.size == 1 else "s")
+                raise ValueError(f"profile row {i} has {count}; each row is (rho, z) or (rho, z, edge)") from None
+            rows.extend(_profile_rows([row]))
+        return rows
+    if array.dtype.kind not in "fiu":
         raise TypeError(f"{what}, not of {array.dtype}")
     if array.ndim != 2 or array.shape[1] not in (2, 3):
         raise ValueError(f"{what}: an array of shape (n, 2) or (n, 3), not {array.shape}")
-    return array.astype(np.float64).tolist()
+    # (A long double beyond float64 becomes inf here, which the core refuses by name.)
+    with np.errstate(over="ignore"):
+        return array.astype(np.float64).tolist()
 
 
 def _profile_text(rows: list[list[float]]) -> str:
-    """A profile's table as the files hold it: one `rho z edge` row a line."""
+    """A profile's table as the files hold it: one `rho z edge` row a line, from the lower pole."""
+    if rows and rows[0][1] > rows[-1][1]:
+        rows = rows[::-1]
     return "\n".join(f"{r[0]!r} {r[1]!r} {int(r[2]) if len(r) > 2 else 0}" for r in rows)
+
 
 
 def _shape_attrs(core: dict) -> dict:
@@ -1201,8 +1217,14 @@ def _read_every_chunk(path: Path) -> None:
                         data[block]
             name = "the text attributes"
             written = f.attrs.get("text_attributes_crc32")
-            if written is not None and int(written) != _text_attributes_crc32(f):
-                raise ValueError("their CRC-32 is not the one the file was written with")
+            if written is None:
+                raise ValueError("the file has no text_attributes_crc32 to check them against (it was "
+                                 "removed, or the file is older than the checksum); open it without check")
+            if int(written) != _text_attributes_crc32(f):
+                # The CRC covers every variable's text attributes: a variable removed or added
+                # changes it as a changed letter does.
+                raise ValueError("their CRC-32, taken over every variable, is not the one the file was "
+                                 "written with: a letter of them changed, or a variable was removed or added")
     except (OSError, KeyError, RuntimeError, ValueError, TypeError, AttributeError, IndexError) as e:
         raise ValueError(f"{path}: the file is damaged: {name if name.startswith('the text') else repr(name)} "
                          f"cannot be read as written ({_one_line(e)}); compute it again") from None

@@ -347,6 +347,20 @@ def test_a_damaged_atlas_is_named_as_damaged_by_the_accessor(slice_atlas, tmp_pa
     letter = tmp_path / "letter.h5"
     letter.write_bytes(bytes(data))
     refused(ValueError, lambda: ra.open_atlas(letter, check=True), str(letter), "damaged", "text attributes")
+    # Without its checksum the text cannot be checked: said, not passed over (it was accepted).
+    unchecked = tmp_path / "unchecked.h5"
+    shutil.copy(slice_atlas, unchecked)
+    with h5py.File(unchecked, "r+") as f:
+        del f.attrs["text_attributes_crc32"]
+    refused(ValueError, lambda: ra.open_atlas(unchecked, check=True), str(unchecked), "no text_attributes_crc32")
+    ra.open_atlas(unchecked).close()
+    # A variable removed changes the checksum too: the message says it may be that, not only a
+    # letter (it named the text alone).
+    removed = tmp_path / "removed.h5"
+    shutil.copy(slice_atlas, removed)
+    with h5py.File(removed, "r+") as f:
+        del f["drift_radius"]
+    refused(ValueError, lambda: ra.open_atlas(removed, check=True), str(removed), "damaged", "variable was removed")
 
 
 

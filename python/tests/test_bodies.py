@@ -202,9 +202,20 @@ def test_diagram_trajectory_and_resonance_take_a_profile():
     (lambda: ra.cells(0.0, None, 1, 1, 0.5, 1.5, shape="disk", profile=EGG), ValueError, "takes no profile"),
     (lambda: ra.cells(0.0, None, 1, 1, 0.5, 1.5, shape="profile", profile="0 -1\n1 0\n0 1"), TypeError, "rows"),
     (lambda: ra.cells(0.0, None, 1, 1, 0.5, 1.5, shape="profile", profile=[[0, -1], [1, 0, 0, 1], [0, 1]]),
-     ValueError, "(n, 2) or (n, 3)"),
+     ValueError, "row 1 has 4 values"),
     (lambda: ra.cells(0.0, None, 1, 1, 0.5, 1.5, shape="profile", profile=[0, -1, 1, 0, 0, 1]), ValueError,
      "(n, 2) or (n, 3)"),
+    # Found by an adversary: True taken as 1, masked points used, a short row named by its shape.
+    (lambda: ra.cells(0.0, None, 1, 1, 0.5, 1.5, shape="profile", profile=[[0, -1], [True, -0.5], [1, 0], [0, 1]]),
+     TypeError, "not True or False"),
+    (lambda: ra.cells(0.0, None, 1, 1, 0.5, 1.5, shape="profile",
+                      profile=np.ma.masked_array([[0, -1], [1, 0], [0, 1]], mask=[[0, 0], [0, 1], [0, 0]])),
+     ValueError, "masked"),
+    (lambda: ra.cells(0.0, None, 1, 1, 0.5, 1.5, shape="profile", profile=[[0, -1], [0.8], [1, 0, 1], [0, 1]]),
+     ValueError, "row 1 has 1 value;"),
+    (lambda: ra.cells(0.0, None, 1, 1, 0.5, 1.5, shape="profile", profile=[[0, -1], [0.8, -0.5], [0.9, 0, 1],
+                                                                        [1.0, 0.3], [0, 1]]),
+     ValueError, "not convex"),
     (lambda: ra.cells(0.0, None, 1, 1, 0.5, 1.5, shape="profile",
                       profile=[[0, -1], [1, -0.5], [0.5, 0], [1, 0.5], [0, 1]]), ValueError, "not convex"),
     (lambda: ra.cells(0.0, 1.0, 1, 1, 0.5, 1.5, shape="profile", profile=EGG), ValueError, "no beta"),
@@ -217,3 +228,13 @@ def test_a_profile_is_refused_where_it_does_not_fit(call, error, words):
     with pytest.raises(error) as e:
         call()
     assert words in str(e.value) and "\n" not in str(e.value), str(e.value)
+
+
+def test_a_profile_is_recorded_from_its_lower_pole_whichever_way_it_is_given():
+    """As the command's files and JSON hold it (files.md): the Python result held it top first."""
+    down = ra.cells(-0.1, None, 0.8, 1.7, kappa=0.5, energy=1.5, shape="profile", profile=EGG[::-1],
+                    fields=["rotation_number"])
+    up = ra.cells(-0.1, None, 0.8, 1.7, kappa=0.5, energy=1.5, shape="profile", profile=EGG,
+                  fields=["rotation_number"])
+    assert down.attrs["profile"] == up.attrs["profile"] and down.attrs["profile"].startswith("0.0 -1.0 0")
+    assert float(down.rotation_number[0]) == float(up.rotation_number[0])

@@ -373,6 +373,12 @@ impl Profile {
                     (_, true) => leave[i],
                     _ => {
                         let (before, after) = (chord(i - 1), chord(i));
+                        if after.partial_cmp(&before) != Some(std::cmp::Ordering::Greater) {
+                            return refuse(format!(
+                                "is not convex at the edge at point {i}: the meridian turns back \
+                                 there"
+                            ));
+                        }
                         let margin = 0.25 * (after - before);
                         (0.5 * (arrive[i] + leave[i])).clamp(before + margin, after - margin)
                     }
@@ -531,33 +537,50 @@ impl Profile {
 }
 
 /// The rows of a profile's table as text: one point a line, `rho z` or `rho z edge`, the
-/// numbers separated by commas or white space; empty lines, lines starting with `#`, and a
-/// first line of column names are skipped. A line that is none of these is refused, by its
-/// number.
+/// numbers separated by commas or by white space; empty lines and lines starting with `#` are
+/// skipped, and so is a first line of column names (words only). Lines end at `\n`, `\r\n`
+/// or `\r`. A line that is not a row of numbers, or a comma-separated line with an empty
+/// field (which would shift the columns), is refused by its number.
 pub fn parse_table(text: &str) -> Result<Vec<Vec<f64>>> {
     let mut rows = Vec::new();
+    let mut first = true;
+    let text = text.replace("\r\n", "\n").replace('\r', "\n");
     for (i, line) in text.lines().enumerate() {
         let line = line.trim();
         if line.is_empty() || line.starts_with('#') {
             continue;
         }
-        let words: Vec<&str> = line
-            .split(|c: char| c == ',' || c.is_whitespace())
-            .filter(|w| !w.is_empty())
-            .collect();
+        let shown = || line.chars().take(60).collect::<String>();
+        let words: Vec<&str> = if line.contains(',') {
+            line.split(',').map(str::trim).collect()
+        } else {
+            line.split_whitespace().collect()
+        };
+        if words.iter().any(|w| w.is_empty()) {
+            return refuse(format!(
+                "has line {} with an empty field: {:?} (give every value)",
+                i + 1,
+                shown()
+            ));
+        }
         let numbers: std::result::Result<Vec<f64>, _> = words.iter().map(|w| w.parse()).collect();
         match numbers {
             Ok(row) => rows.push(row),
-            // Column names before the first point.
-            Err(_) if rows.is_empty() && words.iter().all(|w| w.parse::<f64>().is_err()) => {}
+            // Column names on the first line.
+            Err(_)
+                if first
+                    && words.iter().all(|w| {
+                        w.parse::<f64>().is_err() && w.chars().any(char::is_alphabetic)
+                    }) => {}
             Err(_) => {
                 return refuse(format!(
                     "has line {} that is not a row of numbers: {:?}",
                     i + 1,
-                    line.chars().take(60).collect::<String>()
+                    shown()
                 ))
             }
         }
+        first = false;
     }
     Ok(rows)
 }

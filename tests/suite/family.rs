@@ -423,8 +423,17 @@ fn an_atlas_has_no_slot_empty_everywhere_and_each_slot_is_one_family() {
         for ia in 0..2 {
             for ib in 0..2 {
                 let rows: Vec<usize> = (0..41).collect();
-                let block =
-                    atlas::compute_rows(&scene, &vars, &axis, ia, ib..ib + 1, &rows, &|_| {});
+                let block = atlas::compute_rows(
+                    &scene,
+                    &vars,
+                    &axis,
+                    ia,
+                    ib..ib + 1,
+                    &rows,
+                    &|_| {},
+                    &|| false,
+                )
+                .unwrap();
                 let atlas::Column::U8(family) = &block.columns[family_index] else {
                     panic!("family is u8");
                 };

@@ -396,6 +396,18 @@ fn tables_that_are_no_convex_meridian_are_refused() {
             ],
             "not convex",
         ),
+        // An edge where the meridian turns back, its arcs overshooting (a panic in a clamp).
+        (
+            vec![
+                vec![0.0, -1.0],
+                vec![1.0, -0.5],
+                vec![1.05, 0.0, 1.0],
+                vec![1.12, 0.3],
+                vec![0.8, 0.7],
+                vec![0.0, 1.0],
+            ],
+            "not convex",
+        ),
         (
             vec![vec![0.0, -1.0], vec![f64::NAN, 0.0], vec![0.0, 1.0]],
             "finite",
@@ -453,4 +465,34 @@ fn a_resonant_profile_runs_away_in_the_full_equations() {
         .unwrap()
         .theta_start;
     crate::assert_a_resonant_cell_runs_away(&body, (0.02, 1.5), 3.0, (0.6, 0.8), rim);
+}
+
+/// The text of a table: commas or white space, a header line of words first, comments, and
+/// every line end; an empty field (which shifted the columns: `0.8,,1` was (0.8, 1)) and a
+/// line that is not numbers are refused by their line number.
+#[test]
+fn a_table_is_read_line_by_line_and_refused_by_its_line() {
+    use rubber_atlas::body::parse_profile_table as parse;
+    let ok = |text: &str| parse(text).unwrap();
+    let want = vec![vec![0.0, -1.0], vec![1.0, 0.0, 1.0], vec![0.0, 1.0]];
+    assert_eq!(ok("rho z edge\n0 -1\n1 0 1\n0 1\n"), want);
+    assert_eq!(ok("# c\nrho,z,edge\n0, -1\n1,0,1\n\n0,1"), want);
+    assert_eq!(ok("0 -1\r\n1\t0 1\r\n0 1\r\n"), want);
+    assert_eq!(ok("0 -1\r1 0 1\r0 1\r"), want);
+    for (text, words) in [
+        (
+            "rho,z,edge\n0,-1,0\n0.8,,1\n0,1,0\n",
+            "line 3 with an empty field",
+        ),
+        ("0,-1,\n1,0\n0,1\n", "line 1 with an empty field"),
+        ("a b\nc d\n0 -1\n", "line 2 that is not"),
+        ("0;-1\n1;0\n0;1\n", "line 1 that is not"),
+        ("rho z\r\n0 -1\r\nx 1\r\n", "line 3 that is not"),
+    ] {
+        let text_error = parse(text).unwrap_err().to_string();
+        assert!(
+            text_error.contains(words) && !text_error.contains('\n'),
+            "{text:?}: {text_error}"
+        );
+    }
 }

@@ -772,20 +772,7 @@ fn a_run_stopped_before_its_first_cell_says_that_nothing_was_kept() {
     )
     .unwrap();
     let out = dir.path().join("census.h5");
-    let child = Command::new(BIN)
-        .args([
-            "run",
-            scene.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    std::thread::sleep(Duration::from_millis(500));
-    // SAFETY: a signal to our own child process.
-    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
-    let output = child.wait_with_output().unwrap();
+    let (output, _) = run_interrupted(&scene, &out, Duration::from_millis(500));
     let text = String::from_utf8_lossy(&output.stderr);
     assert_eq!(output.status.code(), Some(130), "{text}");
     assert!(text.contains("laying out the component axis"), "{text}");
@@ -1364,4 +1351,62 @@ fn a_profile_atlas_equals_the_cell_command() {
         "{text}"
     );
     assert_eq!(text.trim().lines().count(), 1, "{text}");
+}
+
+/// Ctrl-C stops a run between two cells, not after its unit: a profile of 2000 points takes
+/// about 30 ms a cell, and a unit of 4,096 cells ran on for 111 s after the signal. The unit
+/// in flight is dropped (nothing kept), and the journal resumes it.
+#[test]
+fn a_run_of_slow_cells_stops_between_two_cells() {
+    let dir = tempfile::tempdir().unwrap();
+    let rows: Vec<String> = (0..2000)
+        .map(|i| {
+            let t = std::f64::consts::PI * i as f64 / 1999.0;
+            let rho = if i == 0 || i == 1999 {
+                0.0
+            } else {
+                1.5 * t.sin()
+            };
+            format!("[{rho:?}, {:?}]", -t.cos())
+        })
+        .collect();
+    let scene = dir.path().join("slow.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            "name = \"slow\"\n[body]\nshape = \"profile\"\nprofile = [{}]\nnu = 1.0\neta = 1.0\n\
+             [axes]\nalpha = [0.1]\nkappa = {{ start = 0.05, stop = 1.5, num = 64 }}\n\
+             energy = {{ start = 1.6, stop = 4.0, num = 64 }}\n",
+            rows.join(", ")
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("slow.h5");
+    let (output, heard) = run_interrupted(&scene, &out, Duration::from_millis(1500));
+    let text = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(130), "{text}");
+    // Not a timing test: heard between cells (0.1 s) or after the unit (minutes).
+    assert!(heard < Duration::from_secs(20), "{heard:?}: {text}");
+    assert!(!out.exists(), "{text}");
+}
+
+/// `run scene --out out`, sent SIGINT `after` its start: its output and how long it took to
+/// end after the signal.
+fn run_interrupted(scene: &Path, out: &Path, after: Duration) -> (Output, Duration) {
+    let child = Command::new(BIN)
+        .args([
+            "run",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(after);
+    let sent = Instant::now();
+    // SAFETY: a signal to our own child process.
+    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    let output = child.wait_with_output().unwrap();
+    (output, sent.elapsed())
 }
