@@ -1,8 +1,8 @@
 //! SIGINT, SIGTERM and SIGHUP during `run` and the other long commands (`trajectory`,
-//! `diagram`, `resonance`, `verdict`): the first asks the work to stop (a run once the units in
-//! flight are in the journal, see [`rubber_atlas::sweep::Progress::interrupted`]; the others
-//! at their next check, writing nothing); a second ends the process at once, with one line
-//! saying what is kept.
+//! `diagram`, `resonance`, `verdict`): the first asks the work to stop (a run between two cells,
+//! keeping the units its journal holds, see [`rubber_atlas::sweep::Progress::interrupted`]; the
+//! others at their next check, writing nothing); a second ends the process at once, with one
+//! line saying what is kept. Once asked, the work stays asked (the flag is never reset).
 
 use signal_hook::consts::signal::{SIGHUP, SIGINT, SIGTERM};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};

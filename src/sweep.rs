@@ -466,7 +466,7 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
                         // Counted as done when the run began: not any more.
                         progress.retract(cells_of(u) as u64);
                     }
-                    // Asked to stop: no new unit (those in flight finish into the journal).
+                    // Asked to stop: no new unit (those in flight are dropped between two cells).
                     if progress.interrupted() {
                         return Ok(None);
                     }

@@ -508,7 +508,11 @@ def _profile_text(rows: list[list[float]]) -> str:
     """A profile's table as the files hold it: one `rho z edge` row a line, from the lower pole."""
     if rows and rows[0][1] > rows[-1][1]:
         rows = rows[::-1]
-    return "\n".join(f"{r[0]!r} {r[1]!r} {int(r[2]) if len(r) > 2 else 0}" for r in rows)
+    def number(x: float) -> str:
+        # As the program writes it (Rust's shortest form): 1e-7, 1e16, not 1e-07, 1e+16.
+        return re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", repr(float(x)))
+
+    return "\n".join(f"{number(r[0])} {number(r[1])} {int(r[2]) if len(r) > 2 else 0}" for r in rows)
 
 
 

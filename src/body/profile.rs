@@ -367,7 +367,10 @@ impl Profile {
             } else {
                 2.0 * chord(i) - tangent[i + 1]
             };
-            if arrive[i] > leave[i] {
+            // An edge whose turn is within rounding (a few ulps: a tip flag on a pole whose
+            // neighbours lie on a circle through it) has none: a joint a few ulps from a pole
+            // would split every integral there, and make the pole a tip.
+            if arrive[i] > leave[i] || leave[i] - arrive[i] <= 64.0 * f64::EPSILON {
                 let common = match (bottom_fixed, top_fixed) {
                     (true, _) => arrive[i],
                     (_, true) => leave[i],
@@ -637,7 +640,9 @@ impl ProfileShape {
         let i = self.profile.joints.partition_point(|&j| j < theta);
         [i.wrapping_sub(1), i].into_iter().find(|&k| {
             self.profile.joints.get(k).is_some_and(|&j| {
-                (theta - j).abs() <= 8.0 * f64::EPSILON * (1.0 + 1.0 / j.sin().max(1e-300))
+                // θ from the pair (sin, cos) is good to a few ulps of itself (atan2): near
+                // θ = 0 relatively, elsewhere to a few ulps of π.
+                (theta - j).abs() <= 16.0 * f64::EPSILON * j.max(theta).min(1.0)
             })
         })
     }
@@ -740,7 +745,10 @@ impl Shape for ProfileShape {
         } else {
             arc.anchor_rho * c / s
         };
-        let turn = if arc.anchor_sin == 0.0 {
+        // (An edge has r = 0: nothing to add, also at sinθ = 0 where the quotient is 0/0.)
+        let turn = if arc.radius == 0.0 {
+            0.0
+        } else if arc.anchor_sin == 0.0 {
             arc.radius * arc.anchor_cos
         } else {
             arc.radius * arc.angle_from_anchor(s, c).0 / s

@@ -496,3 +496,41 @@ fn a_table_is_read_line_by_line_and_refused_by_its_line() {
         );
     }
 }
+
+/// A tip flag on a pole whose neighbours lie on a circle through it turns by a few ulps at
+/// most: no tip, no joint (a joint 1.4e-16 from the pole made every angle of the sphere "at"
+/// it for the sides of U″, and the pole a tip). The ball it draws is the ball, and a top face
+/// gives U′/sinθ = −∞ at the pole (it was 0·x/0 = NaN).
+#[test]
+fn a_tip_flag_that_cannot_turn_makes_no_joint() {
+    let ball = vec![
+        vec![0.0, -1.0, 1.0],
+        vec![0.2f64.sin(), -0.2f64.cos()],
+        vec![0.4f64.sin(), -0.4f64.cos()],
+        vec![1.0, 0.0],
+        vec![0.0, 1.0, 1.0],
+    ];
+    let shape = profile_shape(&ball, 0.3);
+    assert!(shape.kinks().is_empty(), "{:?}", shape.kinks());
+    for theta in angles().into_iter().step_by(50) {
+        let u = shape.potential(theta);
+        assert!(
+            (u - (1.0 + 0.3 * theta.cos())).abs() < 1e-14,
+            "at {theta}: U {u}"
+        );
+    }
+    let faced = profile_shape(
+        &[
+            vec![0.0, -1.0],
+            vec![1.0, 0.0],
+            vec![0.5, 0.8],
+            vec![0.0, 0.8],
+        ],
+        0.0,
+    );
+    let top = Angle {
+        sin: 0.0,
+        cos: -1.0,
+    };
+    assert_eq!(faced.potential_prime_over_sin_at(top), f64::NEG_INFINITY);
+}
