@@ -133,9 +133,9 @@ fn merge_arcs_of_one_circle(arcs: Vec<ProfileArc>) -> Vec<ProfileArc> {
     let mut groups: Vec<Vec<ProfileArc>> = Vec::new();
     for arc in arcs {
         match groups.last_mut() {
-            Some(group) if same(group.last().expect("groups are not empty"), &arc) => {
-                group.push(arc)
-            }
+            // Against the group's first arc, so that a slow drift does not chain arcs of
+            // different circles together.
+            Some(group) if same(&group[0], &arc) => group.push(arc),
             _ => groups.push(vec![arc]),
         }
     }
