@@ -6,7 +6,7 @@
 //! Several of the paper's printed formulas carry misprints; the corrected forms used here are
 //! those of docs/model.md, and the tests check each against a direct numerical search.
 
-use crate::body::{Angle, AnyBody, Body, EdgedShape, EllipsoidBody, Shape};
+use crate::body::{Angle, AnyBody, Body, EllipsoidBody, Shape};
 use crate::error::{AtlasError, Result};
 use crate::reduced::ReducedSystem;
 use crate::torus::bisect;
@@ -931,50 +931,44 @@ fn edged_equilibria<S: Shape>(body: &Body<S>) -> Vec<Equilibrium> {
 }
 
 impl CriticalSet {
-    /// The critical set of an edged body (docs/bodies.md): its curve of permanent rotations
-    /// ([`general_fixed_point`]) sampled as the ellipsoid's is, with the kinks of U sampled and
-    /// listed, a change of stability located (at a kink too, where V″ jumps), the equator
-    /// σ_π/2 of a symmetric body, and its equilibria ([`edged_equilibria`]). No branch ends
-    /// at a face. ε_min is the top of U on [0, π].
-    pub fn of_edged(
-        body: &Body<EdgedShape>,
-        samples: usize,
-        kappa_max: f64,
-        stop: &dyn Fn() -> bool,
-    ) -> Result<Self> {
-        let disk = body.shape.kind == crate::body::EdgedKind::Disk;
-        let (alpha, cut) = (body.shape.alpha, (!disk).then_some(body.shape.cut));
-        Self::of_shape(
-            body,
-            (body.shape.kind.name(), alpha, cut),
-            samples,
-            kappa_max,
-            stop,
-        )
-    }
-
-    /// The critical set of any body ([`CriticalSet::of_until`] for the ellipsoid,
-    /// [`CriticalSet::of_edged`]'s for every other).
+    /// The critical set of any body: [`CriticalSet::of_until`] for the ellipsoid; for every
+    /// other (docs/bodies.md) its curve of permanent rotations ([`general_fixed_point`])
+    /// sampled as the ellipsoid's is, with the kinks of U sampled and listed, a change of
+    /// stability located (at a kink too, where V″ jumps), the equator σ_π/2 of a symmetric
+    /// body, and its equilibria ([`edged_equilibria`]). No branch ends at a face. ε_min is the
+    /// top of U on [0, π]. The output names the shape and its parameters α and cut (if any).
     pub fn of_any(
         body: &AnyBody,
         samples: usize,
         kappa_max: f64,
         stop: &dyn Fn() -> bool,
     ) -> Result<Self> {
+        let parameters = body.shape_parameters();
+        let parameter = |name| parameters.iter().find(|p| p.0 == name).map(|p| p.1);
+        let named = (
+            body.shape_name(),
+            parameter("alpha").expect("every shape has alpha"),
+            parameter("cut"),
+        );
         match body {
             AnyBody::Ellipsoid(b) => Self::of_until(b, samples, kappa_max, stop),
-            AnyBody::Edged(b) => Self::of_edged(b, samples, kappa_max, stop),
-            AnyBody::Profile(b) => Self::of_shape(
-                b,
-                ("profile", b.shape.alpha, None),
-                samples,
-                kappa_max,
-                stop,
-            ),
+            AnyBody::Edged(b) => Self::of_shape(b, named, samples, kappa_max, stop),
+            AnyBody::Profile(b) => Self::of_shape(b, named, samples, kappa_max, stop),
         }
     }
 
-    /// [`CriticalSet::of_edged`] for any shape, named (shape, α, cut) in the output.
+    /// [`CriticalSet::of_any`] of an edged body.
+    pub fn of_edged(
+        body: &Body<crate::body::EdgedShape>,
+        samples: usize,
+        kappa_max: f64,
+        stop: &dyn Fn() -> bool,
+    ) -> Result<Self> {
+        Self::of_any(&AnyBody::Edged(*body), samples, kappa_max, stop)
+    }
+
+    /// [`CriticalSet::of_any`] for a shape other than the ellipsoid, named (shape, α, cut) in
+    /// the output.
     fn of_shape<S: Shape>(
         body: &Body<S>,
         (name, alpha, cut): (&'static str, f64, Option<f64>),

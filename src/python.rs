@@ -812,6 +812,15 @@ fn provenance(call: &str) -> Vec<(String, String)> {
     out
 }
 
+/// A profile's table as the files hold it: one `rho z edge` row a line from the lower pole
+/// ([`crate::Profile::text`]); a table that is no convex meridian is a ValueError.
+#[pyfunction]
+fn profile_text(rows: Vec<Vec<f64>>) -> PyResult<String> {
+    Ok(crate::Profile::from_points(&rows)
+        .map_err(value_error)?
+        .text())
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // NumPy's C API is looked up (and kept) now, on import: looked up first while a
@@ -826,6 +835,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(coordinate, m)?)?;
     m.add_function(wrap_pyfunction!(provenance, m)?)?;
     m.add_function(wrap_pyfunction!(cells, m)?)?;
+    m.add_function(wrap_pyfunction!(profile_text, m)?)?;
     m.add_function(wrap_pyfunction!(bottoms, m)?)?;
     m.add_function(wrap_pyfunction!(diagram, m)?)?;
     m.add_function(wrap_pyfunction!(trajectory, m)?)?;

@@ -421,28 +421,36 @@ fn parameter_error(reader: &Reader<'_>, key: &str, e: AtlasError) -> AtlasError 
     }
 }
 
+/// The text of a small input file (a scene, a profile's table), refused with the reason
+/// where it is not a regular file (a folder, a device, a FIFO, which would be waited on) or
+/// is above 1 MiB, far above any such file (a huge one is not read to the end); `what` says
+/// what it should be, in the refusal.
+pub fn read_small_text(path: &Path, what: &str) -> std::result::Result<String, String> {
+    const MAX_BYTES: u64 = 1 << 20;
+    let meta = std::fs::metadata(path).map_err(|e| e.to_string())?;
+    if !meta.is_file() {
+        return Err(format!("not a regular file ({what})"));
+    }
+    if meta.len() > MAX_BYTES {
+        return Err(format!(
+            "{} bytes: too large ({what}; at most {MAX_BYTES})",
+            meta.len()
+        ));
+    }
+    std::fs::read_to_string(path).map_err(|e| e.to_string())
+}
+
 impl Scene {
     /// Reads and checks the scene file at `path`.
     pub fn from_file(path: &Path) -> Result<Scene> {
-        /// Far above any scene (a few kB): a device or a huge file is not read to the end.
-        const MAX_SCENE_BYTES: u64 = 1 << 20;
         let file = path.display().to_string();
-        let fail = |reason: String| AtlasError::Scene {
-            file: file.clone(),
-            key: "(file)".into(),
-            reason,
-        };
-        let meta = std::fs::metadata(path).map_err(|e| fail(e.to_string()))?;
-        if !meta.is_file() {
-            return Err(fail("not a regular file (a scene is a TOML file)".into()));
-        }
-        if meta.len() > MAX_SCENE_BYTES {
-            return Err(fail(format!(
-                "{} bytes: too large for a scene (at most {MAX_SCENE_BYTES})",
-                meta.len()
-            )));
-        }
-        let text = std::fs::read_to_string(path).map_err(|e| fail(e.to_string()))?;
+        let text = read_small_text(path, "a scene is a TOML file").map_err(|reason| {
+            AtlasError::Scene {
+                file: file.clone(),
+                key: "(file)".into(),
+                reason,
+            }
+        })?;
         Scene::parse(&text, &file)
     }
 

@@ -505,15 +505,9 @@ def _profile_rows(profile) -> list[list[float]]:
 
 
 def _profile_text(rows: list[list[float]]) -> str:
-    """A profile's table as the files hold it: one `rho z edge` row a line, from the lower pole."""
-    if rows and rows[0][1] > rows[-1][1]:
-        rows = rows[::-1]
-    def number(x: float) -> str:
-        # As the program writes it (Rust's shortest form): 1e-7, 1e16, not 1e-07, 1e+16.
-        return re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", repr(float(x)))
-
-    return "\n".join(f"{number(r[0])} {number(r[1])} {int(r[2]) if len(r) > 2 else 0}" for r in rows)
-
+    """A profile's table as the files hold it: one `rho z edge` row a line, from the lower
+    pole, in the program's number form (the core writes it)."""
+    return _core.profile_text(rows)
 
 
 def _shape_attrs(core: dict) -> dict:

@@ -10,12 +10,10 @@
 use super::{check_range, Angle, Profile, Shape};
 use crate::error::Result;
 use nalgebra::Vector3;
-use serde::Serialize;
 
 /// The kinds of body beyond the ellipsoid: the edged bodies of this module, and a body of the
 /// user's own profile ([`super::profile`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum EdgedKind {
     /// A thin disk of rim radius 1, rolling on its rim: U = sinθ + α cosθ.
     Disk,

@@ -175,7 +175,6 @@ pub struct Profile {
     /// (sin, cos) of each joint: an angle is placed among them without its θ.
     joint_sin_cos: Vec<(f64, f64)>,
     faces: [bool; 2],
-    poles: [f64; 2],
 }
 
 impl PartialEq for Profile {
@@ -185,16 +184,6 @@ impl PartialEq for Profile {
 }
 
 impl Eq for Profile {}
-
-/// A profile is written as its table, (ρ, z, edge) rows from the bottom pole.
-impl serde::Serialize for Profile {
-    fn serialize<S: serde::Serializer>(
-        &self,
-        serializer: S,
-    ) -> std::result::Result<S::Ok, S::Error> {
-        self.points.serialize(serializer)
-    }
-}
 
 /// The profiles made so far, each once: a body holds a `&'static Profile` (bodies are `Copy`),
 /// and the same table asked for again (every call of a sweep) is the same profile.
@@ -396,6 +385,9 @@ impl Profile {
                 arcs.push(arc);
             }
         };
+        // The normal turns round an edge from where the meridian arrives to where it leaves
+        // (arrive ≤ leave above; none where they are equal).
+        let edge_arc = |i: usize| ProfileArc::new(arrive[i], leave[i], 0.0, arrive[i], at(i));
         for i in first..last {
             let (a, b) = (at(i), at(i + 1));
             let psi = chord_angle(a, b);
@@ -408,15 +400,7 @@ impl Profile {
                 ),
             };
             if edge(i) {
-                // The normal turns round the edge from where the meridian arrives to where it
-                // leaves.
-                if leave[i].partial_cmp(&arrive[i]).is_none_or(|o| o.is_lt()) {
-                    return Err(not_convex("the edge turns back"));
-                }
-                push(
-                    &mut arcs,
-                    ProfileArc::new(arrive[i], leave[i], 0.0, arrive[i], a),
-                );
+                push(&mut arcs, edge_arc(i));
             }
             let t0 = if edge(i) { leave[i] } else { tangent[i] };
             let t1 = if edge(i + 1) {
@@ -458,16 +442,7 @@ impl Profile {
             push(&mut arcs, ProfileArc::new(tj, t1, r2, t1, b));
         }
         if edge(last) {
-            if leave[last]
-                .partial_cmp(&arrive[last])
-                .is_none_or(|o| o.is_lt())
-            {
-                return refuse(format!("is not convex at the edge at point {last}"));
-            }
-            push(
-                &mut arcs,
-                ProfileArc::new(arrive[last], leave[last], 0.0, arrive[last], at(last)),
-            );
+            push(&mut arcs, edge_arc(last));
         }
         // The normal turns from 0 to π, never back.
         if arcs.first().map(|a| a.theta_start) != Some(0.0)
@@ -489,14 +464,12 @@ impl Profile {
         let arcs = merge_arcs_of_one_circle(arcs);
         let joints: Vec<f64> = arcs[1..].iter().map(|a| a.theta_start).collect();
         let joint_sin_cos = joints.iter().map(|&j| libm::sincos(j)).collect();
-        let poles = [rows[0][1], rows[n - 1][1]];
         Ok(Self {
             points: rows,
             arcs,
             joints,
             joint_sin_cos,
             faces,
-            poles,
         })
     }
 
@@ -517,7 +490,7 @@ impl Profile {
 
     /// The heights z of the bottom and the top pole.
     pub fn poles(&self) -> [f64; 2] {
-        self.poles
+        [self.points[0][1], self.points[self.points.len() - 1][1]]
     }
 
     /// The profile's rows as text, one `rho z edge` a line (for files' attributes).
@@ -601,7 +574,7 @@ pub struct ProfileShape {
 impl ProfileShape {
     /// The body of `profile` with its centre of mass at z = α, strictly between the poles.
     pub fn new(profile: &'static Profile, alpha: f64) -> Result<Self> {
-        let [bottom, top] = profile.poles;
+        let [bottom, top] = profile.poles();
         if !(alpha > bottom && alpha < top) {
             return Err(AtlasError::InvalidParameter {
                 name: "alpha",
@@ -710,7 +683,8 @@ impl Shape for ProfileShape {
     /// d|r|²/dθ = 2U′(U + U″) = 2 r U′.
     fn contact_distance_sq_prime(&self, theta: f64) -> f64 {
         let a = Angle::new(theta);
-        2.0 * self.arc(a).0.radius * self.potential_prime_at(a)
+        let (arc, s, c) = self.arc(a);
+        2.0 * arc.radius * a.sin.signum() * self.values(arc, s, c)[1]
     }
 
     /// U = ρ_a sinθ − (z_a − α) cosθ + r (1 − cos(θ − θ_a)) on the arc in contact.

@@ -286,21 +286,7 @@ fn read_profile(path: &std::path::Path) -> Result<&'static rubber_atlas::Profile
         path: path.display().to_string(),
         reason,
     };
-    if path.is_dir() {
-        return Err(fail("is a directory, not a table of points".into()).into());
-    }
-    let meta = std::fs::metadata(path).map_err(|e| fail(e.to_string()))?;
-    if !meta.is_file() {
-        return Err(fail("is not a regular file (a table of points)".into()).into());
-    }
-    if meta.len() > 1 << 20 {
-        return Err(fail(format!(
-            "has {} bytes; a table of at most 2000 points is far smaller (1 MiB at most)",
-            meta.len()
-        ))
-        .into());
-    }
-    let text = std::fs::read_to_string(path).map_err(|e| fail(e.to_string()))?;
+    let text = rubber_atlas::scene::read_small_text(path, "a table of points").map_err(fail)?;
     let rows = rubber_atlas::body::parse_profile_table(&text).map_err(|e| fail(e.to_string()))?;
     Ok(rubber_atlas::Profile::from_points(&rows).map_err(|e| fail(e.to_string()))?)
 }
