@@ -241,3 +241,269 @@ pub fn spectral_antiderivative(values: &[f64], step: f64) -> Vec<f64> {
         .map(|j| scale * (mean * j as f64 + padded[j] - offset))
         .collect()
 }
+
+/// Which part of a Clenshaw–Curtis rule a piece of a libration uses (see
+/// [`ChebyshevLevel`]): the whole rule on x ∈ [−1, 1] for a piece with no turning point,
+/// θ = θ_l + L (1 + x)/2; or, for a piece with a turning point at one end, its half on
+/// u ∈ [0, 1] with θ − θ_turning = ±L u², whose integrands (dt/du ∝ u/√(ε − V), with
+/// ε − V ∝ u²) are even in u and analytic: the rule on [−1, 1] integrates them twice.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ChebyshevPiece {
+    /// No turning point: x = −cos(iπ/N), node i = 0 … N from the left end.
+    Regular,
+    /// The left end a turning point: u = sin(iπ/N), i = 0 … N/2 (node 0 the turning point).
+    TurningLeft,
+    /// The right end a turning point: u = cos(iπ/N), i = 0 … N/2 (node N/2 the turning point).
+    TurningRight,
+}
+
+impl ChebyshevPiece {
+    /// Nodes of level `level` (N = 2^level intervals on [−1, 1]).
+    #[inline]
+    pub fn count(self, level: u32) -> usize {
+        match self {
+            ChebyshevPiece::Regular => (1 << level) + 1,
+            _ => (1 << (level - 1)) + 1,
+        }
+    }
+
+    /// Index of the node at the turning point, if the piece has one.
+    #[inline]
+    pub fn turning_node(self, level: u32) -> Option<usize> {
+        match self {
+            ChebyshevPiece::Regular => None,
+            ChebyshevPiece::TurningLeft => Some(0),
+            ChebyshevPiece::TurningRight => Some(1 << (level - 1)),
+        }
+    }
+
+    /// Index j of node i in the Chebyshev points x_j = cos(jπ/N) of [−1, 1].
+    #[inline]
+    pub fn chebyshev_index(self, level: u32, i: usize) -> usize {
+        match self {
+            ChebyshevPiece::Regular => (1 << level) - i,
+            ChebyshevPiece::TurningLeft => (1 << (level - 1)) - i,
+            ChebyshevPiece::TurningRight => i,
+        }
+    }
+}
+
+/// The Clenshaw–Curtis rule with N = 2^level intervals on [−1, 1], nodes x_j = cos(jπ/N):
+/// Σ_j w_j f(x_j) = ∫ p over [−1, 1], p the polynomial interpolating f at the nodes
+/// (geometrically convergent for f analytic on [−1, 1]; the levels nest, level k's nodes
+/// being every second of level k + 1's).
+pub struct ChebyshevLevel {
+    /// w_j, weights of ∫ over [−1, 1] (all positive).
+    pub whole: Vec<f64>,
+    /// v_j, weights of ∫ over [0, 1] (those of [−1, 0] are v_{N−j}).
+    pub upper_half: Vec<f64>,
+    /// The weights of each kind of piece by node (left to right), the turning point's halved:
+    /// [Regular, TurningLeft, TurningRight].
+    pub piece: [Vec<f64>; 3],
+    /// For a [`ChebyshevPiece::TurningLeft`] node i (u_i = x_j): v_{N−j}, the weight its
+    /// mirror image −u_i has in ∫ over [0, 1], the turning point's halved.
+    pub turning_left_mirror: Vec<f64>,
+}
+
+/// The finest level of the Clenshaw–Curtis tables (N = 1024).
+pub const FINEST_CHEBYSHEV_LEVEL: u32 = 10;
+const _: () = assert!(1 << FINEST_CHEBYSHEV_LEVEL == FINEST_COSINE_INTERVALS);
+
+impl ChebyshevLevel {
+    /// The rule of `level` (1 … [`FINEST_CHEBYSHEV_LEVEL`]), from tables built once.
+    pub fn get(level: u32) -> &'static ChebyshevLevel {
+        static TABLES: [OnceLock<ChebyshevLevel>; FINEST_CHEBYSHEV_LEVEL as usize + 1] =
+            [const { OnceLock::new() }; FINEST_CHEBYSHEV_LEVEL as usize + 1];
+        TABLES[level as usize].get_or_init(|| Self::new(level))
+    }
+
+    fn new(level: u32) -> Self {
+        let n = 1usize << level;
+        // ∫ T_k over [−1, 1] and over [0, 1]; T_m(0) = cos(mπ/2).
+        let t_at_zero = |m: usize| match m % 4 {
+            0 => 1.0,
+            2 => -1.0,
+            _ => 0.0,
+        };
+        let whole_moment = |k: usize| {
+            if k % 2 == 1 {
+                0.0
+            } else {
+                2.0 / (1.0 - (k * k) as f64)
+            }
+        };
+        let half_moment = |k: usize| match k {
+            0 => 1.0,
+            1 => 0.5,
+            _ => {
+                let (up, down) = (2.0 * (k + 1) as f64, 2.0 * (k - 1) as f64);
+                (1.0 - t_at_zero(k + 1)) / up - (1.0 - t_at_zero(k - 1)) / down
+            }
+        };
+        // w_j = (2/N) h_j Σ''_k cos(jkπ/N) I_k (h_j and the sum's end terms halved), from
+        // p = Σ''_k c_k T_k with c_k = (2/N) Σ''_j f_j cos(jkπ/N).
+        let cosines: Vec<f64> = (0..2 * n)
+            .map(|m| (PI * m as f64 / n as f64).cos())
+            .collect();
+        let weights = |moment: &dyn Fn(usize) -> f64| -> Vec<f64> {
+            let end = |m: usize| if m == 0 || m == n { 0.5 } else { 1.0 };
+            let moments: Vec<f64> = (0..=n).map(|k| end(k) * moment(k)).collect();
+            (0..=n)
+                .map(|j| {
+                    let sum: f64 = (0..=n)
+                        .map(|k| cosines[(j * k) % (2 * n)] * moments[k])
+                        .sum();
+                    2.0 / n as f64 * end(j) * sum
+                })
+                .collect()
+        };
+        let (whole, upper_half) = if level == 0 {
+            (vec![1.0, 1.0], vec![0.5, 0.5])
+        } else {
+            (weights(&whole_moment), weights(&half_moment))
+        };
+        let piece = [
+            ChebyshevPiece::Regular,
+            ChebyshevPiece::TurningLeft,
+            ChebyshevPiece::TurningRight,
+        ]
+        .map(|kind| {
+            if level == 0 && kind != ChebyshevPiece::Regular {
+                return Vec::new();
+            }
+            (0..kind.count(level))
+                .map(|i| {
+                    let j = kind.chebyshev_index(level, i);
+                    // The half rule: ½ ∫ over [−1, 1] of an even function.
+                    match kind {
+                        ChebyshevPiece::Regular => whole[j],
+                        _ if 2 * j == n => 0.5 * whole[j],
+                        _ => whole[j],
+                    }
+                })
+                .collect()
+        });
+        let turning_left_mirror = if level == 0 {
+            Vec::new()
+        } else {
+            let kind = ChebyshevPiece::TurningLeft;
+            (0..kind.count(level))
+                .map(|i| {
+                    let j = kind.chebyshev_index(level, i);
+                    let half = if 2 * j == n { 0.5 } else { 1.0 };
+                    half * upper_half[n - j]
+                })
+                .collect()
+        };
+        Self {
+            whole,
+            upper_half,
+            piece,
+            turning_left_mirror,
+        }
+    }
+}
+
+impl IntervalNode {
+    /// Node i of a piece of kind `kind` with 2^`level` intervals of the Clenshaw–Curtis rule
+    /// on an interval of length `length` (see [`ChebyshevPiece`]); `jacobian` is dθ/dx or
+    /// dθ/du (0 at a turning point).
+    #[inline]
+    pub fn chebyshev_tabulated(kind: ChebyshevPiece, level: u32, i: usize, length: f64) -> Self {
+        match kind {
+            ChebyshevPiece::Regular => {
+                // x = −cos φ with φ = iπ/N: θ − θ_l = L sin²(φ/2), θ_r − θ = L cos²(φ/2).
+                let node = Self::cosine_tabulated(1 << level, i, length);
+                Self {
+                    jacobian: 0.5 * length,
+                    ..node
+                }
+            }
+            _ => {
+                // θ − θ_l = L sin²(iπ/N), θ_r − θ = L cos²(iπ/N): the cosine nodes at φ = 2iπ/N;
+                // dθ/du = 2 L u with u² the distance to the turning point over L.
+                let node = Self::cosine_tabulated(1 << (level - 1), i, length);
+                let from_turning = if kind == ChebyshevPiece::TurningLeft {
+                    node.from_left
+                } else {
+                    node.from_right
+                };
+                Self {
+                    jacobian: 2.0 * (length * from_turning).sqrt(),
+                    ..node
+                }
+            }
+        }
+    }
+}
+
+/// ∫ from −1 to x_j of the polynomial interpolating `values` (f at x_j = cos(jπ/N),
+/// j = 0 … N, N a power of two ≥ 2) into `out` (N + 1 long), from its Chebyshev
+/// coefficients (a DCT-I by a real FFT of 2N points) integrated term by term:
+/// ∫ T_k = T_{k+1}/(2(k+1)) − T_{k−1}/(2(k−1)).
+pub fn chebyshev_antiderivative(values: &[f64], out: &mut [f64]) {
+    let n = values.len() - 1;
+    debug_assert!(n >= 2 && n.is_power_of_two() && out.len() == n + 1);
+    let m = 2 * n;
+    with_buffers(m, n + 1, |buffer, spectrum| {
+        buffer[..=n].copy_from_slice(values);
+        for j in 1..n {
+            buffer[m - j] = values[j];
+        }
+        real_fft(buffer, spectrum);
+        // c_k = F_k / N, the ends halved.
+        let inv_n = 1.0 / n as f64;
+        let c = |k: usize| -> f64 {
+            if k > n {
+                0.0
+            } else if k == 0 || k == n {
+                0.5 * spectrum[k].re * inv_n
+            } else {
+                spectrum[k].re * inv_n
+            }
+        };
+        // b_k, k = 1 … N + 1; T_{N+1} equals T_{N−1} at the nodes.
+        let mut b: Vec<f64> = (0..=n + 1)
+            .map(|k| match k {
+                0 => 0.0,
+                1 => c(0) - 0.5 * c(2),
+                _ => (c(k - 1) - c(k + 1)) / (2 * k) as f64,
+            })
+            .collect();
+        let last = b[n + 1];
+        b[n - 1] += last;
+        // Q(x_j) = Σ_k b_k cos(kjπ/N) by the inverse real FFT of the spectrum X_k = b_k/2,
+        // X_N = b_N.
+        for (k, s) in spectrum.iter_mut().enumerate() {
+            let x = if k == n { b[n] } else { 0.5 * b[k] };
+            *s = Complex::new(x, 0.0);
+        }
+        real_inverse_fft(spectrum, buffer);
+        let start = buffer[n];
+        for (o, q) in out.iter_mut().zip(&buffer[..=n]) {
+            *o = q - start;
+        }
+    });
+}
+
+/// Runs `f` on per-thread buffers of `real` reals and `complex` complex numbers.
+fn with_buffers<R>(
+    real: usize,
+    complex: usize,
+    f: impl FnOnce(&mut [f64], &mut [Complex<f64>]) -> R,
+) -> R {
+    thread_local! {
+        static BUFFERS: RefCell<(Vec<f64>, Vec<Complex<f64>>)> =
+            const { RefCell::new((Vec::new(), Vec::new())) };
+    }
+    BUFFERS.with(|buffers| {
+        let (reals, complexes) = &mut *buffers.borrow_mut();
+        if reals.len() < real {
+            reals.resize(real, 0.0);
+        }
+        if complexes.len() < complex {
+            complexes.resize(complex, Complex::new(0.0, 0.0));
+        }
+        f(&mut reals[..real], &mut complexes[..complex])
+    })
+}

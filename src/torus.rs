@@ -16,7 +16,11 @@ use crate::body::{Angle, Body, Reduction, Shape};
 use crate::dd::{CompensatedSum, DoubleDouble};
 use crate::error::{AtlasError, Result};
 use crate::family::{self, Family, Side};
-use crate::quadrature::{spectral_antiderivative, IntervalNode, TanhSinhLevel, FINEST_LEVEL};
+use crate::quadrature::{
+    chebyshev_antiderivative, spectral_antiderivative, ChebyshevLevel, ChebyshevPiece,
+    IntervalNode, TanhSinhLevel, FINEST_LEVEL,
+};
+use rustfft::num_complex::Complex;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 mod cosine;
@@ -940,10 +944,12 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         }
     }
 
-    /// T, Δψ and (if `with_drift`) Δζ of a libration or rotation by tanh-sinh quadrature,
-    /// refined until the level-to-level change is within `tol` (relative for T and Δζ,
-    /// absolute for N = −Δψ/2π); the error estimates add a bound on the rounding errors of
-    /// the gap ε − V.
+    /// T, Δψ and (if `with_drift`) Δζ of a libration or rotation, refined until the
+    /// level-to-level change is within `tol` (relative for T and Δζ, absolute for
+    /// N = −Δψ/2π); the error estimates add a bound on the rounding errors of the gap ε − V.
+    /// A libration with no kink inside by the cosine substitution (`cosine`); otherwise in
+    /// pieces cut at the kinks, saddles and tangencies, each by Clenshaw–Curtis where it is
+    /// predicted to converge ([`ChebyshevPiece`]), else (or where it does not) by tanh-sinh.
     pub fn integrate(
         &self,
         energy: f64,
@@ -951,6 +957,21 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         tol: f64,
         with_drift: bool,
     ) -> Result<PeriodIntegrals> {
+        self.integrate_by(energy, component, tol, with_drift, Rules::Fastest)
+    }
+
+    /// [`Self::integrate`] by the rules `rules` allows (the tanh-sinh rule alone is the
+    /// other rules' check).
+    #[doc(hidden)]
+    pub fn integrate_by(
+        &self,
+        energy: f64,
+        component: &Component,
+        tol: f64,
+        with_drift: bool,
+        rules: Rules,
+    ) -> Result<PeriodIntegrals> {
+        let fast_rules = rules == Rules::Fastest;
         if component.kind == MotionKind::FixedPoint {
             return Err(AtlasError::NotPeriodic {
                 reason: "the component is a fixed point",
@@ -960,7 +981,8 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         // a pole comes close to the level, that is several times cheaper.
         // (Not across a kink of U: its rule converges geometrically only on an analytic
         // integrand.)
-        if component.kind == MotionKind::Libration
+        if fast_rules
+            && component.kind == MotionKind::Libration
             && self
                 .splits_inside(component.lower.theta, component.upper.theta)
                 .is_empty()
@@ -973,9 +995,23 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             }
         }
         let pieces = self.pieces(energy, component, true);
+        let kinds = if fast_rules {
+            self.chebyshev_kinds(component, &pieces, tol)
+        } else {
+            vec![None; pieces.len()]
+        };
         let mut samples: Vec<PieceSamples> = pieces
             .iter()
-            .map(|p| PieceSamples::new(self, p, energy, START_LEVEL))
+            .zip(&kinds)
+            .map(|(p, kind)| {
+                let chebyshev = kind.and_then(|(kind, least)| {
+                    PieceSamples::chebyshev(self, p, energy, kind, START_LEVEL, least)
+                });
+                match chebyshev {
+                    Some(s) => Ok(s),
+                    None => PieceSamples::new(self, p, energy, START_LEVEL),
+                }
+            })
             .collect::<Result<_>>()?;
         let double = if component.kind == MotionKind::Rotation {
             1.0
@@ -992,11 +1028,26 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         for (piece, sample) in pieces.iter().zip(samples.iter_mut()) {
             // Half of the tolerance for the quadrature, half left for rounding (which the
             // refinement cannot reduce).
-            while sample.error(|n| n.dt)
-                > (0.5 * tol * sample.period(0)).max(0.1 * floor_t * share / double)
+            while sample.level < sample.least_level
+                || sample.error(|n| n.dt)
+                    > (0.5 * tol * sample.period(0)).max(0.1 * floor_t * share / double)
                 || double * sample.error(|n| n.dpsi) / TAU
                     > (0.5 * tol * share).max(0.1 * floor_psi * share / TAU)
             {
+                let chebyshev = sample.rule != Rule::TanhSinh;
+                if chebyshev
+                    && (sample.level >= CHEBYSHEV_LAST_LEVEL
+                        || !sample.refine(self, piece, energy)?)
+                {
+                    // Slow (a near-singular end) or a node outside: tanh-sinh takes over.
+                    let spent = sample.evaluations;
+                    *sample = PieceSamples::new(self, piece, energy, START_LEVEL)?;
+                    sample.evaluations += spent;
+                    continue;
+                }
+                if chebyshev {
+                    continue;
+                }
                 if sample.level >= MAX_LEVEL {
                     converged = false;
                     break;
@@ -1057,8 +1108,14 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 {
                     break;
                 }
+                let mut refined = true;
                 for (piece, sample) in pieces.iter().zip(samples.iter_mut()) {
-                    sample.refine(self, piece, energy)?;
+                    refined &= sample.refine(self, piece, energy)?;
+                }
+                if !refined {
+                    // A Clenshaw–Curtis node outside the allowed set: the drift keeps the
+                    // levels it has, with their estimate.
+                    break;
                 }
                 let psi = double * samples.iter().map(|s| s.psi(0)).sum::<f64>();
                 result = drift_estimate(&samples, psi, double, &mut known);
@@ -1315,6 +1372,135 @@ impl<S: Shape> EffectivePotential<'_, S> {
         })
     }
 
+    /// The Clenshaw–Curtis kind of each piece of a libration cut in two or more, with the
+    /// least level whose differences are trusted (`None`: the tanh-sinh rule): the first
+    /// piece has θ_min, the last θ_max as its turning point.
+    /// Only where the rule is predicted to converge within [`CHEBYSHEV_PLANNED_INTERVALS`]:
+    /// its error falls like ρ^{−N}, ρ = |z + √(z² − 1)| for the singularity z of the
+    /// integrand nearest [−1, 1] in the rule's variable. Those known: a pole beyond a turning
+    /// point (ψ̇ ~ κ/sin²θ), the other zero of ε − V beyond it (a saddle there: its local
+    /// quadratic), and the zeros of ε − V beyond a regular end (its local quadratic: a
+    /// kink's slope, the complex pair ±i√(2(ε − V)/|V″|) of a maximum close to the level), or
+    /// a pole. Never with a narrow peak of 1/J at a piece's end (a split at a zero of U,
+    /// [`Self::splits_inside`]): the rule's coarse levels would all step over it alike.
+    fn chebyshev_kinds(
+        &self,
+        component: &Component,
+        pieces: &[Piece],
+        tol: f64,
+    ) -> Vec<Option<(ChebyshevPiece, u32)>> {
+        let n = pieces.len();
+        let (lower, upper) = (component.lower.theta, component.upper.theta);
+        if component.kind != MotionKind::Libration
+            || n < 2
+            || self.splits_inside(lower, upper).len() != self.kinks_inside(lower, upper).len()
+        {
+            return vec![None; n];
+        }
+        // ρ of a point z of the complex plane of the rule's variable on [−1, 1].
+        let bernstein = |z: Complex<f64>| {
+            let root = (z * z - 1.0).sqrt();
+            (z + root).norm().max((z - root).norm())
+        };
+        // The zeros beyond an end (at outward distance x) of the local model of the gap,
+        // e + a x + ½ c x² (a, c its outward slope and curvature), as complex distances
+        // (real ones only where positive: behind the end the gap is positive).
+        let zeros = |e: f64, a: f64, c: f64| -> Vec<Complex<f64>> {
+            if c == 0.0 || !c.is_finite() {
+                return if a < 0.0 && e > 0.0 {
+                    vec![Complex::new(-e / a, 0.0)]
+                } else {
+                    Vec::new()
+                };
+            }
+            let disc = a * a - 2.0 * e * c;
+            let roots = if disc >= 0.0 {
+                let r = disc.sqrt();
+                vec![
+                    Complex::new((-a + r) / c, 0.0),
+                    Complex::new((-a - r) / c, 0.0),
+                ]
+            } else {
+                let r = (-disc).sqrt() / c;
+                vec![Complex::new(-a / c, r), Complex::new(-a / c, -r)]
+            };
+            roots
+                .into_iter()
+                .filter(|x| x.im != 0.0 || x.re > 0.0)
+                .collect()
+        };
+        // The pole beyond an end (none at κ = 0, where V is smooth through it).
+        let pole = |end: &PieceEnd, left: bool| {
+            (self.kappa != 0.0).then(|| {
+                let distance = if left {
+                    end.site.theta
+                } else {
+                    end.site.from_pi
+                };
+                Complex::new(distance, 0.0)
+            })
+        };
+        // The gap's outward slope and curvature at an end, on the piece's side of a kink.
+        let local = |end: &PieceEnd, left: bool| {
+            let sides = self.curvature_sides_at(end.angle);
+            let curvature = if left { sides[1] } else { sides[0] };
+            let slope = self.slope(end.angle);
+            (if left { slope } else { -slope }, -curvature)
+        };
+        // ρ beyond a regular end, where the variable's dθ/d(variable) is `stretch`.
+        let regular = |end: &PieceEnd, left: bool, stretch: f64| {
+            let (a, c) = local(end, left);
+            zeros(end.excess.max(0.0), a, c)
+                .into_iter()
+                .chain(pole(end, left))
+                .map(|x| bernstein(Complex::new(1.0, 0.0) + x / stretch))
+                .fold(f64::INFINITY, f64::min)
+        };
+        // ρ beyond a turning point of a piece of length L: a point at outward distance x is
+        // at u² = −x/L.
+        let turning = |end: &PieceEnd, left: bool, length: f64| {
+            let (a, c) = local(end, left);
+            zeros(0.0, a, c)
+                .into_iter()
+                .chain(pole(end, left))
+                .map(|x| bernstein((-x / length).sqrt()))
+                .fold(f64::INFINITY, f64::min)
+        };
+        let planned = CHEBYSHEV_PLANNED_INTERVALS as f64;
+        pieces
+            .iter()
+            .enumerate()
+            .map(|(k, p)| {
+                let (kind, rho) = if k == 0 {
+                    let rho = turning(&p.left, true, p.length).min(regular(
+                        &p.right,
+                        false,
+                        2.0 * p.length,
+                    ));
+                    (ChebyshevPiece::TurningLeft, rho)
+                } else if k == n - 1 {
+                    let rho = turning(&p.right, false, p.length).min(regular(
+                        &p.left,
+                        true,
+                        2.0 * p.length,
+                    ));
+                    (ChebyshevPiece::TurningRight, rho)
+                } else {
+                    let rho = regular(&p.left, true, 0.5 * p.length).min(regular(
+                        &p.right,
+                        false,
+                        0.5 * p.length,
+                    ));
+                    (ChebyshevPiece::Regular, rho)
+                };
+                // The intervals the prediction needs; before them a level's differences are
+                // not trusted (the coarse levels of a near-singular end may agree by chance).
+                let needed = -tol.ln() / rho.ln();
+                (needed <= planned).then(|| (kind, needed.max(1.0).log2().ceil() as u32))
+            })
+            .collect()
+    }
+
     /// The pieces of a component: cut at the ends and, if `cut`, at every interior maximum or
     /// tangency and at every kink of U (kinks within a libration measured from its turning
     /// points, [`EffectivePotential::kink_end_from_turning_point`]).
@@ -1418,36 +1604,61 @@ fn drift_estimate(
         known.push((key, value));
         value
     };
-    DriftEstimate::from_levels(level(0), level(1), level(2), Convergence::Unknown)
+    // Clenshaw–Curtis pieces in their geometric regime: the cosine rule's trust (the
+    // drift's integrand is as analytic as T's and Δψ's on each piece).
+    let rate = if samples.iter().all(PieceSamples::geometric) {
+        Convergence::Geometric
+    } else {
+        Convergence::Unknown
+    };
+    DriftEstimate::from_levels(level(0), level(1), level(2), rate)
 }
 
 /// Drift sums already made (Δζ and its path scale), by the pieces' levels.
 type KnownDrifts = Vec<(Vec<u32>, ([f64; 2], f64))>;
 
 /// Δζ and the L1 size of its integrand from every `stride`-th node of each piece's samples.
+/// A Clenshaw–Curtis piece whose left end is θ_min ([`ChebyshevPiece::TurningLeft`]) takes
+/// the way out and the way back apart: continued to u < 0, the way out is the previous
+/// period's way back, e^{−iΔψ} times this one's, and the rule's weights of ∫ over [0, 1] at
+/// the mirrored nodes (v_{N−j}) carry that factor; elsewhere the two ways join smoothly (at
+/// θ_max, or within the piece) and the sum of both is integrated at once.
 fn drift_sum(
     samples: &[PieceSamples],
     psi_advance: f64,
     double: f64,
     stride: usize,
 ) -> ([f64; 2], f64) {
+    let stride_exp = stride.trailing_zeros();
     let (sa, ca) = psi_advance.sin_cos();
     let (mut re, mut im, mut scale) = (0.0, 0.0, 0.0);
     let mut psi_offset = 0.0;
+    let mut psi = Vec::new();
     for s in samples {
-        let step = s.step() * stride as f64;
-        let nodes: Vec<&NodeSample> = s.nodes.iter().step_by(stride).collect();
-        let rates: Vec<f64> = nodes.iter().map(|n| n.dpsi).collect();
-        let psi = spectral_antiderivative(&rates, step);
-        for (n, &p) in nodes.iter().zip(&psi) {
+        s.psi_along(stride_exp, &mut psi);
+        let weights = s.weights(stride_exp);
+        let mirror = (s.rule == Rule::Chebyshev(ChebyshevPiece::TurningLeft))
+            .then(|| &ChebyshevLevel::get(s.level - stride_exp).turning_left_mirror);
+        for (i, (n, &p)) in s.nodes.iter().step_by(stride).zip(&psi).enumerate() {
+            let step = weights.at(i);
             let (sp, cp) = libm::sincos(psi_offset + p);
             // E = e^{iψ}, F = e^{i(Δψ − ψ)} = e^{iΔψ} conj(E).
             let (fr, fi) = (ca * cp + sa * sp, sa * cp - ca * sp);
             let (along, across) = (n.along, n.across);
             if double == 2.0 {
-                // −[along (E + F) + i across (E − F)]
-                re -= step * (along * (cp + fr) - across * (sp - fi));
-                im -= step * (along * (sp + fi) + across * (cp - fr));
+                // −[along (E + F) + i across (E − F)]: the way out −E (along + i across),
+                // the way back −F (along − i across).
+                let out = [-(along * cp - across * sp), -(along * sp + across * cp)];
+                let back = [-(along * fr + across * fi), -(along * fi - across * fr)];
+                re += step * (out[0] + back[0]);
+                im += step * (out[1] + back[1]);
+                if let Some(mirror) = mirror {
+                    // + b [(e^{iΔψ} − 1) out + (e^{−iΔψ} − 1) back].
+                    let b = mirror[i];
+                    let (rc, rs) = (ca - 1.0, sa);
+                    re += b * (rc * out[0] - rs * out[1] + rc * back[0] + rs * back[1]);
+                    im += b * (rc * out[1] + rs * out[0] + rc * back[1] - rs * back[0]);
+                }
             } else {
                 // Rotation: one way round, −[along + i across] E.
                 re -= step * (along * cp - across * sp);
@@ -1526,6 +1737,14 @@ pub struct PeriodIntegrals {
 /// tanh-sinh nodes (the last at e^{−π sinh 4} ≈ 6e-38 of the piece).
 const HIDDEN_PEAK: f64 = 1e-30;
 
+/// The finest Clenshaw–Curtis level tried for T and Δψ (N = 256, 129 nodes on a piece with
+/// a turning point) before the tanh-sinh rule takes the piece over.
+const CHEBYSHEV_LAST_LEVEL: u32 = 8;
+
+/// The Clenshaw–Curtis intervals within which a piece must be predicted to converge for
+/// the rule to be tried (see `EffectivePotential::chebyshev_kinds`).
+const CHEBYSHEV_PLANNED_INTERVALS: usize = 128;
+
 /// The first level, the coarsest at which the level differences are trusted: its two levels
 /// below (steps ½ and ¼ in τ) are then past the first, pre-asymptotic ones.
 const START_LEVEL: u32 = 4;
@@ -1573,10 +1792,33 @@ struct NodeSample {
     rounding: f64,
 }
 
-/// The samples of one piece on its current tanh-sinh level (the level below is every other
-/// node).
+/// Which rules [`EffectivePotential::integrate_by`] may use.
+#[doc(hidden)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Rules {
+    /// The cheapest that converges (as [`EffectivePotential::integrate`]).
+    Fastest,
+    /// The tanh-sinh rule on every piece.
+    TanhSinhOnly,
+}
+
+/// The rule a piece is integrated by.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Rule {
+    /// Tanh-sinh in τ: any end singularity, level differences trusted only to d₁.
+    TanhSinh,
+    /// Clenshaw–Curtis ([`ChebyshevPiece`]): an analytic piece whose only end singularity is
+    /// a turning point's inverse square root, at a fraction of the tanh-sinh nodes.
+    Chebyshev(ChebyshevPiece),
+}
+
+/// The samples of one piece on its current level of its rule (the level below is every
+/// other node).
 struct PieceSamples {
+    rule: Rule,
     level: u32,
+    /// The least level whose differences are trusted.
+    least_level: u32,
     nodes: Vec<NodeSample>,
     evaluations: usize,
 }
@@ -1600,22 +1842,64 @@ impl PieceSamples {
             })
             .collect::<Result<Vec<_>>>()?;
         Ok(Self {
+            rule: Rule::TanhSinh,
             level,
+            least_level: 0,
             evaluations: nodes.len(),
             nodes,
         })
     }
 
-    fn step(&self) -> f64 {
-        TanhSinhLevel::new(self.level).step
+    /// The Clenshaw–Curtis samples of `kind` on `level` (trusted from `least_level`), or
+    /// `None` where a node is not inside the allowed set or the turning point is too flat
+    /// for its limit.
+    fn chebyshev<S: Shape>(
+        v: &EffectivePotential<'_, S>,
+        piece: &Piece,
+        energy: f64,
+        kind: ChebyshevPiece,
+        level: u32,
+        least_level: u32,
+    ) -> Option<Self> {
+        let nodes = (0..kind.count(level))
+            .map(|i| chebyshev_sample(v, piece, energy, kind, level, i))
+            .collect::<Option<Vec<_>>>()?;
+        Some(Self {
+            rule: Rule::Chebyshev(kind),
+            level,
+            least_level,
+            evaluations: nodes.len(),
+            nodes,
+        })
+    }
+
+    /// The quadrature weight of node `i` (of this level) on the level 2^`stride_exp` times
+    /// coarser, whose nodes are every 2^`stride_exp`-th.
+    #[inline]
+    fn weights(&self, stride_exp: u32) -> Weights {
+        match self.rule {
+            Rule::TanhSinh => {
+                Weights::Uniform(TanhSinhLevel::new(self.level).step * (1u32 << stride_exp) as f64)
+            }
+            Rule::Chebyshev(kind) => {
+                Weights::Table(&ChebyshevLevel::get(self.level - stride_exp).piece[kind as usize])
+            }
+        }
     }
 
     /// The sum of `f` over every 2^`stride_exp`-th node (0: this level; 1: the level below),
-    /// times the step of that level.
+    /// times that level's weights.
     fn sum(&self, stride_exp: u32, f: impl Fn(&NodeSample) -> f64) -> f64 {
         let stride = 1usize << stride_exp;
-        let total: CompensatedSum = self.nodes.iter().step_by(stride).map(f).sum();
-        self.step() * stride as f64 * total.value()
+        let nodes = self.nodes.iter().step_by(stride);
+        match self.weights(stride_exp) {
+            Weights::Uniform(step) => step * nodes.map(f).sum::<CompensatedSum>().value(),
+            Weights::Table(w) => nodes
+                .zip(w)
+                .map(|(n, w)| w * f(n))
+                .sum::<CompensatedSum>()
+                .value(),
+        }
     }
 
     fn period(&self, stride_exp: u32) -> f64 {
@@ -1626,36 +1910,153 @@ impl PieceSamples {
         self.sum(stride_exp, |n| n.dpsi)
     }
 
-    /// Error of the sum of `f`: see [`level_error`], plus the tail beyond |τ| = TAU_MAX.
+    /// Error of the sum of `f`: see [`level_error`]; for tanh-sinh plus the tail beyond
+    /// |τ| = TAU_MAX, for Clenshaw–Curtis with the geometric rate trusted where a fourth
+    /// level shows one rate ([`cosine::single_rate`]).
     fn error(&self, f: impl Fn(&NodeSample) -> f64) -> f64 {
-        let tail = self.step() * (f(&self.nodes[0]).abs() + f(self.nodes.last().unwrap()).abs());
-        level_error(
-            [self.sum(0, &f), self.sum(1, &f), self.sum(2, &f)],
-            Convergence::Unknown,
-        ) + tail
+        let sums = [self.sum(0, &f), self.sum(1, &f), self.sum(2, &f)];
+        match self.rule {
+            Rule::TanhSinh => {
+                let tail = TanhSinhLevel::new(self.level).step
+                    * (f(&self.nodes[0]).abs() + f(self.nodes.last().unwrap()).abs());
+                level_error(sums, Convergence::Unknown) + tail
+            }
+            Rule::Chebyshev(_) => {
+                let rate = if self.level >= 4 && cosine::single_rate(self.sum(3, &f), sums) {
+                    Convergence::Geometric
+                } else {
+                    Convergence::Unknown
+                };
+                level_error(sums, rate)
+            }
+        }
     }
 
-    /// Σ ½ (relative gap error) |f| step: the gap enters t′ as (ε − V)^{−1/2}.
+    /// Whether the levels are a Clenshaw–Curtis rule's in one geometric regime (T's and Δψ's
+    /// sums on four levels, [`cosine::single_rate`]).
+    fn geometric(&self) -> bool {
+        matches!(self.rule, Rule::Chebyshev(_))
+            && self.level >= 4
+            && [|n: &NodeSample| n.dt, |n: &NodeSample| n.dpsi]
+                .iter()
+                .all(|f| {
+                    let sums = [self.sum(0, f), self.sum(1, f), self.sum(2, f)];
+                    cosine::single_rate(self.sum(3, f), sums)
+                })
+    }
+
+    /// Σ ½ (relative gap error) |f| weight: the gap enters t′ as (ε − V)^{−1/2}.
     fn rounding(&self, f: impl Fn(&NodeSample) -> f64) -> f64 {
         self.sum(0, |n| 0.5 * n.rounding * f(n).abs())
     }
 
-    /// Halve the step: keep the old nodes (now the even ones) and add the odd ones.
+    /// Halve the step: keep the old nodes (now the even ones) and add the odd ones. `false`
+    /// (the nodes left half-made) where a Clenshaw–Curtis node is not in the allowed set.
     fn refine<S: Shape>(
         &mut self,
         v: &EffectivePotential<'_, S>,
         piece: &Piece,
         energy: f64,
-    ) -> Result<()> {
+    ) -> Result<bool> {
         self.level += 1;
         let level = self.level;
-        interleave(&mut self.nodes, |j| {
-            let node = IntervalNode::tanh_sinh_tabulated(level, j, piece.length);
-            sample(v, piece, energy, node)
-        })?;
+        match self.rule {
+            Rule::TanhSinh => interleave(&mut self.nodes, |j| {
+                let node = IntervalNode::tanh_sinh_tabulated(level, j, piece.length);
+                sample(v, piece, energy, node)
+            })?,
+            Rule::Chebyshev(kind) => {
+                let made = interleave(&mut self.nodes, |i| {
+                    chebyshev_sample(v, piece, energy, kind, level, i).ok_or(
+                        AtlasError::NotPeriodic {
+                            reason: "a quadrature node fell outside the allowed set",
+                        },
+                    )
+                });
+                if made.is_err() {
+                    return Ok(false);
+                }
+            }
+        }
         self.evaluations += self.nodes.len() / 2;
-        Ok(())
+        Ok(true)
     }
+
+    /// ψ from the piece's left end at every `stride`-th node (the cumulative integral of
+    /// ψ̇ dt on that level), into `out`.
+    fn psi_along(&self, stride_exp: u32, out: &mut Vec<f64>) {
+        let stride = 1usize << stride_exp;
+        let rates = self.nodes.iter().step_by(stride).map(|n| n.dpsi);
+        out.clear();
+        match self.rule {
+            Rule::TanhSinh => {
+                let rates: Vec<f64> = rates.collect();
+                let step = TanhSinhLevel::new(self.level).step * stride as f64;
+                out.extend(spectral_antiderivative(&rates, step));
+            }
+            Rule::Chebyshev(kind) => {
+                let level = self.level - stride_exp;
+                let n = 1usize << level;
+                // The rates at x_j = cos(jπ/N), j = 0 … N (a half piece's continued evenly).
+                let mut values = vec![0.0; n + 1];
+                for (i, rate) in rates.enumerate() {
+                    let j = kind.chebyshev_index(level, i);
+                    values[j] = rate;
+                    if kind != ChebyshevPiece::Regular {
+                        values[n - j] = rate;
+                    }
+                }
+                let mut q = vec![0.0; n + 1];
+                chebyshev_antiderivative(&values, &mut q);
+                let count = kind.count(level);
+                out.extend((0..count).map(|i| {
+                    let j = kind.chebyshev_index(level, i);
+                    match kind {
+                        // ∫ from x = −1 (j = N).
+                        ChebyshevPiece::Regular => q[j],
+                        // ∫ from u = 0 (j = N/2) up to u_j.
+                        ChebyshevPiece::TurningLeft => q[j] - q[n / 2],
+                        // ∫ from u = 1 (j = 0) down to u_j.
+                        ChebyshevPiece::TurningRight => q[0] - q[j],
+                    }
+                }));
+            }
+        }
+    }
+}
+
+/// A level's quadrature weights.
+enum Weights {
+    Uniform(f64),
+    Table(&'static [f64]),
+}
+
+impl Weights {
+    #[inline]
+    fn at(&self, i: usize) -> f64 {
+        match self {
+            Weights::Uniform(step) => *step,
+            Weights::Table(w) => w[i],
+        }
+    }
+}
+
+/// The integrands at node `i` of a Clenshaw–Curtis piece; at the turning point their limit
+/// (see `cosine::end_sample`: θ − θ_e = L u², so ℓ = 4L).
+fn chebyshev_sample<S: Shape>(
+    v: &EffectivePotential<'_, S>,
+    piece: &Piece,
+    energy: f64,
+    kind: ChebyshevPiece,
+    level: u32,
+    i: usize,
+) -> Option<NodeSample> {
+    if kind.turning_node(level) == Some(i) {
+        let left = kind == ChebyshevPiece::TurningLeft;
+        return cosine::end_sample_with_length(v, piece, 4.0 * piece.length, left);
+    }
+    let node = IntervalNode::chebyshev_tabulated(kind, level, i, piece.length);
+    sample(v, piece, energy, node).ok()
 }
 
 /// The nodes of the next finer level of a nested rule, in place: the old ones become the

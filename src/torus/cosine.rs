@@ -262,7 +262,7 @@ impl Samples {
 /// B = 1/η + |r|² dips to 0.1 at θ = ±π/2 and has complex zeros 0.066 off the real axis: the
 /// ratios 0.25, 0.042, 1.4e-5 were followed by 0.33 instead of a thousandth, and the error
 /// of T at n = 256 was 3.3 times its estimate). Such levels are not trusted beyond d₁.
-fn single_rate(coarsest: f64, sums: [f64; 3]) -> bool {
+pub(super) fn single_rate(coarsest: f64, sums: [f64; 3]) -> bool {
     let [i0, i1, i2] = sums;
     let (d1, d2, d3) = ((i0 - i1).abs(), (i1 - i2).abs(), (i2 - coarsest).abs());
     if d2 == 0.0 || d3 == 0.0 {
@@ -420,6 +420,16 @@ fn end_sample<S: Shape>(
     map: &Map,
     left: bool,
 ) -> Option<NodeSample> {
+    end_sample_with_length(v, piece, map.end_length(piece, left), left)
+}
+
+/// [`end_sample`] of a substitution with θ − θ_end ≈ ℓ φ²/4 near the end, ℓ = `end_length`.
+pub(super) fn end_sample_with_length<S: Shape>(
+    v: &EffectivePotential<'_, S>,
+    piece: &Piece,
+    end_length: f64,
+    left: bool,
+) -> Option<NodeSample> {
     let end = if left { &piece.left } else { &piece.right };
     if end.excess != 0.0 {
         return None;
@@ -436,7 +446,7 @@ fn end_sample<S: Shape>(
     if g.is_nan() || g <= 1e3 * g_error {
         return None;
     }
-    let dt = root_of_ratio(red.reduced_inertia, map.end_length(piece, left), 2.0 * g);
+    let dt = root_of_ratio(red.reduced_inertia, end_length, 2.0 * g);
     Some(weighted(v, a, &red, dt, 0.0, g_error / g))
 }
 

@@ -63,6 +63,20 @@ fn ellipse_table(beta: f64, n: usize) -> Vec<Vec<f64>> {
         .collect()
 }
 
+/// The egg of atlas/egg.toml: 8 points of its meridian, a sharp rim round its top.
+pub fn egg_with_a_rim() -> Vec<Vec<f64>> {
+    vec![
+        vec![0.0, -1.0],
+        vec![0.45, -0.92],
+        vec![0.8, -0.62],
+        vec![0.98, -0.2],
+        vec![0.97, 0.25],
+        vec![0.8, 0.62, 1.0],
+        vec![0.4, 0.8],
+        vec![0.0, 0.86],
+    ]
+}
+
 fn profile_shape(table: &[Vec<f64>], alpha: f64) -> ProfileShape {
     ProfileShape::new(Profile::from_points(table).unwrap(), alpha).unwrap()
 }
@@ -302,17 +316,7 @@ fn cells_of_a_cut_balls_table_are_the_cut_balls_cells() {
 /// of the full equations, which know the body only by its contact point r(γ).
 #[test]
 fn cells_of_a_profile_agree_with_the_full_equations() {
-    let table = vec![
-        vec![0.0, -1.0],
-        vec![0.45, -0.92],
-        vec![0.8, -0.62],
-        vec![0.98, -0.2],
-        vec![0.97, 0.25],
-        vec![0.8, 0.62, 1.0],
-        vec![0.4, 0.8],
-        vec![0.0, 0.86],
-    ];
-    let body = Body::new(profile_shape(&table, -0.1), 0.8, 1.7).unwrap();
+    let body = Body::new(profile_shape(&egg_with_a_rim(), -0.1), 0.8, 1.7).unwrap();
     for (kappa, theta0) in [(0.5, 0.6), (0.9, 2.2), (0.3, 1.4)] {
         let start = Start {
             kappa,
@@ -445,16 +449,7 @@ fn tables_that_are_no_convex_meridian_are_refused() {
 /// of mass n·|Δζ| from its start in n periods, on a torus that crosses the rim's kink.
 #[test]
 fn a_resonant_profile_runs_away_in_the_full_equations() {
-    let table = vec![
-        vec![0.0, -1.0],
-        vec![0.45, -0.92],
-        vec![0.8, -0.62],
-        vec![0.98, -0.2],
-        vec![0.97, 0.25],
-        vec![0.8, 0.62, 1.0],
-        vec![0.4, 0.8],
-        vec![0.0, 0.86],
-    ];
+    let table = egg_with_a_rim();
     let body = Body::new(profile_shape(&table, -0.1), 0.8, 1.7).unwrap();
     // The rim's kink, where the normal starts to turn round the edge.
     let rim = Profile::from_points(&table)

@@ -389,6 +389,120 @@ mod quadrature {
             assert!((value - exact).abs() < 1e-13, "{value} vs {exact}");
         }
     }
+
+    /// The Clenshaw–Curtis tables: exact for polynomials up to degree N on [−1, 1] and on
+    /// [0, 1]; the weights of the two halves add up to the whole rule's.
+    #[test]
+    fn clenshaw_curtis_weights_integrate_polynomials_exactly() {
+        for level in 1..=FINEST_CHEBYSHEV_LEVEL {
+            let rule = ChebyshevLevel::get(level);
+            let n = 1usize << level;
+            let x = |j: usize| (std::f64::consts::PI * j as f64 / n as f64).cos();
+            for degree in [0, 1, 2, n.min(7), n] {
+                let f = |t: f64| t.powi(degree as i32) + 0.5 * t;
+                let whole: f64 = (0..=n).map(|j| rule.whole[j] * f(x(j))).sum();
+                let half: f64 = (0..=n).map(|j| rule.upper_half[j] * f(x(j))).sum();
+                let d = degree as f64;
+                let exact_whole = if degree % 2 == 0 {
+                    2.0 / (d + 1.0)
+                } else {
+                    0.0
+                };
+                let exact_half = 1.0 / (d + 1.0) + 0.25;
+                assert!(
+                    (whole - exact_whole).abs() < 1e-13,
+                    "level {level} degree {degree}: {whole}"
+                );
+                assert!(
+                    (half - exact_half).abs() < 1e-13,
+                    "level {level} degree {degree}: {half}"
+                );
+            }
+            for j in 0..=n {
+                let both = rule.upper_half[j] + rule.upper_half[n - j];
+                assert!((both - rule.whole[j]).abs() < 1e-15 && rule.whole[j] > 0.0);
+            }
+        }
+    }
+
+    /// The half rule of a piece with a turning point: ∫ over [0, 1] of dθ/√(θ (1 + θ)) ... with
+    /// θ = u², in the nodes of each kind, converging geometrically to 2 asinh(1); the whole
+    /// rule on x: ∫ eˣ over [0, 2].
+    #[test]
+    fn clenshaw_curtis_pieces_converge_geometrically() {
+        let exact = 2.0 * 1f64.asinh();
+        for kind in [ChebyshevPiece::TurningLeft, ChebyshevPiece::TurningRight] {
+            let rule = |level: u32| -> f64 {
+                let weights = &ChebyshevLevel::get(level).piece[kind as usize];
+                (0..kind.count(level))
+                    .map(|i| {
+                        let node = IntervalNode::chebyshev_tabulated(kind, level, i, 1.0);
+                        let theta = if kind == ChebyshevPiece::TurningLeft {
+                            node.from_left
+                        } else {
+                            node.from_right
+                        };
+                        // dθ/du / √θ = 2 u / u = 2 (its limit at the turning point).
+                        let value = if Some(i) == kind.turning_node(level) {
+                            2.0
+                        } else {
+                            node.jacobian / theta.sqrt()
+                        };
+                        weights[i] * value / (1.0 + theta).sqrt()
+                    })
+                    .sum()
+            };
+            assert!((rule(2) - exact).abs() > 1e-4, "{kind:?}");
+            assert!(
+                (rule(5) - exact).abs() < 1e-10,
+                "{kind:?}: {}",
+                rule(5) - exact
+            );
+            assert!(
+                (rule(7) - exact).abs() < 2e-15,
+                "{kind:?}: {}",
+                rule(7) - exact
+            );
+        }
+        let kind = ChebyshevPiece::Regular;
+        let weights = &ChebyshevLevel::get(4).piece[kind as usize];
+        let sum: f64 = (0..kind.count(4))
+            .map(|i| {
+                let node = IntervalNode::chebyshev_tabulated(kind, 4, i, 2.0);
+                weights[i] * node.jacobian * node.from_left.exp()
+            })
+            .sum();
+        let exact = 2f64.exp() - 1.0;
+        assert!((sum - exact).abs() < 1e-14, "{}", sum - exact);
+    }
+
+    #[test]
+    fn chebyshev_antiderivative_matches_a_closed_form() {
+        for level in [1, 3, 6] {
+            let n = 1usize << level;
+            let x: Vec<f64> = (0..=n)
+                .map(|j| (std::f64::consts::PI * j as f64 / n as f64).cos())
+                .collect();
+            let values: Vec<f64> = x.iter().map(|t| t * t * t + 2.0 * t).collect();
+            let mut out = vec![0.0; n + 1];
+            chebyshev_antiderivative(&values, &mut out);
+            for (t, q) in x.iter().zip(&out) {
+                let exact = |t: f64| 0.25 * t.powi(4) + t * t;
+                let exact = exact(*t) - exact(-1.0);
+                if level > 1 {
+                    assert!((q - exact).abs() < 1e-14, "level {level}: {q} vs {exact}");
+                }
+            }
+            let values: Vec<f64> = x.iter().map(|t| t.exp()).collect();
+            chebyshev_antiderivative(&values, &mut out);
+            if level == 6 {
+                for (t, q) in x.iter().zip(&out) {
+                    let exact = t.exp() - (-1f64).exp();
+                    assert!((q - exact).abs() < 1e-14, "{q} vs {exact}");
+                }
+            }
+        }
+    }
 }
 
 mod double_double {
