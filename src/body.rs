@@ -242,6 +242,15 @@ pub trait Shape: Send + Sync {
         1.0
     }
 
+    /// A bound on the error of U as the body is held in doubles, beyond the rounding of its
+    /// evaluation: 0 where the shape's parameters are its inputs; a profile's arcs, fitted
+    /// through its points, carry the fit's rounding
+    /// ([`crate::body::profile::ProfileShape`]). It acts on the cell as an error of the
+    /// energy ([`crate::cell`]'s level offset).
+    fn representation_error(&self) -> f64 {
+        0.0
+    }
+
     /// The θ in (0, π) where U = 0: where the centre of mass lies off the body (the disk with
     /// α ≠ 0, a cut ball with its edge down and h + α < 0, …) it is at the plane's height
     /// there. J² = (cos²θ + ν sin²θ)/η + U² is least there, and the integrands, ∝ 1/J, may

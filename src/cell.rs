@@ -590,10 +590,16 @@ fn level_offset_error<S: Shape>(
     // A priori: the rounding of ε − V(c) and of each turning point (an ulp of θ in its
     // chart), as the common shift and as the spread of the two ends.
     let root = |i: usize| 2.0 * eps * sites[i].ulp_scale() * rates[i].1 .0.abs();
-    let a_priori = 4.0 * eps * (scale + energy.abs()) + root(0) + root(1);
     let length = potential
         .separation(&component.lower, &component.upper)
         .abs();
+    // The body's own representation error δU acts as an error of the level: up to its bound
+    // in common, and between the two ends by at most its variation over the libration,
+    // δU′ times its length, where (as a profile's) δU is the fitted arcs' error, a sum of
+    // sinusoids of θ (centre and radius errors) whose slopes are bounded by their sizes.
+    let represented = potential.body.shape.representation_error();
+    let represented_spread = represented * length.min(2.0);
+    let a_priori = 4.0 * eps * (scale + energy.abs()) + root(0) + root(1);
     // Away from the poles (at an end near a pole ψ̇ peaks in a sliver of time whose share
     // the relative bounds cover): ∫|ψ̇| dt ≤ T max|ψ̇|, and the shift of the orbit by the
     // rounding of each turning point to a double (an ulp in its chart) moves Δψ by
@@ -704,8 +710,8 @@ fn level_offset_error<S: Shape>(
             + eps * rise.abs()
             + rounding;
         Some((
-            s_lower.abs().max(s_upper.abs()) + step,
-            (s_lower - s_upper).abs() + step,
+            s_lower.abs().max(s_upper.abs()) + step + represented,
+            (s_lower - s_upper).abs() + step + represented_spread,
         ))
     };
     // The crude bound is kept (away from a pole) where it is far below the tolerance, or
@@ -734,11 +740,12 @@ fn level_offset_error<S: Shape>(
     // scale it is the drift's).
     let saddle_small =
         values.saddle[0] <= 0.05 * tol * values.period && values.saddle[1] <= 0.05 * tol;
-    let (mut crude, mut tilted, mut depth) = bounds(a_priori, a_priori);
+    let (mut crude, mut tilted, mut depth) =
+        bounds(a_priori + represented, a_priori + represented_spread);
     if enough(&crude, &tilted, false, raw) && saddle_small {
         return crude.plus(tilted);
     }
-    let mut delta = a_priori;
+    let mut delta = a_priori + represented;
     if let Some((common, spread)) = sharp() {
         delta = common;
         (crude, tilted, depth) = bounds(common, spread);

@@ -2,8 +2,9 @@
 //! cosine substitution x = a + L (1 − cos φ)/2, geometrically convergent for an integrand
 //! whose only end singularities are inverse square roots; the tanh-sinh (double-exponential)
 //! rule, which absorbs any integrable end singularity and clusters its nodes at near-singular
-//! ends; and the spectral antiderivative and FFTs that give cumulative integrals (ψ along the
-//! orbit) from the same nodes to the same accuracy.
+//! ends; the Clenshaw–Curtis rule for the pieces of a libration cut at kinks (beside a turning
+//! point after θ − θ_t = ±L u²); and the spectral and Chebyshev antiderivatives and FFTs that
+//! give cumulative integrals (ψ along the orbit) from the same nodes to the same accuracy.
 
 use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
 use rustfft::num_complex::Complex;
@@ -357,11 +358,7 @@ impl ChebyshevLevel {
                 })
                 .collect()
         };
-        let (whole, upper_half) = if level == 0 {
-            (vec![1.0, 1.0], vec![0.5, 0.5])
-        } else {
-            (weights(&whole_moment), weights(&half_moment))
-        };
+        let (whole, upper_half) = (weights(&whole_moment), weights(&half_moment));
         let piece = [
             ChebyshevPiece::Regular,
             ChebyshevPiece::TurningLeft,

@@ -1110,11 +1110,14 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 }
                 let mut refined = true;
                 for (piece, sample) in pieces.iter().zip(samples.iter_mut()) {
-                    refined &= sample.refine(self, piece, energy)?;
+                    if !sample.refine(self, piece, energy)? {
+                        refined = false;
+                        break;
+                    }
                 }
                 if !refined {
                     // A Clenshaw–Curtis node outside the allowed set: the drift keeps the
-                    // levels it has, with their estimate.
+                    // estimate it has.
                     break;
                 }
                 let psi = double * samples.iter().map(|s| s.psi(0)).sum::<f64>();
@@ -1372,17 +1375,18 @@ impl<S: Shape> EffectivePotential<'_, S> {
         })
     }
 
-    /// The Clenshaw–Curtis kind of each piece of a libration cut in two or more, with the
-    /// least level whose differences are trusted (`None`: the tanh-sinh rule): the first
-    /// piece has θ_min, the last θ_max as its turning point.
-    /// Only where the rule is predicted to converge within [`CHEBYSHEV_PLANNED_INTERVALS`]:
-    /// its error falls like ρ^{−N}, ρ = |z + √(z² − 1)| for the singularity z of the
-    /// integrand nearest [−1, 1] in the rule's variable. Those known: a pole beyond a turning
-    /// point (ψ̇ ~ κ/sin²θ), the other zero of ε − V beyond it (a saddle there: its local
-    /// quadratic), and the zeros of ε − V beyond a regular end (its local quadratic: a
-    /// kink's slope, the complex pair ±i√(2(ε − V)/|V″|) of a maximum close to the level), or
-    /// a pole. Never with a narrow peak of 1/J at a piece's end (a split at a zero of U,
-    /// [`Self::splits_inside`]): the rule's coarse levels would all step over it alike.
+    /// The Clenshaw–Curtis kind of each piece of a libration across a kink, with the least
+    /// level whose differences are trusted (`None`: the tanh-sinh rule): the first piece has
+    /// θ_min, the last θ_max as its turning point (a libration with no kink inside, or with a
+    /// narrow peak of 1/J, stays with the tanh-sinh rule). Only where the rule is predicted to
+    /// converge within [`CHEBYSHEV_PLANNED_INTERVALS`]: its error falls like ρ^{−N},
+    /// ρ = |z + √(z² − 1)| for the singularity z of the integrand nearest [−1, 1] in the
+    /// rule's variable. Those located: a pole beyond an end (ψ̇ ~ κ/sin²θ); the other zero of
+    /// ε − V beyond a turning point (a saddle there), from its local quadratic; the zeros of
+    /// ε − V beyond any other end (a kink, or a maximum or tangency the piece is cut at) from
+    /// its local quadratic (V′ and the piece's side of V″: ±i√(2(ε − V)/|V″|) at a maximum)
+    /// and, should both nearly vanish (a near-shoulder, a flat maximum), from the cubic term,
+    /// with |V‴| taken as 6 times V's scale there.
     fn chebyshev_kinds(
         &self,
         component: &Component,
@@ -1391,9 +1395,11 @@ impl<S: Shape> EffectivePotential<'_, S> {
     ) -> Vec<Option<(ChebyshevPiece, u32)>> {
         let n = pieces.len();
         let (lower, upper) = (component.lower.theta, component.upper.theta);
+        let kinks = self.kinks_inside(lower, upper);
         if component.kind != MotionKind::Libration
             || n < 2
-            || self.splits_inside(lower, upper).len() != self.kinks_inside(lower, upper).len()
+            || kinks.is_empty()
+            || self.splits_inside(lower, upper).len() != kinks.len()
         {
             return vec![None; n];
         }
@@ -1440,20 +1446,30 @@ impl<S: Shape> EffectivePotential<'_, S> {
                 Complex::new(distance, 0.0)
             })
         };
-        // The gap's outward slope and curvature at an end, on the piece's side of a kink.
+        // The gap's outward slope and curvature at an end, on the piece's side of a kink
+        // (the sides are ordered by |θ|: mirrored where a lifted angle has sin θ < 0).
         let local = |end: &PieceEnd, left: bool| {
             let sides = self.curvature_sides_at(end.angle);
-            let curvature = if left { sides[1] } else { sides[0] };
+            let inside = usize::from(left == (end.angle.sin >= 0.0));
             let slope = self.slope(end.angle);
-            (if left { slope } else { -slope }, -curvature)
+            (if left { slope } else { -slope }, -sides[inside])
         };
-        // ρ beyond a regular end, where the variable's dθ/d(variable) is `stretch`.
-        let regular = |end: &PieceEnd, left: bool, stretch: f64| {
+        // The cubic term's zeros, at d = (6 e / |V‴|)^{1/3} in the three directions of the
+        // cube roots of −1 that face outwards.
+        let cubic = |end: &PieceEnd| -> [Complex<f64>; 3] {
+            let third = 6.0 * self.value_scale(end.angle);
+            let d = (6.0 * end.excess.max(0.0) / third).cbrt();
+            let r = Complex::from_polar(d, std::f64::consts::FRAC_PI_3);
+            [Complex::new(d, 0.0), r, r.conj()]
+        };
+        // ρ beyond a kink, the rule's variable there z(x) for an outward distance x.
+        let regular = |end: &PieceEnd, left: bool, z: &dyn Fn(Complex<f64>) -> Complex<f64>| {
             let (a, c) = local(end, left);
             zeros(end.excess.max(0.0), a, c)
                 .into_iter()
+                .chain(cubic(end))
                 .chain(pole(end, left))
-                .map(|x| bernstein(Complex::new(1.0, 0.0) + x / stretch))
+                .map(|x| bernstein(z(x)))
                 .fold(f64::INFINITY, f64::min)
         };
         // ρ beyond a turning point of a piece of length L: a point at outward distance x is
@@ -1471,26 +1487,19 @@ impl<S: Shape> EffectivePotential<'_, S> {
             .iter()
             .enumerate()
             .map(|(k, p)| {
+                let length = p.length;
+                // Beside a turning point the far end is u = 1: θ − θ_t = L u², so a point x
+                // beyond it is at u = √(1 + x/L); between kinks x = 1 + 2x/L.
+                let half = |x: Complex<f64>| (1.0 + x / length).sqrt();
+                let whole = |x: Complex<f64>| 1.0 + 2.0 * x / length;
                 let (kind, rho) = if k == 0 {
-                    let rho = turning(&p.left, true, p.length).min(regular(
-                        &p.right,
-                        false,
-                        2.0 * p.length,
-                    ));
+                    let rho = turning(&p.left, true, length).min(regular(&p.right, false, &half));
                     (ChebyshevPiece::TurningLeft, rho)
                 } else if k == n - 1 {
-                    let rho = turning(&p.right, false, p.length).min(regular(
-                        &p.left,
-                        true,
-                        2.0 * p.length,
-                    ));
+                    let rho = turning(&p.right, false, length).min(regular(&p.left, true, &half));
                     (ChebyshevPiece::TurningRight, rho)
                 } else {
-                    let rho = regular(&p.left, true, 0.5 * p.length).min(regular(
-                        &p.right,
-                        false,
-                        0.5 * p.length,
-                    ));
+                    let rho = regular(&p.left, true, &whole).min(regular(&p.right, false, &whole));
                     (ChebyshevPiece::Regular, rho)
                 };
                 // The intervals the prediction needs; before them a level's differences are
@@ -1873,8 +1882,8 @@ impl PieceSamples {
         })
     }
 
-    /// The quadrature weight of node `i` (of this level) on the level 2^`stride_exp` times
-    /// coarser, whose nodes are every 2^`stride_exp`-th.
+    /// The quadrature weights of the level 2^`stride_exp` times coarser, whose nodes are
+    /// every 2^`stride_exp`-th of this level's (indexed by that level's nodes).
     #[inline]
     fn weights(&self, stride_exp: u32) -> Weights {
         match self.rule {
@@ -1951,7 +1960,7 @@ impl PieceSamples {
     }
 
     /// Halve the step: keep the old nodes (now the even ones) and add the odd ones. `false`
-    /// (the nodes left half-made) where a Clenshaw–Curtis node is not in the allowed set.
+    /// (the samples unchanged) where a Clenshaw–Curtis node is not in the allowed set.
     fn refine<S: Shape>(
         &mut self,
         v: &EffectivePotential<'_, S>,
@@ -1966,16 +1975,17 @@ impl PieceSamples {
                 sample(v, piece, energy, node)
             })?,
             Rule::Chebyshev(kind) => {
-                let made = interleave(&mut self.nodes, |i| {
-                    chebyshev_sample(v, piece, energy, kind, level, i).ok_or(
-                        AtlasError::NotPeriodic {
-                            reason: "a quadrature node fell outside the allowed set",
-                        },
-                    )
-                });
-                if made.is_err() {
+                // The new (odd) nodes first: where one is not in the allowed set the samples
+                // stay as they were.
+                let odd = (1..self.nodes.len())
+                    .map(|j| chebyshev_sample(v, piece, energy, kind, level, 2 * j - 1))
+                    .collect::<Option<Vec<_>>>();
+                let Some(odd) = odd else {
+                    self.level -= 1;
                     return Ok(false);
-                }
+                };
+                let mut odd = odd.into_iter();
+                interleave(&mut self.nodes, |_| Ok(odd.next().expect("one a gap")))?;
             }
         }
         self.evaluations += self.nodes.len() / 2;

@@ -20,6 +20,7 @@ sys.path.insert(0, str(ROOT / "scripts"))
 
 from reference import ProfileCell, at  # noqa: E402
 from test_bodies import assert_ok_within_estimates  # noqa: E402
+import whole_domain  # noqa: E402
 
 BIN = os.environ.get("RUBBER_ATLAS_BIN", str(ROOT / "target" / "release" / "rubber-atlas"))
 
@@ -88,3 +89,20 @@ def test_a_table_that_is_no_convex_meridian_is_refused_in_one_line(tmp_path):
     run = subprocess.run([BIN, "cell", "--shape", "profile", "--profile", str(table), "--alpha", "0", "--nu", "1",
                           "--eta", "1", "--kappa", "0.5", "--energy", "2"], capture_output=True, text=True)
     assert run.returncode == 2 and "line 2" in run.stderr and len(run.stderr.strip().splitlines()) == 1, run.stderr
+
+
+def test_the_rounding_of_the_fit_is_in_the_estimates():
+    """A profile's arcs are fitted through its points in doubles; their rounding is an error of
+    U the estimates carry (8 eps times the table's largest coordinate, as an error of the
+    level). Whole-domain seed 2 found this body (α 2e-6 below the top pole, a flat top arc of
+    radius 431, N = 14.7) at tol 1e-12 with N 7.4e-13 off at status `ok`, its estimate
+    1.4e-13: the fitted U is 1.8e-16 off there, where U itself is 3e-3."""
+    rows = ((0.0, -1.0), (1.2724204597935098, -0.999576681768467), (3.8489382310430185, -0.8405716318461958),
+            (4.275401140168607, -0.31977474178239496), (4.277171979843111, -0.2558786716368836),
+            (4.225532546466111, 0.5752056388527097), (4.175428011033271, 0.6534554188145392),
+            (4.012815919540386, 0.7762277878169084), (2.5169923331991386, 0.986199833077917), (0.0, 1.0))
+    case = whole_domain.Case(0.999998, 1.0, 0.4107899917274661, 631.9529193744893, -0.0001595333133471339,
+                             0.0038506335428092555, "random", None, "profile", 0.0, rows)
+    for tol in (1e-10, 1e-12):
+        outcome = whole_domain.check(case, tol=tol)
+        assert not outcome.problems, (tol, outcome.problems)

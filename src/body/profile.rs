@@ -626,6 +626,22 @@ impl Shape for ProfileShape {
         &self.profile.joints
     }
 
+    /// 8 eps times the table's largest coordinate (or |α|): against U of the arc spline fitted
+    /// anew at 50 digits (scripts/reference.py), the fitted arcs' U was within 2.9 eps of it at
+    /// 14,400 random angles of 360 random tables (superellipses of 4 … 24 points, faces,
+    /// α anywhere between the poles: `whole_domain.sample_profiles`, seeds 1 … 3). Where U is
+    /// small (α 2e-6 below the top pole) that is far above U's own rounding: N = 14.7 of such
+    /// a body was 7.4e-13 off at status `ok`, its estimate 1.4e-13, before this term.
+    fn representation_error(&self) -> f64 {
+        let largest = self
+            .profile
+            .points
+            .iter()
+            .map(|p| p[0].abs().max(p[1].abs()))
+            .fold(self.alpha.abs(), f64::max);
+        8.0 * f64::EPSILON * largest
+    }
+
     /// Where a face ends the table: a flat circle on the plane at that pole.
     fn faces(&self) -> [bool; 2] {
         self.profile.faces
