@@ -1613,14 +1613,22 @@ fn drift_estimate(
         known.push((key, value));
         value
     };
-    // Clenshaw–Curtis pieces in their geometric regime: the cosine rule's trust (the
-    // drift's integrand is as analytic as T's and Δψ's on each piece).
+    // Clenshaw–Curtis pieces in their geometric regime (T's and Δψ's sums, and the drift's
+    // own on a fourth level: one rate, as `cosine::single_rate` asks): the cosine rule's trust.
+    let (fine, mid, coarse) = (level(0), level(1), level(2));
     let rate = if samples.iter().all(PieceSamples::geometric) {
-        Convergence::Geometric
+        let coarsest = level(3);
+        let gap = |a: ([f64; 2], f64), b: ([f64; 2], f64)| (a.0[0] - b.0[0]).hypot(a.0[1] - b.0[1]);
+        let (d1, d2, d3) = (gap(fine, mid), gap(mid, coarse), gap(coarse, coarsest));
+        if d2 == 0.0 || d3 == 0.0 || d1 / d2 >= (d2 / d3).powi(2) / 16.0 {
+            Convergence::Geometric
+        } else {
+            Convergence::Unknown
+        }
     } else {
         Convergence::Unknown
     };
-    DriftEstimate::from_levels(level(0), level(1), level(2), rate)
+    DriftEstimate::from_levels(fine, mid, coarse, rate)
 }
 
 /// Drift sums already made (Δζ and its path scale), by the pieces' levels.
