@@ -1028,11 +1028,18 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         for (piece, sample) in pieces.iter().zip(samples.iter_mut()) {
             // Half of the tolerance for the quadrature, half left for rounding (which the
             // refinement cannot reduce).
-            while sample.level < sample.least_level
-                || sample.error(|n| n.dt)
+            let misses = |sample: &PieceSamples| {
+                sample.error(|n| n.dt)
                     > (0.5 * tol * sample.period(0)).max(0.1 * floor_t * share / double)
-                || double * sample.error(|n| n.dpsi) / TAU
-                    > (0.5 * tol * share).max(0.1 * floor_psi * share / TAU)
+                    || double * sample.error(|n| n.dpsi) / TAU
+                        > (0.5 * tol * share).max(0.1 * floor_psi * share / TAU)
+            };
+            // By a pole the tanh-sinh levels must also show one rate: their sums can converge
+            // fast and then stall (a truncated ball at κ = 0.0018, θ_min = 8e-4: d₁ = 2.4e-9
+            // after 2.2e-3, the level's error 4.9e-9; N at tol 1e-6 was 1.44× its estimate).
+            while sample.level < sample.least_level
+                || (sample.rule == Rule::TanhSinh && self.by_a_pole(piece) && !sample.one_rate())
+                || misses(sample)
             {
                 let chebyshev = sample.rule != Rule::TanhSinh;
                 if chebyshev
@@ -1049,7 +1056,8 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                     continue;
                 }
                 if sample.level >= MAX_LEVEL {
-                    converged = false;
+                    // (Levels that never showed one rate keep their estimate, as before.)
+                    converged &= !misses(sample);
                     break;
                 }
                 sample.refine(self, piece, energy)?;
@@ -1373,6 +1381,19 @@ impl<S: Shape> EffectivePotential<'_, S> {
         } else {
             plain
         })
+    }
+
+    /// Whether a turning point of the piece lies by a pole (κ ≠ 0, nearer than 1 % of the
+    /// piece): ψ̇ ~ κ/sin²θ peaks there over a sliver the first levels of the tanh-sinh rule
+    /// may step over alike, their sums converging fast and then stalling.
+    fn by_a_pole(&self, piece: &Piece) -> bool {
+        self.kappa != 0.0
+            && [
+                (&piece.left, piece.left.site.theta),
+                (&piece.right, piece.right.site.from_pi),
+            ]
+            .iter()
+            .any(|(end, distance)| end.excess == 0.0 && *distance < 0.01 * piece.length)
     }
 
     /// The Clenshaw–Curtis kind of each piece of a libration across a kink, with the least
@@ -1949,17 +1970,24 @@ impl PieceSamples {
         }
     }
 
-    /// Whether the levels are a Clenshaw–Curtis rule's in one geometric regime (T's and Δψ's
-    /// sums on four levels, [`cosine::single_rate`]).
-    fn geometric(&self) -> bool {
-        matches!(self.rule, Rule::Chebyshev(_))
-            && self.level >= 4
+    /// Whether T's and Δψ's sums on the last four levels show one rate
+    /// ([`cosine::single_rate`]: each ratio of differences at least a sixteenth of the square
+    /// of the one before, as under E(n) = C ρⁿ and under the tanh-sinh rule's
+    /// E(h) = C e^{−c/h}). A last ratio far below that has the error the earlier levels saw
+    /// die out, and what is left (a feature the coarse levels stepped over) is not seen.
+    fn one_rate(&self) -> bool {
+        self.level >= 4
             && [|n: &NodeSample| n.dt, |n: &NodeSample| n.dpsi]
                 .iter()
                 .all(|f| {
                     let sums = [self.sum(0, f), self.sum(1, f), self.sum(2, f)];
                     cosine::single_rate(self.sum(3, f), sums)
                 })
+    }
+
+    /// Whether the levels are a Clenshaw–Curtis rule's in one geometric regime.
+    fn geometric(&self) -> bool {
+        matches!(self.rule, Rule::Chebyshev(_)) && self.one_rate()
     }
 
     /// Σ ½ (relative gap error) |f| weight: the gap enters t′ as (ε − V)^{−1/2}.
