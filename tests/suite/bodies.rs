@@ -259,6 +259,16 @@ fn crossing_starts() -> Vec<(EdgedShape, f64, f64)> {
     ]
 }
 
+/// Cell options with the drift, at `tol` by `method`.
+fn options(tol: f64, method: Method) -> CellOptions {
+    CellOptions {
+        tol,
+        method,
+        drift: true,
+        resonance_tol: 1e-9,
+    }
+}
+
 /// The body (ν = 0.7, η = 1.3), the start at rest at θ0 and its energy.
 fn crossing_cell(shape: EdgedShape, kappa: f64, theta0: f64) -> (Body<EdgedShape>, Start, f64) {
     let body = Body::new(shape, 0.7, 1.3).unwrap();
@@ -335,12 +345,6 @@ fn cells_across_a_kink_agree_with_the_full_equations() {
 fn the_estimates_across_a_kink_are_honest() {
     for (shape, kappa, theta0) in crossing_starts() {
         let (body, _, energy) = crossing_cell(shape, kappa, theta0);
-        let options = |tol, method| CellOptions {
-            tol,
-            method,
-            drift: true,
-            resonance_tol: 1e-9,
-        };
         let best = solve_cell(&body, kappa, energy, &options(1e-13, Method::Quadrature)).unwrap();
         for tol in [1e-6, 1e-10] {
             let quad = solve_cell(&body, kappa, energy, &options(tol, Method::Quadrature)).unwrap();
@@ -1379,15 +1383,9 @@ fn tanh_sinh_sums_that_stall_by_a_pole_are_not_trusted() {
     )
     .unwrap();
     let (kappa, energy) = (0.0017669486636242152, 1.7017649532325225);
-    let options = |tol| CellOptions {
-        tol,
-        method: Method::Quadrature,
-        drift: true,
-        resonance_tol: 1e-9,
-    };
-    let best = solve_cell(&body, kappa, energy, &options(1e-13)).unwrap();
+    let best = solve_cell(&body, kappa, energy, &options(1e-13, Method::Quadrature)).unwrap();
     for tol in [1e-6, 1e-8, 1e-10] {
-        let cell = solve_cell(&body, kappa, energy, &options(tol)).unwrap();
+        let cell = solve_cell(&body, kappa, energy, &options(tol, Method::Quadrature)).unwrap();
         for (c, b) in cell.components.iter().zip(&best.components) {
             let error = (c.rotation_number - b.rotation_number).abs();
             assert!(
