@@ -740,6 +740,52 @@ fn level_offset_error<S: Shape>(
     // scale it is the drift's).
     let saddle_small =
         values.saddle[0] <= 0.05 * tol * values.period && values.saddle[1] <= 0.05 * tol;
+    // A kink whose level lies within the level's uncertainty of ε, at or next to the
+    // libration: which side of it the turning point lies on is decided by rounding, and X may
+    // jump there (a neutral sphere beside an edge, V′ = 2e-11 on both sides: T = 2866 on the
+    // sphere's side, 120 on the edge's, the two levels within an ulp; whole-domain seed 26).
+    // The error is then the largest change of X between ε and levels beyond the kink's on
+    // either side.
+    let uncertainty = a_priori + represented;
+    let reach_out = 0.1;
+    let ambiguous = potential
+        .kinks_inside(
+            component.lower.theta - reach_out,
+            component.upper.theta + reach_out,
+        )
+        .into_iter()
+        .map(|k| potential.value(k.angle()))
+        .find(|v| (energy - v).abs() <= 4.0 * uncertainty);
+    if let Some(kink_level) = ambiguous {
+        let step = 2.0 * ((energy - kink_level).abs() + uncertainty);
+        let at = |e: f64| libration_integrals(potential, e, &bottom, options);
+        // (Where either side has no libration of this well, the bounds below hold as they
+        // would without the kink: its critical level is a separatrix's, whose terms they have.)
+        if let (Some(below), Some(above)) = (at(energy - step), at(energy + step)) {
+            let sides = [below, above];
+            let change = |x: fn(&PeriodIntegrals) -> (f64, f64)| {
+                sides.iter().fold(0.0, |worst: f64, side| {
+                    let ((value, error), (here, _)) = (x(side), x(&values));
+                    worst.max((value - here).abs() + error)
+                })
+            };
+            let drift =
+                sides
+                    .iter()
+                    .fold(0.0, |worst: f64, side| match (side.drift, values.drift) {
+                        (Some(d), Some(v)) => worst.max(
+                            (d.value[0] - v.value[0]).hypot(d.value[1] - v.value[1]) + d.error,
+                        ),
+                        (None, None) => worst,
+                        _ => f64::INFINITY,
+                    });
+            return EnergyErrors {
+                period: change(|s| (s.period, s.period_error)),
+                psi_advance: change(|s| (s.psi_advance, s.psi_advance_error)),
+                drift,
+            };
+        }
+    }
     let (mut crude, mut tilted, mut depth) =
         bounds(a_priori + represented, a_priori + represented_spread);
     if enough(&crude, &tilted, false, raw) && saddle_small {
@@ -798,15 +844,7 @@ fn level_offset_error<S: Shape>(
         },
         ..*options
     };
-    let at = |e: f64| -> Option<PeriodIntegrals> {
-        integrate(
-            potential,
-            e,
-            &libration_around(potential, e, &bottom)?,
-            options,
-        )
-        .ok()
-    };
+    let at = |e: f64| libration_integrals(potential, e, &bottom, options);
     let (Some(up), Some(down)) = (at(energy + h), at(energy - h)) else {
         return crude.plus(tilted);
     };
@@ -1237,6 +1275,23 @@ fn fixed_point<S: Shape>(
 }
 
 /// The libration at `energy` round the minimum `bottom`, if there is one.
+/// The integrals of the libration of the well of `bottom` at `energy` (`None` where there is
+/// none, or it cannot be integrated).
+fn libration_integrals<S: Shape>(
+    potential: &EffectivePotential<'_, S>,
+    energy: f64,
+    bottom: &CriticalPoint,
+    options: &CellOptions,
+) -> Option<PeriodIntegrals> {
+    integrate(
+        potential,
+        energy,
+        &libration_around(potential, energy, bottom)?,
+        options,
+    )
+    .ok()
+}
+
 fn libration_around<S: Shape>(
     potential: &EffectivePotential<'_, S>,
     energy: f64,

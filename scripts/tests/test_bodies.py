@@ -299,3 +299,16 @@ def test_ordinary_librations_across_kinks_are_cheap():
     works = sorted(c["work"] for case in _ordinary_crossings(16, 2026_11_27)
                    for c in whole_domain.run_cell(case, tol=1e-10)["components"])
     assert works[len(works) // 2] <= 160, works
+
+
+def test_a_level_within_rounding_of_a_kink_holds_both_sides():
+    """A centred truncated ball (α = 0: its sphere neutral, V′ = 2e-11 on both sides of the
+    kink at κ = 7.8e-6) at a level within an ulp of V at the kink: rounding decides on which
+    side the turning point lies, and T is 120.4 on the edge's side, 2866 on the sphere's. The
+    estimates now hold the change to levels beyond the kink's on either side; before, T was
+    2866 ± 48.9 (whole-domain `--bodies --seed 26`)."""
+    case = whole_domain.Case(0.0, 1.0, 1.4763982134217415, 0.1229224391436799, 7.798736413777416e-06,
+                             1.0000000000328788, "next to a kink", None, "truncated_ball", -0.27401628361660224)
+    for tol in (1e-6, 1e-10):
+        outcome = whole_domain.check(case, tol=tol)
+        assert not outcome.problems, (tol, outcome.problems)
