@@ -746,16 +746,29 @@ fn level_offset_error<S: Shape>(
     // sphere's side, 120 on the edge's, the two levels within an ulp; whole-domain seed 26).
     // The error is then the largest change of X between ε and levels beyond the kink's on
     // either side.
+    // (The distance of ε from the nearest kink's level also scales the measured slope's step
+    // below.)
+    let kink_levels = potential
+        .body
+        .shape
+        .kinks()
+        .iter()
+        .map(|&k| (energy - potential.value(Site::at(k).angle())).abs())
+        .fold(f64::INFINITY, f64::min);
     let uncertainty = a_priori + represented;
     let reach_out = 0.1;
-    let ambiguous = potential
-        .kinks_inside(
-            component.lower.theta - reach_out,
-            component.upper.theta + reach_out,
-        )
-        .into_iter()
-        .map(|k| potential.value(k.angle()))
-        .find(|v| (energy - v).abs() <= 4.0 * uncertainty);
+    let ambiguous = (kink_levels <= 4.0 * uncertainty)
+        .then(|| {
+            potential
+                .kinks_inside(
+                    component.lower.theta - reach_out,
+                    component.upper.theta + reach_out,
+                )
+                .into_iter()
+                .map(|k| potential.value(k.angle()))
+                .find(|v| (energy - v).abs() <= 4.0 * uncertainty)
+        })
+        .flatten();
     if let Some(kink_level) = ambiguous {
         let step = 2.0 * ((energy - kink_level).abs() + uncertainty);
         let at = |e: f64| libration_integrals(potential, e, &bottom, options);
@@ -814,13 +827,6 @@ fn level_offset_error<S: Shape>(
     // (X varies on the scale of κ there) and where that scale is below it, the step is
     // 256 times the a-priori bound (never below: the sharp δ may be far below an ulp of ε,
     // where ε ± h would round back to ε).
-    let kink_levels = potential
-        .body
-        .shape
-        .kinks()
-        .iter()
-        .map(|&k| (energy - potential.value(Site::at(k).angle())).abs())
-        .fold(f64::INFINITY, f64::min);
     let variation = depth.min(reach).min(saddles).min(kink_levels);
     let narrow = 256.0 * a_priori;
     let h = if near_pole {
@@ -1274,7 +1280,6 @@ fn fixed_point<S: Shape>(
     result
 }
 
-/// The libration at `energy` round the minimum `bottom`, if there is one.
 /// The integrals of the libration of the well of `bottom` at `energy` (`None` where there is
 /// none, or it cannot be integrated).
 fn libration_integrals<S: Shape>(
@@ -1292,6 +1297,7 @@ fn libration_integrals<S: Shape>(
     .ok()
 }
 
+/// The libration at `energy` round the minimum `bottom`, if there is one.
 fn libration_around<S: Shape>(
     potential: &EffectivePotential<'_, S>,
     energy: f64,

@@ -1041,26 +1041,28 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 || (sample.rule == Rule::TanhSinh && self.by_a_pole(piece) && !sample.one_rate())
                 || misses(sample)
             {
-                let chebyshev = sample.rule != Rule::TanhSinh;
-                if chebyshev
-                    && (sample.level >= CHEBYSHEV_LAST_LEVEL
-                        || !sample.refine(self, piece, energy)?)
-                {
-                    // Slow (a near-singular end) or a node outside: tanh-sinh takes over.
-                    let spent = sample.evaluations;
-                    *sample = PieceSamples::new(self, piece, energy, START_LEVEL)?;
-                    sample.evaluations += spent;
-                    continue;
+                match sample.rule {
+                    Rule::Chebyshev(_) => {
+                        if sample.level >= CHEBYSHEV_LAST_LEVEL
+                            || !sample.refine(self, piece, energy)?
+                        {
+                            // Slow (a near-singular end) or a node outside: tanh-sinh takes
+                            // over.
+                            let spent = sample.evaluations;
+                            *sample = PieceSamples::new(self, piece, energy, START_LEVEL)?;
+                            sample.evaluations += spent;
+                        }
+                    }
+                    Rule::TanhSinh => {
+                        if sample.level >= MAX_LEVEL {
+                            // (Levels that never showed one rate keep their estimate, as
+                            // before.)
+                            converged &= !misses(sample);
+                            break;
+                        }
+                        sample.refine(self, piece, energy)?;
+                    }
                 }
-                if chebyshev {
-                    continue;
-                }
-                if sample.level >= MAX_LEVEL {
-                    // (Levels that never showed one rate keep their estimate, as before.)
-                    converged &= !misses(sample);
-                    break;
-                }
-                sample.refine(self, piece, energy)?;
             }
         }
         let sum = |f: &dyn Fn(&PieceSamples) -> f64| {
