@@ -514,3 +514,44 @@ def critical_levels(alpha, beta, nu, eta, kappa, digits: int = DIGITS) -> list[t
     cell = Cell(alpha, beta, nu, eta, kappa, digits)
     with mpmath.workdps(digits):
         return [(float(p.theta), float(cell.potential(p))) for p in cell.critical_points()]
+
+
+def high_energy_rotation_number(cell: Cell, lam, digits: int = DIGITS):
+    """N∞(λ), the rotation number at ε → ∞ with λ = κ/√ε fixed (docs/model.md), of the body of
+    `cell` (its κ plays no part): (λ/π) ∫ cosθ √B / (J sinθ √(2 sin²θ − λ²)) dθ over
+    sinθ ≥ λ/√2, as it stands (no part subtracted; the halves θ ≶ π/2 integrated apart, each
+    in its distance d from its turning point, so that sinθ − λ/√2 = 2 cos(θ_min + d/2) sin(d/2)
+    keeps its digits), by tanh-sinh split at the kinks and geometrically towards the turning
+    points. Returns (value, the quadrature's error estimate)."""
+    with mpmath.workdps(digits):
+        lam = mpmath.mpf(lam)
+        m = lam / mpmath.sqrt(2)
+        theta_min = mpmath.asin(m)
+        half = mpmath.pi / 2 - theta_min
+
+        def f(d, side):
+            a = theta_min + d
+            s = mpmath.sin(a)
+            c = mpmath.cos(a) * (1 if side == 0 else -1)
+            gap = 2 * mpmath.cos(theta_min + d / 2) * mpmath.sin(d / 2)
+            b = cell.inertia(s, c)
+            j = cell.integral_factor(s, c)
+            return c * mpmath.sqrt(b) / (j * s * mpmath.sqrt(2 * gap * (s + m)))
+
+        total, error = mpmath.mpf(0), mpmath.mpf(0)
+        for side in (0, 1):
+            points = {mpmath.mpf(0), half}
+            for k in cell.kinks():
+                if k.side == side and theta_min < k.x:
+                    points.add(k.x - theta_min)
+            step = theta_min
+            while step < half / 2:
+                points.add(step)
+                step *= 2
+            points = sorted(points)
+            with mpmath.workdps(QUAD_DIGITS + 10):
+                for a, b in zip(points[:-1], points[1:]):
+                    v, e = mpmath.quad(lambda d: f(d, side), [a, b], error=True, maxdegree=10)
+                    total += v
+                    error += e
+        return lam / mpmath.pi * total, lam / mpmath.pi * error

@@ -209,14 +209,24 @@ pub fn solve_high_energy_limit<S: Shape>(
             ..at_infinity(Vec::new())
         });
     }
-    let n = crate::limits::high_energy_rotation_number(body, lambda, options.tol)?;
-    let theta_min = (lambda / std::f64::consts::SQRT_2).asin();
     // λ = 0 is κ = 0: rolling over the top along a meridian, as at every finite ε above
-    // ε_min (N = 0 there).
+    // ε_min (N = 0 there); a body with a face reaches it and stops, as at finite ε.
     let over_the_top = lambda == 0.0;
+    let onto_a_face = over_the_top && body.shape.faces() != [false, false];
+    let n = if onto_a_face {
+        crate::limits::Estimate {
+            value: f64::NAN,
+            error: f64::NAN,
+        }
+    } else {
+        crate::limits::high_energy_rotation_number(body, lambda, options.tol)?
+    };
+    let theta_min = (lambda / std::f64::consts::SQRT_2).asin();
     let fixed = theta_min == std::f64::consts::FRAC_PI_2;
     let omega_psi = if n.value == 0.0 {
         0.0
+    } else if n.value.is_nan() {
+        f64::NAN
     } else {
         -n.value.signum() * f64::INFINITY
     };
@@ -227,8 +237,8 @@ pub fn solve_high_energy_limit<S: Shape>(
         } else {
             PI - theta_min
         },
-        period: 0.0,
-        omega_theta: f64::INFINITY,
+        period: if onto_a_face { f64::NAN } else { 0.0 },
+        omega_theta: if onto_a_face { f64::NAN } else { f64::INFINITY },
         omega_psi,
         rotation_number: n.value,
         drift: f64::NAN,
@@ -242,7 +252,11 @@ pub fn solve_high_energy_limit<S: Shape>(
             MotionKind::Libration
         },
         family: high_energy_families(body, lambda)[0],
-        status: Status::HighEnergyLimit,
+        status: if onto_a_face {
+            Status::ReachesFace
+        } else {
+            Status::HighEnergyLimit
+        },
         error_estimate: n.error,
         errors: ErrorEstimates {
             period: 0.0,
@@ -447,12 +461,10 @@ fn far_out<S: Shape>(
 ) -> Option<Estimate> {
     let kappa = potential.kappa;
     // Ū ≥ 1: ordinary cells leave here before U is evaluated (this runs for every libration).
-    // The limit is derived for bodies smooth up to the poles: not for edged ones.
     if kappa == 0.0
         || component.kind != MotionKind::Libration
         || energy.is_nan()
         || energy < FAR_OUT
-        || !crate::limits::has_high_energy_limit(&potential.body.shape)
     {
         return None;
     }

@@ -15,9 +15,15 @@
 //! Its integrand is even and π-periodic in u, so the trapezoid rule converges geometrically.
 //! At λ → 0, N∞/λ → (1/(√2 π)) ∫_0^{π/2} sin u [H(sin u) − H(−sin u)] du (the slope); at
 //! λ = √2 the torus shrinks to θ = π/2, where ψ̇ = 0, and N∞ = 0.
+//!
+//! The limit holds for any body, but H is smooth only for one without kinks or faces: for the
+//! edged bodies and profiles N∞ is integrated in pieces between the kinks, with a face's peak
+//! next to the turning points taken out exactly ([`edged_high_energy_rotation_number`]), and
+//! tends to (√B/J|₀ − √B/J|π)/2 as λ → 0, not 0 ([`high_energy_limit_at_small_lambda`]).
 
 use crate::body::{Angle, Body, Shape};
 use crate::error::{check_range, Result};
+use crate::quadrature::{IntervalNode, TanhSinhLevel, FINEST_LEVEL};
 use crate::torus::{CriticalKind, CriticalPoint, EffectivePotential};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -30,9 +36,10 @@ pub struct Estimate {
     pub error: f64,
 }
 
-/// Whether the high-energy limit below holds for `shape`: its derivation needs H smooth on
-/// [−1, 1], which a body with a kink or a face (U′/sinθ unbounded at a pole) does not give.
-pub fn has_high_energy_limit<S: Shape>(shape: &S) -> bool {
+/// Whether H is smooth on [−1, 1] for `shape`, so that N∞ is the geometrically converging
+/// trapezoid sum above: not for a body with a kink (U″ jumps, H′ with it) or a face (U′/sinθ
+/// unbounded at a pole), whose limit is [`edged_high_energy_rotation_number`].
+pub fn smooth_high_energy_limit<S: Shape>(shape: &S) -> bool {
     shape.kinks().is_empty() && shape.faces() == [false, false]
 }
 
@@ -191,6 +198,164 @@ fn odd_part_integral<S: Shape>(body: &Body<S>, x0: f64, abs_tol: f64) -> Estimat
     }
 }
 
+/// P(θ) = √B/J − 1 = ((1 − ν)/η sin²θ + U′²) / (J (√B + J)) at the angle `a` (B − J² =
+/// (1 − ν)/η sin²θ + U′², since |r|² = U² + U′²): no cancellation, finite at a face's pole.
+fn excess_at<S: Shape>(body: &Body<S>, a: Angle) -> f64 {
+    let red = body.reduction_at(a);
+    let slope = body.shape.potential_prime_at(a);
+    let num = (1.0 - body.nu) / body.eta * a.sin * a.sin + slope * slope;
+    let j = red.integral_factor;
+    num / (j * (red.reduced_inertia.sqrt() + j))
+}
+
+/// lim N∞(λ) as λ → 0 for any body: (P(0) − P(π))/2 with P = √B/J − 1 at the poles. At a
+/// smooth pole U′ = 0 and B = J², so P = 0 there: only a face (U′ ≠ 0 at its pole) gives a
+/// value; a passage next to a pole turns ψ by −π √B/J there (as at κ → 0), and at high energy
+/// each period passes next to both poles. N∞ is discontinuous at λ = 0 itself, where κ = 0:
+/// the body rolls over the top, or reaches a face and stops.
+pub fn high_energy_limit_at_small_lambda<S: Shape>(body: &Body<S>) -> f64 {
+    if body.shape.symmetric_about_equator() {
+        return 0.0;
+    }
+    let bottom = Angle { sin: 0.0, cos: 1.0 };
+    let top = Angle {
+        sin: 0.0,
+        cos: -1.0,
+    };
+    0.5 * (excess_at(body, bottom) - excess_at(body, top))
+}
+
+/// Fewest and most tanh-sinh levels per piece of [`edged_high_energy_rotation_number`]: a
+/// difference is trusted from level 5 (257 nodes) on, when it has also shrunk.
+const EDGED_FIRST_LEVEL: u32 = 3;
+const EDGED_TRUSTED_LEVEL: u32 = 5;
+
+/// N∞(λ) for a body with kinks or faces, where H is not smooth on [−1, 1]. With μ = λ/√2,
+/// x₀ = √(1 − μ²), and c = cos u in the form of [`high_energy_rotation_number`] (so
+/// cosθ = x₀√(1 − c²), sinθ = √(μ² + x₀²c²), 0 ≤ c ≤ 1 for θ_min ≤ θ ≤ π/2),
+/// N∞ = (μx₀/π) ∫₀¹ Q(c)/(μ² + x₀²c²) dc with Q = P(θ) − P(π − θ) ([`excess_at`]). Near
+/// c = 0 a face makes Q/(μ² + x₀²c²) a peak of width μ/x₀ and height 1/μ², which no rule
+/// resolves as λ → 0; its exact part is taken out:
+/// N∞ = (1/π) [Q(0) arctan(x₀/μ) + μx₀ ∫₀¹ (Q(c) − Q(0))/(μ² + x₀²c²) dc].
+/// The rest is bounded by |Q′|/(2μ) and integrated by tanh-sinh on pieces split where a kink
+/// or a zero of U (a narrow peak of 1/J) lies, each refined until a level changes it by less
+/// than its share of `tol`; the error is that change, the rounding of the sum (16 eps of
+/// each term), and the tails beyond the rule's last nodes. λ = 0 gives the limit λ → 0
+/// ([`high_energy_limit_at_small_lambda`]).
+pub fn edged_high_energy_rotation_number<S: Shape>(
+    body: &Body<S>,
+    lambda: f64,
+    tol: f64,
+) -> Estimate {
+    if body.shape.symmetric_about_equator() || lambda >= SQRT_2 {
+        return Estimate {
+            value: 0.0,
+            error: 0.0,
+        };
+    }
+    let eps = f64::EPSILON;
+    if lambda == 0.0 {
+        let value = high_energy_limit_at_small_lambda(body);
+        return Estimate {
+            value,
+            error: 16.0 * eps * value.abs(),
+        };
+    }
+    let mu = lambda / SQRT_2;
+    let x0 = ((1.0 - mu) * (1.0 + mu)).sqrt();
+    // The angle at c, from c and 1 − c each to full precision.
+    let angle = |c: f64, one_minus_c: f64| Angle {
+        sin: (mu * mu + x0 * x0 * c * c).sqrt(),
+        cos: x0 * (one_minus_c * (1.0 + c)).sqrt(),
+    };
+    let odd = |a: Angle| excess_at(body, a) - excess_at(body, Angle { cos: -a.cos, ..a });
+    let q0 = odd(Angle { sin: mu, cos: x0 });
+    // The split points: kinks and zeros of U, folded onto θ ≤ π/2, as values of c.
+    let shape = &body.shape;
+    let mut cuts: Vec<f64> = shape
+        .kinks()
+        .iter()
+        .copied()
+        .chain(shape.potential_zeros())
+        .filter_map(|theta| {
+            let s = theta.sin();
+            (s > mu).then(|| ((s - mu) * (s + mu)).sqrt() / x0)
+        })
+        .filter(|&c| c > 0.0 && c < 1.0)
+        .collect();
+    cuts.sort_by(f64::total_cmp);
+    cuts.dedup();
+    let ends: Vec<f64> = std::iter::once(0.0)
+        .chain(cuts)
+        .chain(std::iter::once(1.0))
+        .collect();
+    let pieces = ends.len() - 1;
+    let prefactor = mu * x0 / PI;
+    let piece_tol = 0.25 * tol / (prefactor * pieces as f64);
+    let (mut integral, mut error) = (0.0, 0.0);
+    for w in ends.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        let length = b - a;
+        // The term at node j of `level`, and its rounding scale.
+        let term = |level: u32, j: usize| -> (f64, f64) {
+            let node = IntervalNode::tanh_sinh_tabulated(level, j, length);
+            let c = a + node.from_left;
+            let q = odd(angle(c, (1.0 - b) + node.from_right));
+            let den = mu * mu + x0 * x0 * c * c;
+            (
+                node.jacobian * (q - q0) / den,
+                node.jacobian * (q.abs() + q0.abs()) / den,
+            )
+        };
+        let first = TanhSinhLevel::new(EDGED_FIRST_LEVEL);
+        let (mut sum, mut scale) = (0.0, 0.0);
+        for j in 0..first.count {
+            let (v, r) = term(EDGED_FIRST_LEVEL, j);
+            sum += v;
+            scale += r;
+        }
+        let mut value = sum * first.step;
+        // The tails beyond τ = ±TAU_MAX: the outermost terms' integrand times the distance
+        // left to each end (the integrand is bounded on the piece).
+        let tail = {
+            let (l, r) = (
+                IntervalNode::tanh_sinh_tabulated(EDGED_FIRST_LEVEL, 0, length),
+                IntervalNode::tanh_sinh_tabulated(EDGED_FIRST_LEVEL, first.count - 1, length),
+            );
+            let (vl, _) = term(EDGED_FIRST_LEVEL, 0);
+            let (vr, _) = term(EDGED_FIRST_LEVEL, first.count - 1);
+            (vl / l.jacobian).abs() * l.from_left + (vr / r.jacobian).abs() * r.from_right
+        };
+        let mut last_diff = f64::INFINITY;
+        let mut piece_error = f64::INFINITY;
+        let mut step = first.step;
+        for level in EDGED_FIRST_LEVEL + 1..=FINEST_LEVEL {
+            let grid = TanhSinhLevel::new(level);
+            step = grid.step;
+            for j in (1..grid.count).step_by(2) {
+                let (v, r) = term(level, j);
+                sum += v;
+                scale += r;
+            }
+            let next = sum * grid.step;
+            let diff = (next - value).abs();
+            value = next;
+            piece_error = diff;
+            if level >= EDGED_TRUSTED_LEVEL && diff <= piece_tol && diff <= last_diff {
+                break;
+            }
+            last_diff = diff;
+        }
+        integral += value;
+        error += piece_error + tail + 16.0 * eps * scale * step;
+    }
+    let value = (q0 * (x0 / mu).atan() + mu * x0 * integral) / PI;
+    Estimate {
+        value,
+        error: prefactor * error + 16.0 * eps * q0.abs() + 4.0 * eps * value.abs(),
+    }
+}
+
 /// 0 ≤ λ ≤ √2: the high-energy limit has motion only there (κ²/2 ≤ ε).
 fn check_lambda(lambda: f64) -> Result<f64> {
     check_range(
@@ -233,11 +398,8 @@ pub fn high_energy_rotation_number<S: Shape>(
     tol: f64,
 ) -> Result<Estimate> {
     check_lambda(lambda)?;
-    if !has_high_energy_limit(&body.shape) {
-        return Err(crate::error::AtlasError::NotPeriodic {
-            reason: "the high-energy limit is derived for bodies smooth up to the poles, \
-                     not for a body with edges or faces",
-        });
+    if !smooth_high_energy_limit(&body.shape) {
+        return Ok(edged_high_energy_rotation_number(body, lambda, tol));
     }
     let x0 = turning_cosine(lambda);
     let factor = lambda * x0 / (SQRT_2 * PI);
@@ -350,6 +512,12 @@ impl HighEnergyLimit {
     /// Slope and extrema of N∞ and Ñ to the accuracy `tol` (values; λ to 1e-7, which moves
     /// an extremum's value by N″·1e-14).
     pub fn of<S: Shape>(body: &Body<S>, tol: f64) -> Result<Self> {
+        if !smooth_high_energy_limit(&body.shape) {
+            return Err(crate::error::AtlasError::NotPeriodic {
+                reason: "the slope and extrema of the high-energy limit are computed for bodies \
+                         smooth up to the poles only",
+            });
+        }
         check_range(
             "tol",
             tol,

@@ -696,19 +696,6 @@ impl Scene {
                 }
             }
         }
-        // The high-energy limit N∞(λ) (s = 0) is derived for a U smooth on [−1, 1] in cosθ:
-        // the ellipsoid's only.
-        if plane == Plane::Compact && shape.is_some() && energy.values.contains(&0.0) {
-            return Err(reader.error(
-                "axes.s",
-                format!(
-                    "s = 0 (energy = infinity) is the high-energy limit, derived for the \
-                     ellipsoid only (its U is smooth at the poles); for the {} start s above 0",
-                    shape_name(shape)
-                ),
-            ));
-        }
-
         let mut options = CellOptions::default();
         if let Some(v) = root.get("solver") {
             let Value::Table(solver) = v else {

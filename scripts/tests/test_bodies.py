@@ -14,6 +14,7 @@ import sys
 from pathlib import Path
 
 import mpmath
+import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -312,3 +313,59 @@ def test_a_level_within_rounding_of_a_kink_holds_both_sides():
     for tol in (1e-6, 1e-10):
         outcome = whole_domain.check(case, tol=tol)
         assert not outcome.problems, (tol, outcome.problems)
+
+
+# (shape, α, cut or profile table, ν, η): a face down, faces at both poles, a disk with α ≠ 0,
+# the egg (kinks only) and a profile with a face down.
+EGG = [[0.0, -1.0], [0.45, -0.92], [0.8, -0.62], [0.98, -0.2], [0.97, 0.25], [0.8, 0.62, 1], [0.4, 0.8], [0.0, 0.86]]
+FACED = [[0.0, -0.6], [0.5, -0.6, 1], [0.9, -0.2], [1.0, 0.1], [0.8, 0.6], [0.0, 1.0]]
+HIGH_ENERGY = [
+    ("truncated_ball", 0.2, 0.4, 0.7, 1.3),
+    ("truncated_ball", -0.3, -0.5, 1.0, 2.0),
+    ("wheel", 0.1, 0.5, 1.0, 2.0),
+    ("disk", 0.3, None, 2.0, 4.0),
+    ("profile", 0.05, EGG, 0.8, 1.5),
+    ("profile", 0.1, FACED, 0.8, 1.5),
+]
+
+
+@pytest.mark.parametrize("case", HIGH_ENERGY, ids=[f"{c[0]}-{c[1]}" for c in HIGH_ENERGY])
+def test_the_high_energy_limit_of_edged_bodies_against_50_digits(case, make_atlas):
+    """The s = 0 row of a (λ, s) scene (ε = ∞: N∞(λ), docs/model.md) of a body with edges,
+    faces or kinks, against the reference's own quadrature of N∞'s θ-integral as it stands
+    (scripts/reference.py), at tol 1e-12: within the estimate, status high_energy_limit; at
+    λ = 0 a body with a face reaches it (status reaches_face, no N)."""
+    from rubber_atlas import flag_names, open_atlas
+    from reference import ProfileCell, high_energy_rotation_number
+
+    shape, alpha, second, nu, eta = case
+    lambdas = [0.0, 1e-6, 1e-3, 0.05, 0.3, 0.8, 1.2, 1.41]
+    if shape == "profile":
+        body = f"profile = {json.dumps(second)}\n"
+        axes = f"alpha = [{alpha}]\n"
+        cell = ProfileCell(second, alpha, nu, eta, 1)
+    else:
+        body = ""
+        axes = f"alpha = [{alpha}]\n" + ("" if second is None else f"cut = [{second}]\n")
+        cell = EdgedCell(shape, alpha, second or 0, nu, eta, 1)
+    scene = (f'name = "limit"\n[body]\nshape = "{shape}"\nnu = {nu}\neta = {eta}\n{body}'
+             f"[axes]\n{axes}lambda = {lambdas}\ns = [0.0, 0.5]\n[solver]\ntolerance = 1e-12\n"
+             '[outputs]\nfields = ["rotation_number", "status", "error_estimate"]\n')
+    ds = open_atlas(make_atlas(f"limit-{shape}", scene))
+    row = ds.isel(s=0).squeeze()
+    names = flag_names(ds.status)
+    faces = shape != "profile" or second is FACED
+    for i, lam in enumerate(lambdas):
+        at_lambda = row.isel({"lambda": i})
+        present = np.flatnonzero(np.asarray(at_lambda.status) != 255)
+        statuses = [names[int(at_lambda.status[k])] for k in present]
+        if lam == 0.0:
+            assert statuses == (["reaches_face"] if faces else ["high_energy_limit"]), statuses
+            continue
+        assert statuses == ["high_energy_limit"], (lam, statuses)
+        k = present[0]
+        n, err = float(at_lambda.rotation_number[k]), float(at_lambda.error_estimate[k])
+        ref, ref_err = high_energy_rotation_number(cell, lam)
+        assert ref_err < 1e-20
+        assert abs(n - float(ref)) <= err, (lam, n, err, float(ref))
+        assert err <= 1e-12, (lam, err)

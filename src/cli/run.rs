@@ -35,7 +35,7 @@ Scene files (TOML):
 
 The plane is one of: kappa with energy; kappa with excess_energy (energy measured from the
 bottom of V at each kappa); lambda with s (kappa = lambda / s, energy = 1 / s^2; s = 0 is
-the high-energy limit, for the ellipsoid only). Shapes and their parameters: docs/bodies.md.
+the high-energy limit). Shapes and their parameters: docs/bodies.md.
 Fields: theta_min, theta_max, period, omega_theta, omega_psi, rotation_number, drift,
 drift_radius, bounded, motion, status, error_estimate. Examples: atlas/*.toml in the
 repository; every key: docs/scenes.md.";

@@ -4,12 +4,15 @@
 //! small-amplitude cells, and the κ → 0 limits against cells at κ = 1e-7.
 
 use rubber_atlas::cell::{solve_cell, CellOptions};
+use rubber_atlas::limits::high_energy_limit_at_small_lambda;
 use rubber_atlas::limits::{
     bottom_rotation_number, high_energy_rotation_number, high_energy_slope, small_kappa_limit,
     HighEnergyLimit,
 };
 use rubber_atlas::torus::{CriticalKind, EffectivePotential};
-use rubber_atlas::EllipsoidBody;
+use rubber_atlas::{
+    with_body, AnyBody, Body, EdgedShape, EllipsoidBody, Profile, ProfileShape, Shape,
+};
 
 /// The bodies: the paper's type (c), the issue's counterexamples (a prolate type (a) and the
 /// strongly oblate α = 0.9, β = 20), extreme shapes and masses.
@@ -165,4 +168,120 @@ fn small_kappa_limits_match_cells() {
         .unwrap();
     let nb = bottom_rotation_number(&potential, m).unwrap();
     assert!((nb - 0.5).abs() < 1e-5, "{nb}");
+}
+
+/// A profile with a flat face down (its first stretch) and a rim.
+fn profile_with_a_face() -> Vec<Vec<f64>> {
+    vec![
+        vec![0.0, -0.6],
+        vec![0.5, -0.6, 1.0],
+        vec![0.9, -0.2],
+        vec![1.0, 0.1],
+        vec![0.8, 0.6],
+        vec![0.0, 1.0],
+    ]
+}
+
+/// The edged bodies and profiles of the high-energy tests: a face down (two cut balls), faces
+/// at both poles (a wheel, a disk with α ≠ 0), kinks only (the egg with a rim), a profile
+/// with a face and a rim.
+fn edged_bodies() -> Vec<(&'static str, AnyBody)> {
+    let profile = |rows: Vec<Vec<f64>>, alpha: f64| {
+        let shape = ProfileShape::new(Profile::from_points(&rows).unwrap(), alpha).unwrap();
+        AnyBody::Profile(Body::new(shape, 0.8, 1.5).unwrap())
+    };
+    let edged =
+        |shape: EdgedShape, nu: f64, eta: f64| AnyBody::Edged(Body::new(shape, nu, eta).unwrap());
+    vec![
+        (
+            "truncated ball 0.2, 0.4",
+            edged(EdgedShape::truncated_ball(0.2, 0.4).unwrap(), 0.7, 1.3),
+        ),
+        (
+            "truncated ball -0.3, -0.5",
+            edged(EdgedShape::truncated_ball(-0.3, -0.5).unwrap(), 1.0, 2.0),
+        ),
+        (
+            "wheel 0.1, 0.5",
+            edged(EdgedShape::wheel(0.1, 0.5).unwrap(), 1.0, 2.0),
+        ),
+        ("disk 0.3", edged(EdgedShape::disk(0.3).unwrap(), 2.0, 4.0)),
+        ("egg", profile(crate::profile::egg_with_a_rim(), 0.05)),
+        ("profile with a face", profile(profile_with_a_face(), 0.1)),
+    ]
+}
+
+/// The only component's N and its estimate at (κ, ε), at tol 1e-13.
+fn edged_cell_n<S: Shape>(body: &Body<S>, kappa: f64, energy: f64) -> (f64, f64) {
+    let r = solve_cell(body, kappa, energy, &options(1e-13)).unwrap();
+    assert_eq!(r.components.len(), 1, "κ = {kappa}, ε = {energy}");
+    let c = &r.components[0];
+    (c.rotation_number, c.error_estimate)
+}
+
+/// N∞(λ) of bodies with edges, faces and kinks (their H is not smooth: the limit is
+/// integrated in pieces, with the face's peak at the turning point taken out exactly) is
+/// where their cells go: N(ε) − N∞ = a/ε + O(1/ε²), so the cells at ε = 1e6 and 1e8
+/// extrapolated to ε = ∞ (N(1e8) + (N(1e8) − N(1e6))/99) meet N∞ to the cells' own error.
+#[test]
+fn the_high_energy_limit_of_edged_bodies_is_where_their_cells_go() {
+    for (name, body) in edged_bodies() {
+        with_body!(&body, b => {
+            for lambda in [1e-6, 1e-3, 0.05, 0.3, 0.8, 1.2, 1.41] {
+                let limit = high_energy_rotation_number(b, lambda, 1e-13).unwrap();
+                assert!(limit.error < 1e-13, "{name}, λ = {lambda}: {limit:?}");
+                let (near, near_err) = edged_cell_n(b, lambda * 1e3, 1e6);
+                let (far, far_err) = edged_cell_n(b, lambda * 1e4, 1e8);
+                let extrapolated = far + (far - near) / 99.0;
+                let gap = (extrapolated - limit.value).abs();
+                let ctx = format!(
+                    "{name}, λ = {lambda}: N∞ {limit:?}, N(1e6) {near}, N(1e8) {far}, \
+                     extrapolated {extrapolated}"
+                );
+                // O(1/ε) visible: the cells approach N∞ a hundredfold per hundredfold ε.
+                assert!((far - limit.value).abs() <= 0.02 * (near - limit.value).abs() + 1e-12, "{ctx}");
+                assert!(gap <= 1.03 * far_err + 0.03 * near_err + limit.error + 1e-12, "{ctx}");
+            }
+        });
+    }
+}
+
+/// As λ → 0 (κ fixed, ε → ∞) N∞ tends to (P(0) − P(π))/2, P = √B/J − 1 at the poles: 0 for
+/// a smooth pole, not for a face, where a passage turns ψ by −π√B/J rather than −π. Here
+/// against that closed form written out for the cut ball (a face down: U(0) = h + α,
+/// U′(0) = ρ; the sphere up), against N∞ at λ = 1e-9 and against a cell at κ = 1, ε = 1e18.
+#[test]
+fn a_face_keeps_n_away_from_zero_at_the_highest_energies() {
+    let (alpha, cut, nu, eta) = (0.2, 0.4, 0.7, 1.3);
+    let body = Body::new(EdgedShape::truncated_ball(alpha, cut).unwrap(), nu, eta).unwrap();
+    let rho2 = 1.0 - cut * cut;
+    let j2 = 1.0 / eta + (cut + alpha) * (cut + alpha);
+    let closed_form = 0.5 * (((j2 + rho2) / j2).sqrt() - 1.0);
+    let limit = high_energy_limit_at_small_lambda(&body);
+    assert!(
+        (limit - closed_form).abs() < 1e-15,
+        "{limit} against {closed_form}"
+    );
+    assert!(limit > 0.15, "{limit}");
+    let tiny = high_energy_rotation_number(&body, 1e-9, 1e-13).unwrap();
+    // N∞(λ) − N∞(0+) = O(λ log λ): 2e-8 at λ = 1e-9.
+    assert!(
+        (tiny.value - limit).abs() < 1e-7,
+        "{tiny:?} against {limit}"
+    );
+    let (n, err) = edged_cell_n(&body, 1.0, 1e18);
+    assert!(
+        (n - tiny.value).abs() < 1e-7 + err,
+        "N(1, 1e18) = {n} ± {err}, N∞ {tiny:?}"
+    );
+    // A smooth pole at both ends (the egg) gives 0; two faces give their difference.
+    let egg = ProfileShape::new(
+        Profile::from_points(&crate::profile::egg_with_a_rim()).unwrap(),
+        0.05,
+    )
+    .unwrap();
+    assert_eq!(
+        high_energy_limit_at_small_lambda(&Body::new(egg, 0.8, 1.5).unwrap()),
+        0.0
+    );
 }

@@ -246,6 +246,31 @@ fn a_table_of_an_ellipses_points_tends_to_the_ellipsoid() {
     assert!(gaps[2].1 < 1e-5, "{gaps:?}");
 }
 
+/// The same for the high-energy limit: a profile's N∞(λ), integrated in pieces between its
+/// joints, tends to the ellipsoid's, the smooth body's trapezoid sum (src/limits.rs).
+#[test]
+fn an_ellipse_tables_high_energy_limit_tends_to_the_ellipsoids() {
+    use rubber_atlas::limits::high_energy_rotation_number;
+    let (beta, alpha) = (1.6, 0.3);
+    let ellipsoid = Body::new(Ellipsoid::new(alpha, beta).unwrap(), 0.7, 1.3).unwrap();
+    for lambda in [1e-4, 0.3, 1.2] {
+        let exact = high_energy_rotation_number(&ellipsoid, lambda, 1e-13).unwrap();
+        let gaps: Vec<f64> = [41, 81, 161]
+            .iter()
+            .map(|&n| {
+                let body =
+                    Body::new(profile_shape(&ellipse_table(beta, n), alpha), 0.7, 1.3).unwrap();
+                let limit = high_energy_rotation_number(&body, lambda, 1e-13).unwrap();
+                assert!(limit.error < 1e-13, "{limit:?}");
+                (limit.value - exact.value).abs()
+            })
+            .collect();
+        let ctx = format!("λ = {lambda}: N∞ {exact:?}, gaps {gaps:?}");
+        assert!(gaps[1] < gaps[0] / 3.0 && gaps[2] < gaps[1] / 3.0, "{ctx}");
+        assert!(gaps[2] < 1e-6 * (1.0 + exact.value.abs() / lambda), "{ctx}");
+    }
+}
+
 /// Cells of a profile against the cut ball it draws: the same N and T within the two
 /// estimates, at starts that cross the edge's kink.
 #[test]
