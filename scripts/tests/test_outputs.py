@@ -94,3 +94,28 @@ def test_diagram_file_opens_with_branches_and_summary(tmp_path):
     assert np.all(cols["stable"][cols["branch"] == 1] == 0)
     assert np.all(cols["stable"][cols["branch"] != 1] == 1)
     assert np.max(cols["kappa"][cols["branch"] == 1]) == pytest.approx(summary["cusp"]["kappa"], abs=1e-12)
+
+
+def test_update_leaves_a_file_open_in_h5py_for_writing_alone(tmp_path):
+    """A researcher's file open in h5py to write ("a") is locked by HDF5, and this program
+    cannot read it: `run --update` took that for a damaged atlas of its own and replaced the
+    file (the data under the open h5py handle lost). It now refuses in one line, exit 2, and
+    the file is as it was; an atlas open in h5py only to read is still updated as usual."""
+    import h5py
+
+    scene = tmp_path / "s.toml"
+    scene.write_text('name = "s"\n[body]\nnu = 0.5\neta = 0.5\n[axes]\nalpha = [0.5]\nbeta = [3.0]\n'
+                     "kappa = { start = 0.1, stop = 1.0, num = 4 }\nenergy = { start = 1.0, stop = 2.0, num = 4 }\n")
+    mine = tmp_path / "mine.h5"
+    with h5py.File(mine, "w") as f:
+        f["precious"] = [1.0, 2.0, 3.0]
+    with h5py.File(mine, "a") as f:
+        o = subprocess.run([BIN, "run", str(scene), "--out", str(mine), "--update", "--quiet"],
+                           capture_output=True, text=True)
+        assert o.returncode == 2 and len(o.stderr.splitlines()) == 1, o.stderr
+        assert "is open for writing in another program" in o.stderr
+        assert list(f.keys()) == ["precious"] and f["precious"][2] == 3.0
+    own = tmp_path / "own.h5"
+    run("run", str(scene), "--out", str(own), "--quiet")
+    with h5py.File(own, "r"):
+        run("run", str(scene), "--out", str(own), "--update", "--quiet")

@@ -76,8 +76,9 @@ pub struct RunArgs {
     /// No progress and no summary.
     #[arg(long)]
     pub quiet: bool,
-    /// (Internal, for --update) Exit 0 if the output is current, 3 if not: asked in a
-    /// child process, since reading a damaged file can crash HDF5.
+    /// (Internal, for --update) Exit 0 if the output is current, 3 if not, 4 if it is not an
+    /// atlas of rubber-atlas, 5 if another scene's, 6 if another program holds it open for
+    /// writing: asked in a child process, since reading a damaged file can crash HDF5.
     #[arg(long, hide = true)]
     pub probe_current: bool,
 }
@@ -129,6 +130,17 @@ fn output_current(args: &RunArgs, out: &std::path::Path) -> Result<bool> {
             }
             .into());
         }
+        // Open for writing in another program: not readable here, and not ours to replace.
+        Ok(status) if status.code() == Some(6) => {
+            return Err(AtlasError::Atlas {
+                path: out.display().to_string(),
+                reason: "is open for writing in another program (it holds the file's HDF5 \
+                         lock): --update neither reads nor replaces it; close it there and run \
+                         again (or run with --force in its place to replace it)"
+                    .into(),
+            }
+            .into());
+        }
         Ok(status) if status.code().is_none() && !args.quiet => {
             eprintln!(
                 "rubber-atlas: reading {} crashed HDF5 (a damaged file); it is computed afresh",
@@ -164,7 +176,9 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
     }
     if args.probe_current {
         use rubber_atlas::store::atlas_file::AtlasFile;
-        std::process::exit(if sweep::output_is_current(&out, &scene, shard) {
+        std::process::exit(if AtlasFile::is_locked_by_another(&out) {
+            6
+        } else if sweep::output_is_current(&out, &scene, shard) {
             0
         } else if AtlasFile::is_foreign(&out) {
             4

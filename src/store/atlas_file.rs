@@ -327,6 +327,15 @@ impl AtlasFile {
         })
     }
 
+    /// Whether another process holds the file at `path` open for writing with HDF5's lock (an
+    /// exclusive flock, which HDF5 takes on every file it opens to write: h5py in mode "a",
+    /// another program writing it). Such a file cannot be opened here, which is neither
+    /// damage nor proof that it is an atlas: `--update` must not replace it.
+    pub fn is_locked_by_another(path: &Path) -> bool {
+        std::fs::File::open(path)
+            .is_ok_and(|f| matches!(f.try_lock_shared(), Err(std::fs::TryLockError::WouldBlock)))
+    }
+
     /// The `scene_name` attribute of the atlas at `path`, if it can be read.
     pub fn scene_name(path: &Path) -> Option<String> {
         let file = hdf5::File::open(path).ok()?;

@@ -16,6 +16,32 @@ mod run;
 mod units;
 mod verdict;
 
+/// How [`h5`] opens a file.
+pub enum H5 {
+    Create,
+    Read,
+    ReadWrite,
+}
+
+/// An HDF5 file opened by this test process, with HDF5's file locking off. HDF5 opens without
+/// O_CLOEXEC and locks with flock, so a program another test spawns while a file is open here
+/// inherits the descriptor and keeps the file locked for as long as it runs, even after the
+/// file is closed here; the program a test runs next on that file then fails to open it
+/// ("unable to lock file, errno = 11"). That made `run::four_shards_merged_equal_a_single_run`
+/// and `cli::update_replaces_only_its_own_files` fail now and then (reproduced: a child that
+/// slept 3 s held a file closed here locked until it ended).
+pub fn h5(path: impl AsRef<std::path::Path>, mode: H5) -> hdf5::File {
+    let mut builder = hdf5::File::with_options();
+    builder.with_fapl(|p| p.file_locking(false));
+    let path = path.as_ref();
+    match mode {
+        H5::Create => builder.create(path),
+        H5::Read => builder.open(path),
+        H5::ReadWrite => builder.open_rw(path),
+    }
+    .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
 /// How far the full equations carry the centre of mass from `start` on `body` in time
 /// `t_end` (an unbounded path runs away n·|Δζ| in n periods).
 pub fn full_model_distance<S: rubber_atlas::Shape>(

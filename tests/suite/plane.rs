@@ -43,7 +43,7 @@ fn run_scene_text(dir: &Path, text: &str) -> hdf5::File {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    hdf5::File::open(out).unwrap()
+    crate::h5(out, crate::H5::Read)
 }
 
 fn read4(f: &hdf5::File, name: &str) -> ndarray::Array4<f64> {

@@ -57,7 +57,7 @@ fn ok(output: &Output) -> String {
 
 /// Every dataset of an atlas file as raw bytes, by name.
 fn arrays(path: &Path) -> Vec<(String, Vec<u8>)> {
-    let file = hdf5::File::open(path).unwrap();
+    let file = crate::h5(path, crate::H5::Read);
     let mut out = Vec::new();
     for name in file.member_names().unwrap() {
         let ds = file.dataset(&name).unwrap();
@@ -206,7 +206,7 @@ fn atlas_values_equal_the_cell_command() {
         out.to_str().unwrap(),
         "--quiet",
     ]));
-    let file = hdf5::File::open(&out).unwrap();
+    let file = crate::h5(&out, crate::H5::Read);
     let n = file
         .dataset("rotation_number")
         .unwrap()
@@ -549,7 +549,7 @@ fn four_shards_merged_equal_a_single_run() {
     for (i, index) in [(0usize, 2i64), (1, 1)] {
         let copy = dir.path().join(format!("swapped-{i}.h5"));
         std::fs::copy(&shards[i], &copy).unwrap();
-        let f = hdf5::File::open_rw(&copy).unwrap();
+        let f = crate::h5(&copy, crate::H5::ReadWrite);
         f.attr("shard_index").unwrap().write_scalar(&index).unwrap();
     }
     let mut swapped = vec!["merge".to_string()];
@@ -589,8 +589,7 @@ fn tiny_slices_are_grouped_into_units_and_their_shards_merge() {
     .unwrap();
     let s = scene.to_str().unwrap();
     let single = run_quietly(s, &dir.path().join("single.h5"));
-    let chunks = hdf5::File::open(&single)
-        .unwrap()
+    let chunks = crate::h5(&single, crate::H5::Read)
         .dataset("rotation_number")
         .unwrap()
         .chunk()
@@ -628,7 +627,7 @@ fn a_shard_file_holds_just_its_region_equal_to_a_single_run() {
     let dir = tempfile::tempdir().unwrap();
     let scene = small_scene(dir.path());
     let whole = run_quietly(scene.to_str().unwrap(), &dir.path().join("whole.h5"));
-    let whole = hdf5::File::open(&whole).unwrap();
+    let whole = crate::h5(&whole, crate::H5::Read);
     let read_f64 = |f: &hdf5::File, name: &str| f.dataset(name).unwrap().read_raw::<f64>().unwrap();
     let whole_alpha = read_f64(&whole, "alpha");
     let whole_n = whole
@@ -648,7 +647,7 @@ fn a_shard_file_holds_just_its_region_equal_to_a_single_run() {
             &format!("{i}/2"),
             "--quiet",
         ]));
-        let f = hdf5::File::open(&shard).unwrap();
+        let f = crate::h5(&shard, crate::H5::Read);
         // The scene has two alpha, two beta and one block of kappa rows: shards split alpha.
         let alpha = read_f64(&f, "alpha");
         assert_eq!(alpha.len(), 1);
@@ -921,7 +920,7 @@ fn edged_body_atlases_equal_the_cell_command_and_their_shards_merge() {
         let s = scene.to_str().unwrap();
         let single = dir.path().join(format!("{shape}.h5"));
         let summary = ok(&run(&["run", s, "--out", single.to_str().unwrap()]));
-        let file = hdf5::File::open(&single).unwrap();
+        let file = crate::h5(&single, crate::H5::Read);
         // The dimensions are the shape's parameters: the disk's file has no second one.
         let status = file.dataset("cell_status").unwrap();
         let grid: Vec<usize> = [2].into_iter().chain(values.first().map(|_| 2)).collect();
@@ -1262,7 +1261,7 @@ fn a_profile_atlas_equals_the_cell_command() {
         "--out",
         out.to_str().unwrap(),
     ]));
-    let file = hdf5::File::open(&out).unwrap();
+    let file = crate::h5(&out, crate::H5::Read);
     let text = |name: &str| {
         file.attr(name)
             .unwrap()
