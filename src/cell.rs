@@ -254,8 +254,10 @@ pub fn solve_high_energy_limit<S: Shape>(
         family: high_energy_families(body, lambda)[0],
         status: if onto_a_face {
             Status::ReachesFace
-        } else {
+        } else if n.error <= options.tol {
             Status::HighEnergyLimit
+        } else {
+            Status::ToleranceNotReached
         },
         error_estimate: n.error,
         errors: ErrorEstimates {

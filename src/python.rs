@@ -696,6 +696,33 @@ fn resonance<'py>(
     ))
 }
 
+/// Which integers N reaches over the (κ, ε) plane of one body of any shape, as JSON (the
+/// `verdict --shape … --json` object), with the GIL released and Ctrl-C heard between
+/// components.
+#[pyfunction]
+#[pyo3(signature = (alpha, beta, nu, eta, tol, resolution, shape="ellipsoid", profile=None))]
+#[allow(clippy::too_many_arguments)]
+fn census(
+    py: Python<'_>,
+    alpha: f64,
+    beta: f64,
+    nu: f64,
+    eta: f64,
+    tol: f64,
+    resolution: i64,
+    shape: &str,
+    profile: Option<Vec<Vec<f64>>>,
+) -> PyResult<String> {
+    let resolution = resolution_between(resolution, 8, "")?;
+    let body = any_body(shape, profile.as_deref(), alpha, beta, nu, eta)?;
+    let options = crate::verdict::CensusOptions { tol, resolution };
+    let report = interruptible(py, &None, |stop| {
+        crate::verdict::census_report(&body, &options, stop)
+    })?
+    .map_err(value_error)?;
+    serde_json::to_string(&report).map_err(|e| bad(e.to_string()))
+}
+
 /// The verdict of the boundedness hypothesis (docs/hypothesis.md) for each body, as JSON (the
 /// `verdict --json` object), computed in parallel with the GIL released.
 #[pyfunction]
@@ -841,6 +868,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(trajectory, m)?)?;
     m.add_function(wrap_pyfunction!(resonance, m)?)?;
     m.add_function(wrap_pyfunction!(verdicts, m)?)?;
+    m.add_function(wrap_pyfunction!(census, m)?)?;
     m.add_function(wrap_pyfunction!(boundaries, m)?)?;
     Ok(())
 }

@@ -22,7 +22,9 @@
 //! β² > 1 + α and α > 0: bounded for κ > κ_max, the top (fold) of the N = 0 curve that hugs
 //! σ_u. Other bodies (α = 0 with β ≥ 1, and β² = 1 + α exactly) are not covered.
 
-use crate::body::Shape;
+use crate::body::{Body, Shape};
+
+mod census;
 use crate::cell::{solve_component, CellOptions, Status};
 use crate::critical::{CriticalSet, DiagramType};
 use crate::error::{check_range, AtlasError, Result};
@@ -30,6 +32,10 @@ use crate::limits::{golden_max, HighEnergyLimit};
 use crate::resonance::{self, bracketed_root, ResonanceOptions};
 use crate::torus::{CriticalKind, EffectivePotential, MotionKind};
 use crate::EllipsoidBody;
+pub use census::{
+    census, census_report, high_energy_scan, Census, CensusOptions, CensusReport, HighEnergyScan,
+    LimitResonance,
+};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -246,16 +252,35 @@ fn grid_energy(low: f64, q: f64) -> f64 {
     low / ((1.0 - q) * (1.0 - q))
 }
 
-struct Sampler<'a> {
-    body: &'a EllipsoidBody,
+struct Sampler<'a, S: Shape> {
+    body: &'a Body<S>,
     cell: CellOptions,
     energies: usize,
+    /// Base energies ε = V_low/(1 − q)² (the ellipsoid, whose V_low > 0), or, for any body,
+    /// ε = V_low + max(|V_low|, 1)((1 − q)^{−2} − 1), which stays spread where V_low ≤ 0 or
+    /// is tiny (the disk's U reaches 0 and below).
+    offset_energies: bool,
+    /// A point on a resonance needs only N's error within the tolerance, not every output's
+    /// (the census: beside a separatrix T's relative error is the first to miss it, while N
+    /// and the drift are sharp); the verdict asks for status ok.
+    n_alone: bool,
     /// Asked to stop: no new component is solved (the verdict then returns
     /// [`AtlasError::Stopped`]).
     stop: &'a (dyn Fn() -> bool + Sync),
 }
 
-impl Sampler<'_> {
+impl<S: Shape> Sampler<'_, S> {
+    /// The energy of base grid point q at the bottom `low` of a line.
+    fn energy(&self, low: f64, q: f64) -> f64 {
+        if self.offset_energies {
+            let scale = low.abs().max(1.0);
+            let floor = low - scale;
+            floor + scale / ((1.0 - q) * (1.0 - q))
+        } else {
+            grid_energy(low, q)
+        }
+    }
+
     /// Every component at every sampled energy of the κ-line.
     fn line(&self, kappa: f64) -> Vec<Sample> {
         let potential = EffectivePotential::new(self.body, kappa);
@@ -265,12 +290,12 @@ impl Sampler<'_> {
             return Vec::new();
         };
         let mut energies: Vec<(f64, Option<usize>)> = (0..self.energies)
-            .map(|i| (grid_energy(low, grid_q(i, self.energies)), Some(i)))
+            .map(|i| (self.energy(low, grid_q(i, self.energies)), Some(i)))
             .collect();
         energies.extend(
             HIGH_ENERGY_TAIL
                 .iter()
-                .map(|&t| (grid_energy(low, 1.0 - t), None)),
+                .map(|&t| (self.energy(low, 1.0 - t), None)),
         );
         energies.extend(
             potential
@@ -598,6 +623,26 @@ fn polish_fold(
     Some((root, width + cell.tol / slope.abs().max(f64::MIN_POSITIVE)))
 }
 
+/// The solver's tolerance (1e-13 … 1e-4) and the resolution (8 … 4096) of a verdict's or a
+/// census's sampling, refused in one line naming the value.
+fn check_sampling(tol: f64, resolution: usize) -> Result<()> {
+    check_range(
+        "tol",
+        tol,
+        Some((1e-13, true)),
+        Some((1e-4, true)),
+        "must satisfy 1e-13 <= tol <= 1e-4",
+    )?;
+    if !(8..=4096).contains(&resolution) {
+        return Err(AtlasError::InvalidParameter {
+            name: "resolution",
+            value: resolution as f64,
+            reason: "must be between 8 and 4096",
+        });
+    }
+    Ok(())
+}
+
 /// The verdict for one body with α ≥ 0.
 pub fn verdict(body: &EllipsoidBody, options: &VerdictOptions) -> Result<Verdict> {
     verdict_until(body, options, &|| false)
@@ -625,20 +670,7 @@ pub fn verdict_until(
             reason: "the verdict is computed for alpha >= 0; alpha < 0 is its mirror image theta -> pi - theta",
         });
     }
-    check_range(
-        "tol",
-        options.tol,
-        Some((1e-13, true)),
-        Some((1e-4, true)),
-        "must satisfy 1e-13 <= tol <= 1e-4",
-    )?;
-    if !(8..=4096).contains(&options.resolution) {
-        return Err(AtlasError::InvalidParameter {
-            name: "resolution",
-            value: options.resolution as f64,
-            reason: "must be between 8 and 4096",
-        });
-    }
+    check_sampling(options.tol, options.resolution)?;
     let case = Case::of(alpha, beta);
     // Beyond the checked bodies even the limit is not computed (at β = 1e10 its quadrature
     // takes a minute and means nothing): its values are null there.
@@ -752,6 +784,8 @@ pub fn verdict_until(
             body,
             cell,
             energies: half,
+            offset_energies: false,
+            n_alone: false,
             stop,
         };
         let lines: Vec<Vec<Sample>> = kappas.par_iter().map(|&k| sampler.line(k)).collect();
@@ -768,6 +802,8 @@ pub fn verdict_until(
         body,
         cell,
         energies: resolution,
+        offset_energies: false,
+        n_alone: false,
         stop,
     };
     let (kappas, lines) = coarse.unwrap_or_else(|| {
@@ -798,25 +834,15 @@ pub fn verdict_until(
         if options.counterexamples && !found.iter().any(|c| c.integer == *k) {
             // The resonance it proves lies at larger κ: two more lines, as far as double
             // precision resolves ε − V (κ² ≲ 1e12).
-            let extra: Vec<Vec<Sample>> = EXTRA_KAPPA_LINES
-                .par_iter()
-                .map(|&k| sampler.line(k))
-                .collect();
             kappa_top = *EXTRA_KAPPA_LINES.last().expect("lines");
-            let mut joined = vec![lines.last().cloned().unwrap_or_default()];
-            joined.extend(extra);
-            let more = brackets(&joined, options.tol, symmetric);
+            let (_, more, extra_failures) = search_beyond(
+                &sampler,
+                lines.last().map_or(&[][..], |l| &l[..]),
+                symmetric,
+                &mut found,
+            );
             integer_brackets += more.len();
-            let (extra_found, extra_failures) = counterexamples(&sampler, &more);
             refinement_failures += extra_failures;
-            for c in extra_found {
-                if !found
-                    .iter()
-                    .any(|f| f.integer == c.integer && f.kappa == c.kappa)
-                {
-                    found.push(c);
-                }
-            }
         }
     }
     verdict.counterexamples = found;
@@ -884,8 +910,8 @@ pub fn verdict_until(
 /// The largest `sign` · `value` over the samples that pass `eligible`, refined round the best
 /// of them by golden sections until it stops growing (below), so that it follows the true
 /// extremum rather than the grid. `value(N, κ, ε)`; None without an eligible sample.
-fn refined_extreme(
-    sampler: &Sampler<'_>,
+fn refined_extreme<S: Shape>(
+    sampler: &Sampler<'_, S>,
     lines: &[Vec<Sample>],
     sign: f64,
     eligible: &dyn Fn(&Sample) -> bool,
@@ -1009,8 +1035,8 @@ fn refined_extreme(
 /// samples are refined ([`refined_extreme`]): a margin that follows the grid would move its
 /// root, the boundary, with the resolution (N_min by 9.8e-4 in β from resolution 16 to 64 at
 /// α = 0.5). The edge κ → ∞ contributes N∞(λ)/λ and N∞'s extrema.
-fn fail_margin(
-    sampler: &Sampler<'_>,
+fn fail_margin<S: Shape>(
+    sampler: &Sampler<'_, S>,
     lines: &[Vec<Sample>],
     high_energy: &HighEnergyLimit,
     (n_lo, n_hi): (f64, f64),
@@ -1049,8 +1075,8 @@ fn fail_margin(
 
 /// The smallest and the largest N over the samples, each refined ([`refined_extreme`]), and
 /// over the high-energy limit's N∞ (κ → ∞).
-fn rotation_number_range(
-    sampler: &Sampler<'_>,
+fn rotation_number_range<S: Shape>(
+    sampler: &Sampler<'_, S>,
     lines: &[Vec<Sample>],
     high_energy: &HighEnergyLimit,
 ) -> (f64, f64) {
@@ -1183,6 +1209,36 @@ fn limit_undecided(h: &HighEnergyLimit) -> Option<String> {
     })
 }
 
+/// The lines beyond the last regular one ([`EXTRA_KAPPA_LINES`]), searched when a limit
+/// proves a resonance the regular lines did not reach (it lies at larger κ, as far as double
+/// precision resolves ε − V: κ² ≲ 1e12). Their new counterexamples are added to `found`;
+/// returns the lines, their brackets (with the `last` regular line) and the refinements that
+/// failed.
+fn search_beyond<S: Shape>(
+    sampler: &Sampler<'_, S>,
+    last: &[Sample],
+    symmetric: bool,
+    found: &mut Vec<Counterexample>,
+) -> (Vec<Vec<Sample>>, Vec<Candidate>, usize) {
+    let extra: Vec<Vec<Sample>> = EXTRA_KAPPA_LINES
+        .par_iter()
+        .map(|&k| sampler.line(k))
+        .collect();
+    let mut joined = vec![last.to_vec()];
+    joined.extend(extra.iter().cloned());
+    let more = brackets(&joined, sampler.cell.tol, symmetric);
+    let (extra_found, failures) = counterexamples(sampler, &more);
+    for c in extra_found {
+        if !found
+            .iter()
+            .any(|f| f.integer == c.integer && f.kappa == c.kappa)
+        {
+            found.push(c);
+        }
+    }
+    (extra, more, failures)
+}
+
 /// Integer brackets along each line (same family: gap and well) and across neighbouring
 /// lines at the same base energy index. Along a line, a sample is paired with the next one of
 /// its family whose N is off every integer by more than its error bar, so that a sample that
@@ -1219,8 +1275,8 @@ fn brackets(lines: &[Vec<Sample>], tol: f64, symmetric: bool) -> Vec<Candidate> 
 /// bracket nearest κ = 1 (the most tractable to check with a trajectory), then the one of
 /// largest κ (how far the resonance reaches). Returns them and the number of failed
 /// refinements.
-fn counterexamples(
-    sampler: &Sampler<'_>,
+fn counterexamples<S: Shape>(
+    sampler: &Sampler<'_, S>,
     candidates: &[Candidate],
 ) -> (Vec<Counterexample>, usize) {
     let mut integers: Vec<i64> = candidates.iter().map(|c| c.k).collect();
@@ -1258,7 +1314,7 @@ fn counterexamples(
 /// The bracket refined to N = k by regula falsi (along ε on one line, or along the segment
 /// between two lines at one base energy index), then solved with the drift: a counterexample
 /// if the drift over a period exceeds its error.
-fn refine(sampler: &Sampler<'_>, c: &Candidate) -> Option<Counterexample> {
+fn refine<S: Shape>(sampler: &Sampler<'_, S>, c: &Candidate) -> Option<Counterexample> {
     let k = c.k as f64;
     let tol = sampler.cell.tol;
     let (kappa, energy) = match c.b {
@@ -1280,7 +1336,7 @@ fn refine(sampler: &Sampler<'_>, c: &Candidate) -> Option<Counterexample> {
             let at = |t: f64| -> Option<(f64, f64)> {
                 let kappa = c.a.kappa + t * (b.kappa - c.a.kappa);
                 let low = EffectivePotential::new(sampler.body, kappa).lowest_minimum()?;
-                Some((kappa, grid_energy(low, q)))
+                Some((kappa, sampler.energy(low, q)))
             };
             let f = |t: f64| {
                 let (kappa, energy) = at(t)?;
@@ -1291,10 +1347,14 @@ fn refine(sampler: &Sampler<'_>, c: &Candidate) -> Option<Counterexample> {
         }
     };
     let (component, r) = sampler.solve(kappa, energy, &c.a, true)?;
-    // Only a value the solver vouches for: status ok (every error within the tolerance),
-    // and N on the integer within that tolerance.
-    if r.status != Status::Ok || (r.rotation_number - k).abs() > sampler.cell.tol + r.error_estimate
-    {
+    // Only a value the solver vouches for: status ok (every error within the tolerance), or
+    // for a census N's own error within it; and N on the integer within that tolerance.
+    let vouched = if sampler.n_alone {
+        r.status != Status::Separatrix && r.error_estimate <= sampler.cell.tol
+    } else {
+        r.status == Status::Ok
+    };
+    if !vouched || (r.rotation_number - k).abs() > sampler.cell.tol + r.error_estimate {
         return None;
     }
     if r.bounded != Some(false) {

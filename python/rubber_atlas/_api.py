@@ -1977,6 +1977,59 @@ def resonance(alpha: float, beta: float, nu: float, eta: float, rotation_number,
     return _table(table, attrs)
 
 
+def census(alpha: float, nu: float, eta: float, *, shape: str, cut: float | None = None, profile=None,
+           tol: float = 1e-10, resolution: int = 64) -> dict:
+    """Which integers N reaches over the whole (κ, ε) plane of a body other than the ellipsoid
+    (docs/bodies.md, "Which integers N reaches"): `rubber-atlas verdict --shape … --json`.
+
+    The paper's hypothesis is the ellipsoid's (`verdict`); for the disk, the cut balls and a
+    profile this reports the integer resonances found, each with a point where the path runs
+    away, and what the high-energy limit proves. It claims no boundedness.
+
+    Parameters
+    ----------
+    alpha, nu, eta : float
+        The body: α its centre of mass (docs/bodies.md), 0 < ν ≤ 2, η > 0.
+    shape : str
+        "disk", "truncated_ball", "wheel" or "profile".
+    cut : float, optional
+        h of the cut balls.
+    profile : rows of (rho, z) or (rho, z, edge), optional
+        The meridian of shape="profile", as for `cells`.
+    tol : float, default 1e-10
+        The cell solver's tolerance (1e-13 … 1e-4): N at a point equals the integer to this.
+    resolution : int, default 64
+        κ-lines of each kind and base energies per line (8 … 4096).
+
+    Returns
+    -------
+    dict
+        ``shape``, the shape's parameters, ``nu``, ``eta``; ``integers`` (reached where the
+        path runs away), ``bracketed`` (between samples, no point confirmed),
+        ``counterexamples`` (κ, ε, N, θ range, drift and its error, family, component),
+        ``from_limits``, ``unbounded_motion`` (True, or None when none was found),
+        ``high_energy`` (N∞'s limit at λ → 0, extrema, sign changes) and ``evidence``.
+
+    Raises
+    ------
+    ValueError
+        A parameter out of range, or shape="ellipsoid" (use `verdict`).
+    TypeError
+        A parameter that is not one number, `resolution` not a whole number.
+
+    Examples
+    --------
+    >>> import rubber_atlas as ra
+    >>> c = ra.census(0.2, 0.7, 1.3, shape="truncated_ball", cut=0.4, resolution=16)
+    >>> 0 in c["integers"], c["unbounded_motion"]
+    (True, True)
+    """
+    if isinstance(shape, str) and shape == "ellipsoid":
+        raise ValueError("census: shape = \"ellipsoid\" has the paper's hypothesis: use verdict(alpha, beta, nu, eta)")
+    body, shape, extra, values, named = _one_body(shape, alpha, None, nu, eta, cut, profile)
+    return json.loads(_core.census(*values, _real("tol", tol), _count("resolution", resolution), **extra))
+
+
 _CASES = {"1": 0, "2": 1, "not_covered": 2}
 
 

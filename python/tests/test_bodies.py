@@ -238,3 +238,34 @@ def test_a_profile_is_recorded_from_its_lower_pole_whichever_way_it_is_given():
                   fields=["rotation_number"])
     assert down.attrs["profile"] == up.attrs["profile"] and down.attrs["profile"].startswith("0.0 -1.0 0")
     assert float(down.rotation_number[0]) == float(up.rotation_number[0])
+
+
+@pytest.mark.parametrize("shape", ["disk", "truncated_ball", "profile"])
+def test_census_equals_verdict_of_the_shape(shape, tmp_path):
+    """`census` is `verdict --shape … --json` as a dict, equal to the command's."""
+    cut = 0.4 if shape == "truncated_ball" else None
+    alpha = -0.1 if shape == "profile" else 0.3
+    profile = EGG if shape == "profile" else None
+    got = ra.census(alpha, 0.7, 1.3, shape=shape, cut=cut, profile=profile, resolution=16)
+    args = ["verdict", "--shape", shape, "--alpha", alpha, "--nu", "0.7", "--eta", "1.3", "--resolution", "16",
+            "--json"]
+    if cut is not None:
+        args += ["--cut", cut]
+    if profile is not None:
+        table = tmp_path / "egg.txt"
+        table.write_text("".join(" ".join(str(x) for x in row) + "\n" for row in profile))
+        args += ["--profile", str(table)]
+    assert got == json.loads(run(*args))
+    assert got["shape"] == shape and 0 in got["integers"] and got["unbounded_motion"] is True
+
+
+@pytest.mark.parametrize("kwargs, error, words", [
+    (dict(shape="ellipsoid"), ValueError, "use verdict"),
+    (dict(shape="wheel"), TypeError, "needs cut"),
+    (dict(shape="disk", resolution=4), ValueError, "resolution"),
+    (dict(shape="disk", tol=1.0), ValueError, "tol"),
+    (dict(shape="disk", resolution=16.5), TypeError, "resolution"),
+])
+def test_census_refuses_what_it_does_not_take(kwargs, error, words):
+    with pytest.raises(error, match=words):
+        ra.census(0.3, 0.7, 1.3, **kwargs)

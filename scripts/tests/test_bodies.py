@@ -326,6 +326,8 @@ HIGH_ENERGY = [
     ("disk", 0.3, None, 2.0, 4.0),
     ("profile", 0.05, EGG, 0.8, 1.5),
     ("profile", 0.1, FACED, 0.8, 1.5),
+    # Nearly its own mirror image: Q = P(θ) − P(π − θ) cancels (its rounding was short 120×).
+    ("disk", 1e-8, None, 1.0, 1.0),
 ]
 
 
@@ -339,7 +341,8 @@ def test_the_high_energy_limit_of_edged_bodies_against_50_digits(case, make_atla
     from reference import ProfileCell, high_energy_rotation_number
 
     shape, alpha, second, nu, eta = case
-    lambdas = [0.0, 1e-6, 1e-3, 0.05, 0.3, 0.8, 1.2, 1.41]
+    # The last one ulp below √2, where 1 − λ/√2 must keep its digits (it was 25 % off).
+    lambdas = [0.0, 1e-6, 1e-3, 0.05, 0.3, 0.8, 1.2, 1.41, 1.4142135623730949]
     if shape == "profile":
         body = f"profile = {json.dumps(second)}\n"
         axes = f"alpha = [{alpha}]\n"

@@ -71,7 +71,8 @@ pub enum Command {
     Resonance(ResonanceArgs),
     /// The paper's boundedness hypothesis for one body over the whole (κ, ε) plane: its case,
     /// whether it holds, κ_max, counterexamples on integer resonances and the high-energy
-    /// limit N∞(λ); with --boundaries, the β at which the verdict changes for one α.
+    /// limit N∞(λ); with --boundaries, the β at which the verdict changes for one α; with
+    /// --shape (a disk, a cut ball, a profile), which integers N reaches over its plane.
     Verdict(VerdictArgs),
     /// Prints a completion script for a shell, e.g. `rubber-atlas completions bash >
     /// /etc/bash_completion.d/rubber-atlas`.

@@ -1,7 +1,7 @@
 //! `rubber-atlas verdict`: the boundedness hypothesis for one body, or the β where its verdict
 //! changes along β.
 
-use crate::cli::number;
+use crate::cli::{number, BodyShapeArgs, ShapeKindArg};
 use anyhow::Result;
 use clap::Args;
 use rubber_atlas::error::{show, show_digits as digits, AtlasError};
@@ -20,10 +20,21 @@ pub struct VerdictArgs {
         long,
         value_parser = number,
         allow_hyphen_values = true,
-        required_unless_present = "boundaries",
+        required_unless_present_any = ["boundaries", "shape"],
         conflicts_with = "boundaries"
     )]
     pub beta: Option<f64>,
+    /// Another body (disk, truncated_ball, wheel, profile; docs/bodies.md): not the paper's
+    /// hypothesis, which is the ellipsoid's, but which integers N reaches over its whole
+    /// (κ, ε) plane, with points where the path runs away.
+    #[arg(long, value_enum, conflicts_with = "boundaries")]
+    pub shape: Option<ShapeKindArg>,
+    /// h of the cut balls (--shape truncated_ball or wheel).
+    #[arg(value_parser = number, long, allow_hyphen_values = true)]
+    pub cut: Option<f64>,
+    /// The meridian's table of --shape profile.
+    #[arg(long, value_name = "FILE")]
+    pub profile: Option<std::path::PathBuf>,
     /// ν = i3/i1, 0 < ν <= 2.
     #[arg(value_parser = number, long, allow_hyphen_values = true)]
     pub nu: f64,
@@ -163,6 +174,9 @@ pub(super) fn verdict(args: VerdictArgs) -> Result<()> {
         }
         return Ok(());
     }
+    if let Some(shape) = args.shape.filter(|&s| s != ShapeKindArg::Ellipsoid) {
+        return census(&args, shape);
+    }
     let beta = args.beta.unwrap_or(1.0);
     let body = EllipsoidBody::ellipsoid(args.alpha, beta, args.nu, args.eta)?;
     let options = VerdictOptions {
@@ -267,4 +281,124 @@ fn resolution(text: &str) -> std::result::Result<usize, String> {
         .and_then(|n| u32::try_from(n).ok())
         .map(|n| n as usize)
         .ok_or_else(|| range.to_string())
+}
+
+/// The census of a body other than the ellipsoid (`verdict --shape`): which integers N
+/// reaches over its plane ([`verdict::census`]).
+fn census(args: &VerdictArgs, shape: ShapeKindArg) -> Result<()> {
+    let body = BodyShapeArgs {
+        shape,
+        alpha: args.alpha,
+        beta: args.beta,
+        cut: args.cut,
+        profile: args.profile.clone(),
+    }
+    .body(args.nu, args.eta)?;
+    let options = verdict::CensusOptions {
+        tol: args.tol,
+        resolution: args.resolution,
+    };
+    let full = verdict::census_report(&body, &options, &crate::stop::requested)?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&full)?);
+        return Ok(());
+    }
+    let report = &full.census;
+    let parameters = body.shape_parameters();
+    let named: Vec<String> = parameters
+        .iter()
+        .map(|(name, value)| format!("{name} = {}", show(*value)))
+        .collect();
+    println!(
+        "{} {} (nu = {}, eta = {}): which integers N reaches over the (kappa, energy) plane",
+        body.shape_name(),
+        named.join(", "),
+        show(args.nu),
+        show(args.eta)
+    );
+    println!("  (the paper's hypothesis is the ellipsoid's: this is a census, not a verdict)");
+    let list = |ks: &[i64]| -> String {
+        if ks.is_empty() {
+            "none".to_string()
+        } else {
+            ks.iter()
+                .map(|k| k.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        }
+    };
+    println!(
+        "  integers reached where the path runs away: {}",
+        list(&report.integers)
+    );
+    let spans = |rs: &[[i64; 2]]| -> String {
+        rs.iter()
+            .map(|&[a, b]| match b - a {
+                0 => a.to_string(),
+                1 => format!("{a}, {b}"),
+                _ => format!("{a} ... {b}"),
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if !report.bracketed.is_empty() {
+        println!(
+            "  bracketed by samples of one family, no point confirmed: {}",
+            spans(&report.bracketed)
+        );
+    }
+    match report.unbounded_motion {
+        Some(true) => {
+            println!("  unbounded motion: yes, where N is an integer and the drift is not 0:")
+        }
+        _ => println!(
+            "  unbounded motion: {}",
+            report.evidence.undecided.as_deref().unwrap_or("not shown")
+        ),
+    }
+    for c in &report.counterexamples {
+        println!(
+            "    N = {} at kappa = {}, energy = {} (component {}, theta in [{:.6}, {:.6}]): |drift| = {} +- {} a period",
+            c.integer,
+            digits(c.kappa, 10),
+            digits(c.energy, 10),
+            c.component,
+            c.theta_min,
+            c.theta_max,
+            digits(c.drift, 6),
+            digits(c.drift_error, 2)
+        );
+    }
+    for l in &report.from_limits {
+        println!(
+            "  proved by a limit: N = {}: {}",
+            spans(&[[l.lowest, l.highest]]),
+            l.reason
+        );
+    }
+    let h = &report.high_energy;
+    println!(
+        "  high energy: N_inf -> {} as lambda -> 0; min {} at lambda = {}; max {} at lambda = {}; sign changes at lambda = {:?} (error {})",
+        digits(h.at_small_lambda, 10),
+        digits(h.n_min, 10),
+        digits(h.lambda_at_min, 6),
+        digits(h.n_max, 10),
+        digits(h.lambda_at_max, 6),
+        h.zeros,
+        digits(h.error, 2)
+    );
+    let e = &report.evidence;
+    println!(
+        "  evidence: {} kappa-lines in [{}, {}], {} energies per line, {} components; N sampled in [{}, {}]; {} integer brackets, {} refinements failed",
+        e.kappa_lines,
+        show(e.kappa_range[0]),
+        show(e.kappa_range[1]),
+        e.energies_per_line,
+        e.components_solved,
+        digits(e.rotation_number_range[0], 6),
+        digits(e.rotation_number_range[1], 6),
+        e.integer_brackets,
+        e.refinement_failures
+    );
+    Ok(())
 }

@@ -1398,3 +1398,97 @@ fn tanh_sinh_sums_that_stall_by_a_pole_are_not_trusted() {
         }
     }
 }
+
+/// `verdict --shape` (src/verdict/census.rs): which integers N reaches over the plane of
+/// each edged body of docs/bodies.md's table. It finds the resonance curves that table lists
+/// (the disk's N = −1, 0, 1, the cut ball's 0 and 1, the wheel's 0 and 1), and each point it
+/// reports runs away in the full equations (which see the body only through its contact
+/// point): after 5 periods the centre of mass is 5·|Δζ| from its start, to 1e-6. The cut
+/// ball's N = 0 is also proved by the high-energy limit (N∞ changes sign at λ ≈ 0.884).
+#[test]
+fn a_census_finds_the_resonances_and_its_points_run_away_in_the_full_equations() {
+    use rubber_atlas::verdict::{census, CensusOptions};
+    let options = CensusOptions {
+        tol: 1e-10,
+        resolution: 32,
+    };
+    for (shape, nu, eta, expected) in [
+        (EdgedShape::disk(0.3).unwrap(), 2.0, 4.0, vec![-1, 0, 1]),
+        (
+            EdgedShape::truncated_ball(0.2, 0.4).unwrap(),
+            0.7,
+            1.3,
+            vec![0, 1],
+        ),
+        (EdgedShape::wheel(0.25, 0.7).unwrap(), 0.7, 1.3, vec![0, 1]),
+    ] {
+        let body = Body::new(shape, nu, eta).unwrap();
+        let c = census(&body, &options, &|| false).unwrap();
+        let ctx = format!("{:?}: {:?}", shape.kind, c.integers);
+        for k in &expected {
+            assert!(c.integers.contains(k), "{ctx}");
+        }
+        assert_eq!(c.unbounded_motion, Some(true), "{ctx}");
+        assert!(c.integers.windows(2).all(|w| w[0] < w[1]), "{ctx}");
+        assert!(
+            !c.bracketed
+                .iter()
+                .any(|r| c.integers.iter().any(|k| (r[0]..=r[1]).contains(k))),
+            "{ctx}"
+        );
+        // One point per integer, re-solved and run in the full equations.
+        let mut seen = Vec::new();
+        for p in c.counterexamples.iter().filter(|p| p.kappa < 10.0) {
+            if seen.contains(&p.integer) {
+                continue;
+            }
+            seen.push(p.integer);
+            let cell = solve_cell(&body, p.kappa, p.energy, &options_with_drift()).unwrap();
+            let comp = &cell.components[p.component];
+            assert!(
+                (comp.rotation_number - p.integer as f64).abs() <= 1e-9,
+                "{ctx}: {p:?} re-solved {comp:?}"
+            );
+            let start = Start {
+                kappa: p.kappa,
+                theta0: comp.theta_min,
+                theta_dot0: 0.0,
+            };
+            let away = crate::full_model_distance(&body, &start, 5.0 * comp.period);
+            assert!(
+                (away - 5.0 * comp.drift).abs() <= 1e-6 * 5.0 * comp.drift,
+                "{ctx}: {p:?}: the full model is {away} away after 5 periods, not 5 x {}",
+                comp.drift
+            );
+        }
+        assert!(seen.len() >= expected.len(), "{ctx}: points for {seen:?}");
+    }
+    let ball = Body::new(EdgedShape::truncated_ball(0.2, 0.4).unwrap(), 0.7, 1.3).unwrap();
+    let c = census(&ball, &options, &|| false).unwrap();
+    assert!(
+        c.from_limits
+            .iter()
+            .any(|l| l.lowest == 0 && l.highest == 0),
+        "{:?}",
+        c.from_limits
+    );
+    assert_eq!(c.high_energy.zeros.len(), 1, "{:?}", c.high_energy);
+    assert!(
+        (c.high_energy.zeros[0] - 0.884).abs() < 1e-3,
+        "{:?}",
+        c.high_energy
+    );
+    assert!(
+        (c.high_energy.at_small_lambda - 0.16028).abs() < 1e-5,
+        "{:?}",
+        c.high_energy
+    );
+}
+
+fn options_with_drift() -> CellOptions {
+    CellOptions {
+        tol: 1e-12,
+        drift: true,
+        ..CellOptions::default()
+    }
+}

@@ -1495,3 +1495,90 @@ fn manual_pages_are_outputs_like_any_other() {
         None,
     );
 }
+
+/// `verdict --shape` for a body other than the ellipsoid: the census as JSON (the body by
+/// name and parameters, the integers, the points, the high-energy scan, the evidence), a
+/// text summary, and the refusals in one line, exit 2.
+#[test]
+fn verdict_of_another_shape_is_a_census() {
+    let o = run(&[
+        "verdict",
+        "--shape",
+        "wheel",
+        "--alpha",
+        "0.25",
+        "--cut",
+        "0.7",
+        "--nu",
+        "0.7",
+        "--eta",
+        "1.3",
+        "--resolution",
+        "16",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["shape"], "wheel");
+    assert_eq!(v["alpha"], 0.25);
+    assert_eq!(v["cut"], 0.7);
+    for key in [
+        "nu",
+        "eta",
+        "integers",
+        "bracketed",
+        "counterexamples",
+        "from_limits",
+        "unbounded_motion",
+        "high_energy",
+        "evidence",
+    ] {
+        assert!(v.get(key).is_some(), "{key}: {v}");
+    }
+    assert!(v["high_energy"]["at_small_lambda"].as_f64().unwrap() < -0.04);
+    let o = run(&[
+        "verdict",
+        "--shape",
+        "disk",
+        "--alpha",
+        "0.3",
+        "--nu",
+        "2",
+        "--eta",
+        "4",
+        "--resolution",
+        "16",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("integers reached where the path runs away: -1, 0, 1"),
+        "{text}"
+    );
+    for (args, words) in [
+        (
+            vec!["--shape", "wheel", "--alpha", "0.2"],
+            "--cut is required",
+        ),
+        (
+            vec!["--shape", "disk", "--alpha", "0.2", "--beta", "2"],
+            "takes no --beta",
+        ),
+        (
+            vec!["--shape", "disk", "--alpha", "0.2", "--boundaries"],
+            "cannot be used with",
+        ),
+        (
+            vec!["--shape", "disk", "--alpha", "0.2", "--resolution", "4"],
+            "resolution",
+        ),
+    ] {
+        let mut all = vec!["verdict"];
+        all.extend(args);
+        all.extend(["--nu", "1", "--eta", "1"]);
+        let o = run(&all);
+        let said = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{all:?}: {said}");
+        assert!(said.contains(words), "{all:?}: {said}");
+    }
+}

@@ -285,3 +285,24 @@ fn a_face_keeps_n_away_from_zero_at_the_highest_energies() {
         0.0
     );
 }
+
+/// Where 1/J peaks at a zero of U more narrowly than U's rounding can place it (a cut ball
+/// with its edge down at the equator, η = 1e30 and 1e60), N∞ has no error bound: before, it
+/// came out 0.327 ± 0.088 against the true 0.433 at η = 1e60 (a helper's mpmath check), and
+/// 2.6e-7 off with ± 1.4e-7 at η = 1e30. At η = 1e8 the same body is resolved.
+#[test]
+fn a_peak_of_one_over_j_below_the_rounding_of_u_has_no_error_bound() {
+    for (eta, resolved) in [(1e8, true), (1e30, false), (1e60, false)] {
+        let body = Body::new(
+            EdgedShape::truncated_ball(1e-12, -0.999999).unwrap(),
+            0.1,
+            eta,
+        )
+        .unwrap();
+        let limit = high_energy_rotation_number(&body, 1.4, 1e-12).unwrap();
+        assert_eq!(limit.error.is_finite(), resolved, "η = {eta}: {limit:?}");
+        if resolved {
+            assert!(limit.error < 1e-12, "η = {eta}: {limit:?}");
+        }
+    }
+}

@@ -1,0 +1,354 @@
+//! A boundedness report for any body (docs/bodies.md, "Which integers N reaches"): the
+//! integer resonances N = k found over the whole (κ, ε) plane, each with a point where the path
+//! runs away, sampled as the verdict samples the ellipsoid's plane and closed by the limits of
+//! [`crate::limits`]. It claims no boundedness: the paper's hypothesis is the ellipsoid's.
+
+use super::{
+    brackets, check_sampling, counterexamples, kappa_lines, search_beyond, Counterexample,
+    Evidence, Sample, Sampler, EXTRA_KAPPA_LINES, KAPPA_FLOOR,
+};
+use crate::body::{Body, Shape};
+use crate::cell::CellOptions;
+use crate::error::{AtlasError, Result};
+use crate::limits::{golden_max, high_energy_limit_at_small_lambda, high_energy_rotation_number};
+use rayon::prelude::*;
+use serde::Serialize;
+use std::f64::consts::SQRT_2;
+
+/// How a census samples the plane: the cell solver's tolerance and the resolution (κ-lines
+/// of each kind, base energies per line), as for the verdict.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CensusOptions {
+    pub tol: f64,
+    pub resolution: usize,
+}
+
+impl Default for CensusOptions {
+    fn default() -> Self {
+        Self {
+            tol: 1e-10,
+            resolution: 64,
+        }
+    }
+}
+
+/// N∞(λ) over 0 < λ < √2 (the high-energy limit of [`crate::limits`]), scanned.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct HighEnergyScan {
+    /// lim N∞ as λ → 0, that is N at fixed κ as ε → ∞: (√B/J|₀ − √B/J|π)/2, not 0 only for
+    /// a body with a face.
+    pub at_small_lambda: f64,
+    /// The smallest and largest N∞ and where (refined by golden sections; a limit at an end
+    /// of (0, √2) is reported there).
+    pub n_min: f64,
+    pub lambda_at_min: f64,
+    pub n_max: f64,
+    pub lambda_at_max: f64,
+    /// The λ where N∞ changes sign: an N = 0 resonance curve that runs to ε = ∞ along
+    /// κ ≈ λ√ε.
+    pub zeros: Vec<f64>,
+    /// The largest error estimate of the N∞ values behind these.
+    pub error: f64,
+}
+
+/// Integer resonances that a limit proves, beyond what the sampled lines show: every integer
+/// from `lowest` to `highest`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LimitResonance {
+    pub lowest: i64,
+    pub highest: i64,
+    pub reason: String,
+}
+
+/// Which integers N reaches over the (κ, ε) plane of one body.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Census {
+    /// The integers N reaches where the path runs away, a point found on each
+    /// (`counterexamples`). Ascending.
+    pub integers: Vec<i64>,
+    /// Further integers between the N of two neighbouring samples of one family (N − k of
+    /// reliable signs on both), for which no point was confirmed (beside a separatrix, where
+    /// N runs to ±∞, N's own error grows beyond the tolerance; or beyond the six integers
+    /// nearest 0 that are refined): ranges [lowest, highest] of consecutive integers, those
+    /// within ±100 (`evidence.rotation_number_range` shows how far N goes).
+    pub bracketed: Vec<[i64; 2]>,
+    /// Points on them where the path runs away (N = k to the tolerance, |Δζ| above its
+    /// error): up to two each for the six integers nearest 0.
+    pub counterexamples: Vec<Counterexample>,
+    /// Integers the high-energy limit proves (N = k at every large κ), as ranges.
+    pub from_limits: Vec<LimitResonance>,
+    /// true when a counterexample was found; null otherwise (no resonance found is not a
+    /// proof of boundedness for these bodies).
+    pub unbounded_motion: Option<bool>,
+    pub high_energy: HighEnergyScan,
+    pub evidence: Evidence,
+}
+
+/// Bracketed integers are listed up to this size (near a separatrix of an extreme body the
+/// samples' N reach millions: every integer between is bracketed, and the list would be that
+/// long); the sampled range of N in `evidence` shows how far N goes.
+const BRACKETED_LISTED: i64 = 100;
+
+/// λ samples of the high-energy scan over (0, √2), besides the small ones.
+const SCAN: usize = 96;
+/// Small λ scanned besides: N∞ reaches its λ → 0 limit as λ log λ with a face.
+const SMALL_LAMBDAS: [f64; 4] = [1e-8, 1e-6, 1e-4, 1e-2];
+
+/// N∞ over (0, √2), its λ → 0 limit, extrema and sign changes, to `tol`.
+pub fn high_energy_scan<S: Shape>(body: &Body<S>, tol: f64) -> Result<HighEnergyScan> {
+    let at = |l: f64| high_energy_rotation_number(body, l, tol);
+    let mut lambdas: Vec<f64> = SMALL_LAMBDAS
+        .into_iter()
+        .chain((1..SCAN).map(|i| SQRT_2 * i as f64 / SCAN as f64))
+        .collect();
+    lambdas.sort_by(f64::total_cmp);
+    let values = lambdas
+        .par_iter()
+        .map(|&l| at(l))
+        .collect::<Result<Vec<_>>>()?;
+    let mut error = values.iter().map(|v| v.error).fold(0.0, f64::max);
+    let limit = high_energy_limit_at_small_lambda(body);
+    // The extremum of sign·N∞: an interior sample refined, else the end it tends to.
+    let mut extremum = |sign: f64| -> Result<(f64, f64)> {
+        let i = (0..values.len())
+            .max_by(|&a, &b| (sign * values[a].value).total_cmp(&(sign * values[b].value)))
+            .expect("the scan has points");
+        let (end_small, end_top) = (sign * limit, 0.0);
+        let best = sign * values[i].value;
+        if end_small >= best && end_small >= end_top {
+            return Ok((limit, 0.0));
+        }
+        if end_top >= best {
+            return Ok((0.0, SQRT_2));
+        }
+        if i == 0 || i + 1 == values.len() {
+            return Ok((values[i].value, lambdas[i]));
+        }
+        let (l, _) = golden_max(
+            |l| at(l).map_or(f64::NEG_INFINITY, |v| sign * v.value),
+            lambdas[i - 1],
+            lambdas[i + 1],
+            1e-9,
+        );
+        let v = at(l)?;
+        error = error.max(v.error);
+        Ok((v.value, l))
+    };
+    let (n_max, lambda_at_max) = extremum(1.0)?;
+    let (n_min, lambda_at_min) = extremum(-1.0)?;
+    // Sign changes between samples whose signs are beyond their errors.
+    let mut zeros = Vec::new();
+    let reliable: Vec<usize> = (0..values.len())
+        .filter(|&i| values[i].value.abs() > values[i].error.max(tol))
+        .collect();
+    for w in reliable.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        if values[a].value.signum() != values[b].value.signum() {
+            let root = crate::resonance::bracketed_root(
+                |l| at(l).ok().map(|v| v.value),
+                (lambdas[a], values[a].value),
+                (lambdas[b], values[b].value),
+                1e-12,
+                0.0,
+            );
+            zeros.push(root.unwrap_or(0.5 * (lambdas[a] + lambdas[b])));
+        }
+    }
+    Ok(HighEnergyScan {
+        at_small_lambda: limit,
+        n_min,
+        lambda_at_min,
+        n_max,
+        lambda_at_max,
+        zeros,
+        error,
+    })
+}
+
+/// The integers the high-energy limit proves: N → N∞(λ) uniformly on compact λ-sets as
+/// κ → ∞, so an integer strictly inside N∞'s range (beyond its error), and 0 where N∞
+/// changes sign, is on a resonance curve at every large κ. The limit at λ → 0 and 0 at
+/// λ = √2 are approached, not reached: an integer equal to one of them is not proved.
+fn limit_resonances(h: &HighEnergyScan) -> Vec<LimitResonance> {
+    let e = h.error;
+    let mut out = Vec::new();
+    if !h.zeros.is_empty() {
+        out.push(LimitResonance {
+            lowest: 0,
+            highest: 0,
+            reason: format!(
+                "high energy: N_inf changes sign at lambda = {:?}, so N = 0 on a curve to energy = infinity along kappa ~ lambda sqrt(energy)",
+                h.zeros
+            ),
+        });
+    }
+    let (lo, hi) = (h.n_min + e, h.n_max - e);
+    if !(lo.is_finite() && hi.is_finite()) {
+        return out;
+    }
+    // The integers strictly inside (lo, hi), 0 apart (taken above only where N∞ changes sign).
+    let first = lo.floor() as i64 + 1;
+    let last = hi.ceil() as i64 - 1;
+    let reason = format!(
+        "high energy: N_inf runs from {} to {}, so N reaches each of these at every large kappa",
+        h.n_min, h.n_max
+    );
+    for (lowest, highest) in [(first, last.min(-1)), (first.max(1), last)] {
+        if lowest <= highest {
+            out.push(LimitResonance {
+                lowest,
+                highest,
+                reason: reason.clone(),
+            });
+        }
+    }
+    out
+}
+
+/// Ascending integers as ranges of consecutive ones.
+fn ranges(mut ks: Vec<i64>) -> Vec<[i64; 2]> {
+    ks.sort_unstable();
+    ks.dedup();
+    let mut out: Vec<[i64; 2]> = Vec::new();
+    for k in ks {
+        match out.last_mut() {
+            Some(r) if r[1] + 1 == k => r[1] = k,
+            _ => out.push([k, k]),
+        }
+    }
+    out
+}
+
+/// The census of one body (any shape), polled for `stop` between components.
+pub fn census<S: Shape>(
+    body: &Body<S>,
+    options: &CensusOptions,
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Result<Census> {
+    check_sampling(options.tol, options.resolution)?;
+    let stopped = || {
+        if stop() {
+            Err(AtlasError::Stopped)
+        } else {
+            Ok(())
+        }
+    };
+    let high_energy = high_energy_scan(body, options.tol.min(1e-12))?;
+    stopped()?;
+    let sampler = Sampler {
+        body,
+        cell: CellOptions {
+            tol: options.tol,
+            drift: false,
+            ..CellOptions::default()
+        },
+        energies: options.resolution,
+        offset_energies: true,
+        n_alone: true,
+        stop,
+    };
+    let symmetric = body.shape.symmetric_about_equator();
+    let kappas = kappa_lines(KAPPA_FLOOR, 4.0, options.resolution);
+    let mut lines: Vec<Vec<Sample>> = kappas.par_iter().map(|&k| sampler.line(k)).collect();
+    stopped()?;
+    let mut candidates = brackets(&lines, options.tol, symmetric);
+    let (mut found, mut failures) = counterexamples(&sampler, &candidates);
+    stopped()?;
+    let from_limits = limit_resonances(&high_energy);
+    let mut kappa_top = *kappas.last().expect("lines");
+    // A resonance the limit proves but the lines did not reach lies at larger κ.
+    let without_point = |k: i64| !found.iter().any(|c| c.integer == k);
+    if from_limits
+        .iter()
+        .any(|l| (l.lowest..=l.highest).take(8).any(without_point))
+    {
+        kappa_top = *EXTRA_KAPPA_LINES.last().expect("lines");
+        let last = lines.last().cloned().unwrap_or_default();
+        let (extra, more, extra_failures) = search_beyond(&sampler, &last, symmetric, &mut found);
+        failures += extra_failures;
+        candidates.extend(more);
+        lines.extend(extra);
+    }
+    stopped()?;
+    found.sort_by(|a, b| {
+        (a.integer.abs(), a.integer)
+            .cmp(&(b.integer.abs(), b.integer))
+            .then(a.kappa.total_cmp(&b.kappa))
+    });
+    let mut integers: Vec<i64> = found.iter().map(|c| c.integer).collect();
+    integers.sort_unstable();
+    integers.dedup();
+    let bracketed = ranges(
+        candidates
+            .iter()
+            .map(|c| c.k)
+            .filter(|k| k.abs() <= BRACKETED_LISTED && !integers.contains(k))
+            .collect(),
+    );
+    let all: Vec<&Sample> = lines.iter().flatten().collect();
+    let n_range = all.iter().fold([f64::INFINITY, f64::NEG_INFINITY], |r, s| {
+        [r[0].min(s.n), r[1].max(s.n)]
+    });
+    let unbounded_motion = (!found.is_empty()).then_some(true);
+    let undecided = found.is_empty().then(|| {
+        "no point where the path runs away was found; that is no proof of boundedness for a \
+         body other than the ellipsoid"
+            .to_string()
+    });
+    Ok(Census {
+        integers,
+        bracketed,
+        counterexamples: found,
+        from_limits,
+        unbounded_motion,
+        high_energy,
+        evidence: Evidence {
+            kappa_range: [kappas[0], kappa_top],
+            kappa_lines: lines.len(),
+            energies_per_line: options.resolution,
+            components_solved: all.len(),
+            rotation_number_range: n_range,
+            integer_brackets: candidates.len(),
+            refinement_failures: failures,
+            limit_failure: None,
+            undecided,
+            limits: vec![
+                "bottom: each line starts at the deepest minimum of V (the linearised N of the stable permanent rotation)",
+                "high energy: each line runs to energy = V_low + 1e12 max(|V_low|, 1); beyond the last line N tends to N_inf(lambda) (limits::high_energy_rotation_number, for every body)",
+                "kappa -> 0: below kappa = 1e-6 N tends to +-1/2 beside a smooth pole, to +-sqrt(B/J^2)/2 beside a face (its value at the pole), and to 0 across both poles; the first line (kappa = 1e-6) holds these",
+                "separatrices: levels 1e-1 ... 1e-13 (relative) on both sides of every maximum of V, where N -> +-infinity: every integer of that sign lies on a resonance curve there, the listed ones are those the samples bracket",
+            ],
+        },
+    })
+}
+
+/// A census with the body it is of, as `verdict --shape … --json` prints it and the Python
+/// package's `census` returns it: `shape`, the shape's parameters by name, `nu`, `eta`, then
+/// the census's fields.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CensusReport {
+    pub shape: &'static str,
+    #[serde(flatten)]
+    pub parameters: std::collections::BTreeMap<&'static str, f64>,
+    pub nu: f64,
+    pub eta: f64,
+    #[serde(flatten)]
+    pub census: Census,
+}
+
+/// The census of `body` with its name and parameters.
+pub fn census_report(
+    body: &crate::body::AnyBody,
+    options: &CensusOptions,
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Result<CensusReport> {
+    let census = crate::with_body!(body, b => census(b, options, stop))?;
+    let (nu, eta) = crate::with_body!(body, b => (b.nu, b.eta));
+    Ok(CensusReport {
+        shape: body.shape_name(),
+        parameters: body.shape_parameters().into_iter().collect(),
+        nu,
+        eta,
+        census,
+    })
+}
