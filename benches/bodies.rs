@@ -2,8 +2,10 @@
 //! the same size: 256 κ-rows in [0.01, 2] × 256 energies ε = V_min(κ) + 4 j/255, j = 1 … 256,
 //! so that every cell has motion, tol 1e-10, all outputs, 2 threads, rows shared out by rayon
 //! one at a time. The slices run interleaved, seven times each, in one process, so that the
-//! ratios are meaningful on a shared machine; prints components per second (median and best
-//! of seven) and each body's ratio to the ellipsoid. Besides the ellipsoid and the three edged
+//! ratios are meaningful on a shared machine; prints cells per second (the slices have the
+//! same 65,536 cells: the ratio of the times) and components per second (a body with fewer
+//! tori per cell has fewer components to solve), median and best of seven, and each body's
+//! ratios to the ellipsoid. Besides the ellipsoid and the three edged
 //! bodies: two profiles (docs/bodies.md, "Your own body"), the egg of atlas/egg.toml and the
 //! truncated ball given as a table of 12 points (the same body as the shape, with more joints).
 //! `cargo bench --bench bodies`.
@@ -14,13 +16,18 @@ use rubber_atlas::torus::EffectivePotential;
 use rubber_atlas::{Body, EdgedShape, EllipsoidBody, Profile, ProfileShape, Shape};
 use std::time::Instant;
 
+/// κ-rows of each slice, and energies per row.
+const ROWS: usize = 256;
+/// Cells in each slice.
+const CELLS: usize = ROWS * ROWS;
+
 /// Components and seconds of one slice of `body`.
 fn slice<S: Shape>(
     body: &Body<S>,
     pool: &rayon::ThreadPool,
     options: &CellOptions,
 ) -> (usize, f64) {
-    let n = 256;
+    let n = ROWS;
     let start = Instant::now();
     let components = pool.install(|| {
         (0..n)
@@ -88,6 +95,7 @@ fn main() {
         "truncated ball as 12 points",
     ];
     let mut rates: [Vec<f64>; 6] = Default::default();
+    let mut cell_rates: [Vec<f64>; 6] = Default::default();
     for _ in 0..7 {
         let runs = [
             slice(&ellipsoid, &pool, &options),
@@ -97,21 +105,26 @@ fn main() {
             slice(&egg, &pool, &options),
             slice(&ball_table, &pool, &options),
         ];
-        for (rate, (components, seconds)) in rates.iter_mut().zip(runs) {
+        for ((rate, cell_rate), (components, seconds)) in
+            rates.iter_mut().zip(cell_rates.iter_mut()).zip(runs)
+        {
             rate.push(components as f64 / seconds);
+            cell_rate.push(CELLS as f64 / seconds);
         }
     }
     let stats = |r: &mut Vec<f64>| {
         r.sort_by(f64::total_cmp);
         (r[r.len() / 2], r[r.len() - 1])
     };
-    let summary: Vec<(f64, f64)> = rates.iter_mut().map(stats).collect();
-    println!("components per second, 2 threads, tol 1e-10, all outputs (median, best of 7):");
-    for (name, (median, best)) in names.iter().zip(&summary) {
-        println!(
-            "  {name:<28} {median:>9.0} {best:>9.0}   ratio to the ellipsoid {:.2} (median), {:.2} (best)",
-            median / summary[0].0,
-            best / summary[0].1
-        );
+    for (what, rates) in [("cells", &mut cell_rates), ("components", &mut rates)] {
+        let summary: Vec<(f64, f64)> = rates.iter_mut().map(stats).collect();
+        println!("{what} per second, 2 threads, tol 1e-10, all outputs (median, best of 7):");
+        for (name, (median, best)) in names.iter().zip(&summary) {
+            println!(
+                "  {name:<28} {median:>9.0} {best:>9.0}   ratio to the ellipsoid {:.2} (median), {:.2} (best)",
+                median / summary[0].0,
+                best / summary[0].1
+            );
+        }
     }
 }
