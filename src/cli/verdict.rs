@@ -369,6 +369,18 @@ fn census(args: &VerdictArgs, shape: ShapeKindArg) -> Result<()> {
             digits(c.drift_error, 2)
         );
     }
+    for r in &report.full_model_checks {
+        println!(
+            "    full equations, N = {} at kappa = {}: {} periods carry the centre of mass {} away, {} x |drift| = {} (relative gap {:.1e})",
+            r.integer,
+            digits(r.kappa, 6),
+            r.periods,
+            digits(r.distance, 8),
+            r.periods,
+            digits(r.expected, 8),
+            r.relative_gap
+        );
+    }
     for l in &report.from_limits {
         println!(
             "  proved by a limit: N = {}: {}",

@@ -80,6 +80,11 @@ pub struct Census {
     /// true when a counterexample was found; null otherwise (no resonance found is not a
     /// proof of boundedness for these bodies).
     pub unbounded_motion: Option<bool>,
+    /// For each integer in `integers`, its point nearest κ = 1 followed in the full
+    /// equations, which see the body only through its contact point: how far the centre of
+    /// mass runs in a few periods against that many |Δζ| (a check independent of the
+    /// quadrature).
+    pub full_model_checks: Vec<RunawayCheck>,
     pub high_energy: HighEnergyScan,
     pub evidence: Evidence,
 }
@@ -88,6 +93,71 @@ pub struct Census {
 /// samples' N reach millions: every integer between is bracketed, and the list would be that
 /// long); the sampled range of N in `evidence` shows how far N goes.
 const BRACKETED_LISTED: i64 = 100;
+
+/// A point of a resonance followed in the full equations (`eqred` with the contact point,
+/// [`crate::trajectory`]) from θ_min at rest in θ for `periods` θ-periods.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RunawayCheck {
+    pub integer: i64,
+    pub kappa: f64,
+    pub energy: f64,
+    pub periods: f64,
+    /// How far the centre of mass ends from its start.
+    pub distance: f64,
+    /// periods · |Δζ| from the quadrature.
+    pub expected: f64,
+    /// |distance − expected| / expected: the full model's own accuracy is about 1e-6 of it.
+    pub relative_gap: f64,
+}
+
+/// θ-periods a point is followed in the full equations.
+const CHECK_PERIODS: f64 = 5.0;
+
+/// The runaway of `point` in the full equations ([`RunawayCheck`]); None where the point's
+/// cell or the trajectory cannot be computed (it is then not reported).
+fn full_model_check<S: Shape>(
+    body: &Body<S>,
+    point: &Counterexample,
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Option<RunawayCheck> {
+    use crate::trajectory::{integrate, Model, Start};
+    let options = CellOptions {
+        tol: 1e-12,
+        ..CellOptions::default()
+    };
+    let cell = crate::cell::solve_cell(body, point.kappa, point.energy, &options).ok()?;
+    let c = cell.components.get(point.component)?;
+    if !(c.period.is_finite() && c.drift.is_finite()) {
+        return None;
+    }
+    let start = Start {
+        kappa: point.kappa,
+        theta0: c.theta_min,
+        theta_dot0: 0.0,
+    };
+    let t = integrate(
+        body,
+        &start,
+        Model::Full,
+        CHECK_PERIODS * c.period,
+        4,
+        1e-12,
+        stop,
+    )
+    .ok()?;
+    let n = t.t.len().checked_sub(1)?;
+    let distance = (t.x_c[n] - t.x_c[0]).hypot(t.y_c[n] - t.y_c[0]);
+    let expected = CHECK_PERIODS * c.drift;
+    Some(RunawayCheck {
+        integer: point.integer,
+        kappa: point.kappa,
+        energy: point.energy,
+        periods: CHECK_PERIODS,
+        distance,
+        expected,
+        relative_gap: (distance - expected).abs() / expected,
+    })
+}
 
 /// λ samples of the high-energy scan over (0, √2), besides the small ones.
 const SCAN: usize = 96;
@@ -290,6 +360,18 @@ pub fn census<S: Shape>(
         [r[0].min(s.n), r[1].max(s.n)]
     });
     let unbounded_motion = (!found.is_empty()).then_some(true);
+    stopped()?;
+    let full_model_checks: Vec<RunawayCheck> = integers
+        .par_iter()
+        .filter_map(|&k| {
+            let nearest = found
+                .iter()
+                .filter(|c| c.integer == k)
+                .min_by(|a, b| a.kappa.ln().abs().total_cmp(&b.kappa.ln().abs()))?;
+            full_model_check(body, nearest, stop)
+        })
+        .collect();
+    stopped()?;
     let undecided = found.is_empty().then(|| {
         "no point where the path runs away was found; that is no proof of boundedness for a \
          body other than the ellipsoid"
@@ -301,6 +383,7 @@ pub fn census<S: Shape>(
         counterexamples: found,
         from_limits,
         unbounded_motion,
+        full_model_checks,
         high_energy,
         evidence: Evidence {
             kappa_range: [kappas[0], kappa_top],

@@ -1462,6 +1462,11 @@ fn a_census_finds_the_resonances_and_its_points_run_away_in_the_full_equations()
             );
         }
         assert!(seen.len() >= expected.len(), "{ctx}: points for {seen:?}");
+        // The census's own check in the full equations: one per integer, each on 5·|Δζ|.
+        assert_eq!(c.full_model_checks.len(), c.integers.len(), "{ctx}");
+        for r in &c.full_model_checks {
+            assert!(r.relative_gap <= 1e-6 && r.periods == 5.0, "{ctx}: {r:?}");
+        }
     }
     let ball = Body::new(EdgedShape::truncated_ball(0.2, 0.4).unwrap(), 0.7, 1.3).unwrap();
     let c = census(&ball, &options, &|| false).unwrap();

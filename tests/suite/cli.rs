@@ -1530,6 +1530,7 @@ fn verdict_of_another_shape_is_a_census() {
         "counterexamples",
         "from_limits",
         "unbounded_motion",
+        "full_model_checks",
         "high_energy",
         "evidence",
     ] {
