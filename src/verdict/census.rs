@@ -305,6 +305,33 @@ pub fn census<S: Shape>(
     };
     let high_energy = high_energy_scan(body, options.tol.min(1e-12))?;
     stopped()?;
+    // As for the verdict: beyond the η over which the sampling is checked the cells stop
+    // converging (at η = 1e300 a disk's cell takes 16,515 evaluations and misses the
+    // tolerance; a census took minutes): no lines, and the reason, at once.
+    if let Some(reason) = super::outside_checked_range(1.0, body.eta) {
+        let from_limits = limit_resonances(&high_energy);
+        return Ok(Census {
+            integers: Vec::new(),
+            bracketed: Vec::new(),
+            counterexamples: Vec::new(),
+            from_limits,
+            unbounded_motion: None,
+            full_model_checks: Vec::new(),
+            high_energy,
+            evidence: Evidence {
+                kappa_range: [f64::NAN; 2],
+                kappa_lines: 0,
+                energies_per_line: options.resolution,
+                components_solved: 0,
+                rotation_number_range: [f64::NAN; 2],
+                integer_brackets: 0,
+                refinement_failures: 0,
+                limit_failure: None,
+                undecided: Some(reason.replace("the verdict's", "the census's")),
+                limits: Vec::new(),
+            },
+        });
+    }
     let sampler = Sampler {
         body,
         cell: CellOptions {

@@ -1497,3 +1497,17 @@ fn options_with_drift() -> CellOptions {
         ..CellOptions::default()
     }
 }
+
+/// A census beyond the η over which its sampling is checked (the verdict's range) answers at
+/// once with the reason: at η = 1e300 a disk's cells stop converging (16,515 evaluations a
+/// cell, tolerance missed) and a census took minutes (an adversary pass).
+#[test]
+fn a_census_of_an_extreme_body_says_why_it_has_no_lines() {
+    use rubber_atlas::verdict::{census, CensusOptions};
+    let body = Body::new(EdgedShape::disk(0.3).unwrap(), 2.0, 1e300).unwrap();
+    let c = census(&body, &CensusOptions::default(), &|| false).unwrap();
+    assert_eq!(c.evidence.components_solved, 0);
+    assert_eq!(c.unbounded_motion, None);
+    let reason = c.evidence.undecided.unwrap();
+    assert!(reason.contains("eta = 1e300 is outside"), "{reason}");
+}
