@@ -34,7 +34,7 @@ use crate::torus::{CriticalKind, EffectivePotential, MotionKind};
 use crate::EllipsoidBody;
 pub use census::{
     census, census_report, high_energy_scan, Census, CensusOptions, CensusReport, HighEnergyScan,
-    LimitResonance, RunawayCheck,
+    LimitResonance, RunawayCheck, FULL_MODEL_GAP,
 };
 use rayon::prelude::*;
 use serde::Serialize;

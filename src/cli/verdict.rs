@@ -174,10 +174,18 @@ pub(super) fn verdict(args: VerdictArgs) -> Result<()> {
         }
         return Ok(());
     }
-    if let Some(shape) = args.shape.filter(|&s| s != ShapeKindArg::Ellipsoid) {
-        return census(&args, shape);
+    match args.shape {
+        Some(ShapeKindArg::Ellipsoid) | None => {}
+        Some(shape) => return census(&args, shape),
     }
-    let beta = args.beta.unwrap_or(1.0);
+    // --shape ellipsoid lifts clap's requirement of --beta: it is still required.
+    let Some(beta) = args.beta else {
+        return Err(AtlasError::Atlas {
+            path: "options".into(),
+            reason: "--shape ellipsoid: --beta is required".into(),
+        }
+        .into());
+    };
     let body = EllipsoidBody::ellipsoid(args.alpha, beta, args.nu, args.eta)?;
     let options = VerdictOptions {
         coarse_first: true,
@@ -371,14 +379,19 @@ fn census(args: &VerdictArgs, shape: ShapeKindArg) -> Result<()> {
     }
     for r in &report.full_model_checks {
         println!(
-            "    full equations, N = {} at kappa = {}: {} periods carry the centre of mass {} away, {} x |drift| = {} (relative gap {:.1e})",
+            "    full equations, N = {} at kappa = {}: {} periods carry the centre of mass {} away, {} x |drift| = {} (relative gap {:.1e}{})",
             r.integer,
             digits(r.kappa, 6),
             r.periods,
             digits(r.distance, 8),
             r.periods,
             digits(r.expected, 8),
-            r.relative_gap
+            r.relative_gap,
+            if r.relative_gap > verdict::FULL_MODEL_GAP {
+                ": beyond the full model's usual accuracy, which does not resolve this body at its tolerance"
+            } else {
+                ""
+            }
         );
     }
     for l in &report.from_limits {
@@ -400,6 +413,9 @@ fn census(args: &VerdictArgs, shape: ShapeKindArg) -> Result<()> {
         digits(h.error, 2)
     );
     let e = &report.evidence;
+    if e.kappa_lines == 0 {
+        return Ok(());
+    }
     println!(
         "  evidence: {} kappa-lines in [{}, {}], {} energies per line, {} components; N sampled in [{}, {}]; {} integer brackets, {} refinements failed",
         e.kappa_lines,

@@ -4,8 +4,8 @@
 //! [`crate::limits`]. It claims no boundedness: the paper's hypothesis is the ellipsoid's.
 
 use super::{
-    brackets, check_sampling, counterexamples, kappa_lines, search_beyond, Counterexample,
-    Evidence, Sample, Sampler, EXTRA_KAPPA_LINES, KAPPA_FLOOR,
+    brackets, check_sampling, counterexamples, kappa_lines, search_beyond, Candidate,
+    Counterexample, Evidence, Sample, Sampler, EXTRA_KAPPA_LINES, KAPPA_FLOOR, ON_INTEGER_KAPPA,
 };
 use crate::body::{Body, Shape};
 use crate::cell::CellOptions;
@@ -108,10 +108,18 @@ pub struct RunawayCheck {
     pub expected: f64,
     /// |distance − expected| / expected: the full model's own accuracy is about 1e-6 of it.
     pub relative_gap: f64,
+    /// Whether the gap is within [`FULL_MODEL_GAP`].
+    pub agrees: bool,
 }
 
 /// θ-periods a point is followed in the full equations.
 const CHECK_PERIODS: f64 = 5.0;
+
+/// The relative gap of a [`RunawayCheck`] within which the full model (tol 1e-12) agrees: its
+/// own accuracy is about 1e-6 of the distance on ordinary bodies (measured 2e-11 … 6e-8);
+/// beyond it (a pancake 2e6 wide and 2e-6 thick: 1.3e-2) the full model does not resolve the
+/// body at that tolerance, and the point rests on the quadrature alone.
+pub const FULL_MODEL_GAP: f64 = 1e-4;
 
 /// The runaway of `point` in the full equations ([`RunawayCheck`]); None where the point's
 /// cell or the trajectory cannot be computed (it is then not reported).
@@ -156,6 +164,7 @@ fn full_model_check<S: Shape>(
         distance,
         expected,
         relative_gap: (distance - expected).abs() / expected,
+        agrees: (distance - expected).abs() <= FULL_MODEL_GAP * expected,
     })
 }
 
@@ -165,14 +174,24 @@ const SCAN: usize = 96;
 const SMALL_LAMBDAS: [f64; 4] = [1e-8, 1e-6, 1e-4, 1e-2];
 
 /// N∞ over (0, √2), its λ → 0 limit, extrema and sign changes, to `tol`.
-pub fn high_energy_scan<S: Shape>(body: &Body<S>, tol: f64) -> Result<HighEnergyScan> {
-    let at = |l: f64| high_energy_rotation_number(body, l, tol);
+pub fn high_energy_scan<S: Shape>(
+    body: &Body<S>,
+    tol: f64,
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Result<HighEnergyScan> {
+    // Ctrl-C is heard before each λ (a profile of 2,000 points takes 0.3 s a λ).
+    let at = |l: f64| {
+        if stop() {
+            return Err(AtlasError::Stopped);
+        }
+        high_energy_rotation_number(body, l, tol)
+    };
     let mut lambdas: Vec<f64> = SMALL_LAMBDAS
         .into_iter()
         .chain((1..SCAN).map(|i| SQRT_2 * i as f64 / SCAN as f64))
         .collect();
     lambdas.sort_by(f64::total_cmp);
-    let values = lambdas
+    let mut values = lambdas
         .par_iter()
         .map(|&l| at(l))
         .collect::<Result<Vec<_>>>()?;
@@ -206,8 +225,19 @@ pub fn high_energy_scan<S: Shape>(body: &Body<S>, tol: f64) -> Result<HighEnergy
     };
     let (n_max, lambda_at_max) = extremum(1.0)?;
     let (n_min, lambda_at_min) = extremum(-1.0)?;
-    // Sign changes between samples whose signs are beyond their errors.
+    // Sign changes between samples whose signs are beyond their errors, the limit at λ → 0
+    // among them (N∞ tends to it continuously: a wheel nearly a mirror image had its sign
+    // change below the smallest λ sampled).
     let mut zeros = Vec::new();
+    lambdas.insert(0, 0.0);
+    let limit_error = 16.0 * f64::EPSILON * limit.abs();
+    values.insert(
+        0,
+        crate::limits::Estimate {
+            value: limit,
+            error: limit_error,
+        },
+    );
     let reliable: Vec<usize> = (0..values.len())
         .filter(|&i| values[i].value.abs() > values[i].error.max(tol))
         .collect();
@@ -303,7 +333,7 @@ pub fn census<S: Shape>(
             Ok(())
         }
     };
-    let high_energy = high_energy_scan(body, options.tol.min(1e-12))?;
+    let high_energy = high_energy_scan(body, options.tol.min(1e-12), stop)?;
     stopped()?;
     // As for the verdict: beyond the η over which the sampling is checked the cells stop
     // converging (at η = 1e300 a disk's cell takes 16,515 evaluations and misses the
@@ -349,6 +379,27 @@ pub fn census<S: Shape>(
     let mut lines: Vec<Vec<Sample>> = kappas.par_iter().map(|&k| sampler.line(k)).collect();
     stopped()?;
     let mut candidates = brackets(&lines, options.tol, symmetric);
+    // A sample on an integer to the tolerance is a point by the census's own rule (N's error
+    // within the tolerance, N on the integer to it, |Δζ| above its error) even without a
+    // bracket: a disk 1e-12 from its own mirror image has N ≈ ±1e-11 on whole families and
+    // no sign change to bracket (its N = 0 went unreported). Away from κ → 0 and the bottom,
+    // where N reaches 0 only as a limit.
+    candidates.extend(
+        lines
+            .iter()
+            .flatten()
+            .filter(|s| {
+                s.grid.is_some_and(|i| i > 0)
+                    && s.kappa >= ON_INTEGER_KAPPA
+                    && s.error <= options.tol
+                    && (s.n - s.n.round()).abs() <= options.tol
+            })
+            .map(|s| Candidate {
+                a: *s,
+                b: None,
+                k: s.n.round() as i64,
+            }),
+    );
     let (mut found, mut failures) = counterexamples(&sampler, &candidates);
     stopped()?;
     let from_limits = limit_resonances(&high_energy);

@@ -1465,7 +1465,10 @@ fn a_census_finds_the_resonances_and_its_points_run_away_in_the_full_equations()
         // The census's own check in the full equations: one per integer, each on 5·|Δζ|.
         assert_eq!(c.full_model_checks.len(), c.integers.len(), "{ctx}");
         for r in &c.full_model_checks {
-            assert!(r.relative_gap <= 1e-6 && r.periods == 5.0, "{ctx}: {r:?}");
+            assert!(
+                r.relative_gap <= 1e-6 && r.agrees && r.periods == 5.0,
+                "{ctx}: {r:?}"
+            );
         }
     }
     let ball = Body::new(EdgedShape::truncated_ball(0.2, 0.4).unwrap(), 0.7, 1.3).unwrap();
@@ -1510,4 +1513,35 @@ fn a_census_of_an_extreme_body_says_why_it_has_no_lines() {
     assert_eq!(c.unbounded_motion, None);
     let reason = c.evidence.undecided.unwrap();
     assert!(reason.contains("eta = 1e300 is outside"), "{reason}");
+}
+
+/// Two bodies an adversary pass found the census short on: a disk 1e-12 from its own mirror
+/// image has N ≈ ±1e-11 on whole families, on 0 to the tolerance but with no sign change to
+/// bracket (N = 0 was in none of the lists; a cell there has N = −1.6e-11 ± 3.5e-13 and
+/// |Δζ| = 17.8); a wheel nearly its own mirror image has N∞'s sign change below the smallest
+/// λ sampled (7.6e-9), between it and the λ → 0 limit (+2e-12), and N = 0 far out was missed.
+#[test]
+fn a_census_finds_the_resonances_of_nearly_symmetric_bodies() {
+    use rubber_atlas::verdict::{census, CensusOptions};
+    let options = CensusOptions {
+        tol: 1e-10,
+        resolution: 32,
+    };
+    let disk = Body::new(EdgedShape::disk(1e-12).unwrap(), 2.0, 4.0).unwrap();
+    let c = census(&disk, &options, &|| false).unwrap();
+    assert!(c.integers.contains(&0), "{:?}", c.integers);
+    let wheel = Body::new(EdgedShape::wheel(-0.999999, 0.999999).unwrap(), 2.0, 1e-3).unwrap();
+    let c = census(&wheel, &options, &|| false).unwrap();
+    assert!(
+        c.high_energy.zeros.iter().any(|&z| z > 0.0 && z < 1e-8),
+        "{:?}",
+        c.high_energy
+    );
+    assert!(
+        c.from_limits
+            .iter()
+            .any(|l| l.lowest == 0 && l.highest == 0),
+        "{:?}",
+        c.from_limits
+    );
 }

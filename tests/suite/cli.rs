@@ -1561,6 +1561,11 @@ fn verdict_of_another_shape_is_a_census() {
             vec!["--shape", "wheel", "--alpha", "0.2"],
             "--cut is required",
         ),
+        // (It ran the ellipsoid with beta = 1: an adversary pass.)
+        (
+            vec!["--shape", "ellipsoid", "--alpha", "0.2"],
+            "--beta is required",
+        ),
         (
             vec!["--shape", "disk", "--alpha", "0.2", "--beta", "2"],
             "takes no --beta",
