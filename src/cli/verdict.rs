@@ -178,6 +178,25 @@ pub(super) fn verdict(args: VerdictArgs) -> Result<()> {
         Some(ShapeKindArg::Ellipsoid) | None => {}
         Some(shape) => return census(&args, shape),
     }
+    // The ellipsoid takes neither (they were ignored).
+    for (given, flag) in [
+        (
+            args.cut.is_some(),
+            "--cut (only truncated_ball and wheel take it)",
+        ),
+        (
+            args.profile.is_some(),
+            "--profile (only --shape profile takes it)",
+        ),
+    ] {
+        if given {
+            return Err(AtlasError::Atlas {
+                path: "options".into(),
+                reason: format!("--shape ellipsoid: takes no {flag}"),
+            }
+            .into());
+        }
+    }
     // --shape ellipsoid lifts clap's requirement of --beta: it is still required.
     let Some(beta) = args.beta else {
         return Err(AtlasError::Atlas {
@@ -353,6 +372,12 @@ fn census(args: &VerdictArgs, shape: ShapeKindArg) -> Result<()> {
         println!(
             "  bracketed by samples of one family, no point confirmed: {}",
             spans(&report.bracketed)
+        );
+    }
+    if !report.near_integers.is_empty() {
+        println!(
+            "  N within the tolerance of, with no sign change to prove it reaches them: {}",
+            list(&report.near_integers)
         );
     }
     match report.unbounded_motion {

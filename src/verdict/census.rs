@@ -4,8 +4,8 @@
 //! [`crate::limits`]. It claims no boundedness: the paper's hypothesis is the ellipsoid's.
 
 use super::{
-    brackets, check_sampling, counterexamples, kappa_lines, search_beyond, Candidate,
-    Counterexample, Evidence, Sample, Sampler, EXTRA_KAPPA_LINES, KAPPA_FLOOR, ON_INTEGER_KAPPA,
+    brackets, check_sampling, counterexamples, kappa_lines, search_beyond, Counterexample,
+    Evidence, Sample, Sampler, EXTRA_KAPPA_LINES, KAPPA_FLOOR, ON_INTEGER_KAPPA,
 };
 use crate::body::{Body, Shape};
 use crate::cell::CellOptions;
@@ -45,7 +45,7 @@ pub struct HighEnergyScan {
     pub n_max: f64,
     pub lambda_at_max: f64,
     /// The λ where N∞ changes sign: an N = 0 resonance curve that runs to ε = ∞ along
-    /// κ ≈ λ√ε.
+    /// κ ≈ λ√ε (to 1e-12 in λ; the middle of the bracket of samples where that search fails).
     pub zeros: Vec<f64>,
     /// The largest error estimate of the N∞ values behind these.
     pub error: f64,
@@ -67,14 +67,20 @@ pub struct Census {
     /// (`counterexamples`). Ascending.
     pub integers: Vec<i64>,
     /// Further integers between the N of two neighbouring samples of one family (N − k of
-    /// reliable signs on both), for which no point was confirmed (beside a separatrix, where
+    /// reliable signs on both; for a body that is its own mirror image, also a sample on one
+    /// within its own error bar), for which no point was confirmed (beside a separatrix, where
     /// N runs to ±∞, N's own error grows beyond the tolerance; or beyond the six integers
     /// nearest 0 that are refined): ranges [lowest, highest] of consecutive integers, those
     /// within ±100 (`evidence.rotation_number_range` shows how far N goes).
     pub bracketed: Vec<[i64; 2]>,
     /// Points on them where the path runs away (N = k to the tolerance, |Δζ| above its
-    /// error): up to two each for the six integers nearest 0.
+    /// error): up to two each for the six integers nearest 0 (more where the lines beyond
+    /// κ = 1e4 are searched).
     pub counterexamples: Vec<Counterexample>,
+    /// Integers N comes within the tolerance of (samples with N's error within it, away from
+    /// κ → 0 and the bottom) with no sign change that proves N reaches them: a value, not a
+    /// resonance, until a tighter tolerance decides. Within ±100.
+    pub near_integers: Vec<i64>,
     /// Integers the high-energy limit proves (N = k at every large κ), as ranges.
     pub from_limits: Vec<LimitResonance>,
     /// true when a counterexample was found; null otherwise (no resonance found is not a
@@ -343,6 +349,7 @@ pub fn census<S: Shape>(
         return Ok(Census {
             integers: Vec::new(),
             bracketed: Vec::new(),
+            near_integers: Vec::new(),
             counterexamples: Vec::new(),
             from_limits,
             unbounded_motion: None,
@@ -379,37 +386,17 @@ pub fn census<S: Shape>(
     let mut lines: Vec<Vec<Sample>> = kappas.par_iter().map(|&k| sampler.line(k)).collect();
     stopped()?;
     let mut candidates = brackets(&lines, options.tol, symmetric);
-    // A sample on an integer to the tolerance is a point by the census's own rule (N's error
-    // within the tolerance, N on the integer to it, |Δζ| above its error) even without a
-    // bracket: a disk 1e-12 from its own mirror image has N ≈ ±1e-11 on whole families and
-    // no sign change to bracket (its N = 0 went unreported). Away from κ → 0 and the bottom,
-    // where N reaches 0 only as a limit.
-    candidates.extend(
-        lines
-            .iter()
-            .flatten()
-            .filter(|s| {
-                s.grid.is_some_and(|i| i > 0)
-                    && s.kappa >= ON_INTEGER_KAPPA
-                    && s.error <= options.tol
-                    && (s.n - s.n.round()).abs() <= options.tol
-            })
-            .map(|s| Candidate {
-                a: *s,
-                b: None,
-                k: s.n.round() as i64,
-            }),
-    );
     let (mut found, mut failures) = counterexamples(&sampler, &candidates);
     stopped()?;
     let from_limits = limit_resonances(&high_energy);
     let mut kappa_top = *kappas.last().expect("lines");
     // A resonance the limit proves but the lines did not reach lies at larger κ.
-    let without_point = |k: i64| !found.iter().any(|c| c.integer == k);
-    if from_limits
-        .iter()
-        .any(|l| (l.lowest..=l.highest).take(8).any(without_point))
-    {
+    // The integer of each proved range nearest 0 (the refined ones are the nearest 0).
+    let without_point = |l: &LimitResonance| {
+        let k = l.lowest.max(0).min(l.highest);
+        !found.iter().any(|c| c.integer == k)
+    };
+    if from_limits.iter().any(without_point) {
         kappa_top = *EXTRA_KAPPA_LINES.last().expect("lines");
         let last = lines.last().cloned().unwrap_or_default();
         let (extra, more, extra_failures) = search_beyond(&sampler, &last, symmetric, &mut found);
@@ -433,6 +420,25 @@ pub fn census<S: Shape>(
             .filter(|k| k.abs() <= BRACKETED_LISTED && !integers.contains(k))
             .collect(),
     );
+    // Samples on an integer to the tolerance without a sign change that proves N reaches it
+    // (a disk 1e-12 from its own mirror image: N = −1.6e-11 ± 3.5e-13 on whole families):
+    // a value, not a resonance, until a tighter tolerance decides.
+    let listed =
+        |k: &i64| integers.contains(k) || bracketed.iter().any(|r| (r[0]..=r[1]).contains(k));
+    let mut near_integers: Vec<i64> = lines
+        .iter()
+        .flatten()
+        .filter(|s| {
+            s.grid.is_some_and(|i| i > 0)
+                && s.kappa >= ON_INTEGER_KAPPA
+                && s.error <= options.tol
+                && (s.n - s.n.round()).abs() <= options.tol
+        })
+        .map(|s| s.n.round() as i64)
+        .filter(|k| k.abs() <= BRACKETED_LISTED && !listed(k))
+        .collect();
+    near_integers.sort_unstable();
+    near_integers.dedup();
     let all: Vec<&Sample> = lines.iter().flatten().collect();
     let n_range = all.iter().fold([f64::INFINITY, f64::NEG_INFINITY], |r, s| {
         [r[0].min(s.n), r[1].max(s.n)]
@@ -458,6 +464,7 @@ pub fn census<S: Shape>(
     Ok(Census {
         integers,
         bracketed,
+        near_integers,
         counterexamples: found,
         from_limits,
         unbounded_motion,

@@ -1529,6 +1529,7 @@ fn verdict_of_another_shape_is_a_census() {
         "bracketed",
         "counterexamples",
         "from_limits",
+        "near_integers",
         "unbounded_motion",
         "full_model_checks",
         "high_energy",
@@ -1565,6 +1566,10 @@ fn verdict_of_another_shape_is_a_census() {
         (
             vec!["--shape", "ellipsoid", "--alpha", "0.2"],
             "--beta is required",
+        ),
+        (
+            vec!["--alpha", "0.2", "--beta", "2", "--cut", "0.5"],
+            "takes no --cut",
         ),
         (
             vec!["--shape", "disk", "--alpha", "0.2", "--beta", "2"],
