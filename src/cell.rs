@@ -471,11 +471,7 @@ fn far_out<S: Shape>(
         return None;
     }
     let shape = &potential.body.shape;
-    let scale = 1.0
-        + [0.0, 0.5 * PI, PI]
-            .iter()
-            .map(|&t| shape.potential(t).abs())
-            .fold(0.0, f64::max);
+    let scale = 1.0 + crate::limits::potential_scale(shape);
     if energy < FAR_OUT * scale * scale {
         return None;
     }

@@ -225,17 +225,21 @@ pub fn high_energy_limit_at_small_lambda<S: Shape>(body: &Body<S>) -> f64 {
     0.5 * (excess_at(body, bottom) - excess_at(body, top))
 }
 
+/// Ū, the scale of U: its largest |U| at the poles and the equator.
+pub(crate) fn potential_scale<S: Shape>(shape: &S) -> f64 {
+    [0.0, 0.5 * PI, PI]
+        .iter()
+        .map(|&t| shape.potential(t).abs())
+        .fold(0.0, f64::max)
+}
+
 /// ∞ where a zero of U lies in the allowed set sinθ ≥ μ and J there, √((cos²θ + ν sin²θ)/η),
 /// is within a hundred roundings of U (8 eps of its scale): 1/J then peaks on a width that U's
 /// rounding decides, and the integral cannot be trusted (a cut ball with η = 1e60 and a zero
 /// of U at the equator gave N∞ = 0.327 ± 0.088 against 0.433); else 0.
 fn unresolved_peaks<S: Shape>(body: &Body<S>, mu: f64) -> f64 {
     let shape = &body.shape;
-    let scale = [0.0, 0.5 * PI, PI]
-        .iter()
-        .map(|&t| shape.potential(t).abs())
-        .fold(1.0, f64::max);
-    let rounding = 8.0 * f64::EPSILON * scale;
+    let rounding = 8.0 * f64::EPSILON * potential_scale(shape).max(1.0);
     let hidden = shape.potential_zeros().into_iter().any(|theta| {
         let (s, c) = theta.sin_cos();
         let j2 = (c * c + body.nu * s * s) / body.eta;
@@ -347,24 +351,24 @@ pub fn edged_high_energy_rotation_number<S: Shape>(
             )
         };
         let first = TanhSinhLevel::new(EDGED_FIRST_LEVEL);
-        let (mut sum, mut scale) = (0.0, 0.0);
+        let (mut sum, mut scale, mut tail) = (0.0, 0.0, 0.0);
         for j in 0..first.count {
             let (v, r) = term(EDGED_FIRST_LEVEL, j);
             sum += v;
             scale += r;
+            // The tails beyond τ = ±TAU_MAX: the outermost terms' integrand times the
+            // distance left to each end (the integrand is bounded on the piece).
+            if j == 0 || j + 1 == first.count {
+                let node = IntervalNode::tanh_sinh_tabulated(EDGED_FIRST_LEVEL, j, length);
+                let to_end = if j == 0 {
+                    node.from_left
+                } else {
+                    node.from_right
+                };
+                tail += (v / node.jacobian).abs() * to_end;
+            }
         }
         let mut value = sum * first.step;
-        // The tails beyond τ = ±TAU_MAX: the outermost terms' integrand times the distance
-        // left to each end (the integrand is bounded on the piece).
-        let tail = {
-            let (l, r) = (
-                IntervalNode::tanh_sinh_tabulated(EDGED_FIRST_LEVEL, 0, length),
-                IntervalNode::tanh_sinh_tabulated(EDGED_FIRST_LEVEL, first.count - 1, length),
-            );
-            let (vl, _) = term(EDGED_FIRST_LEVEL, 0);
-            let (vr, _) = term(EDGED_FIRST_LEVEL, first.count - 1);
-            (vl / l.jacobian).abs() * l.from_left + (vr / r.jacobian).abs() * r.from_right
-        };
         let mut last_diff = f64::INFINITY;
         // A piece that does not settle by the finest level has no error bound: its last
         // difference could be far below the truth (a peak of 1/J narrower than the nodes).

@@ -6,7 +6,7 @@ use anyhow::Result;
 use clap::Args;
 use rubber_atlas::error::{show, show_digits as digits, AtlasError};
 use rubber_atlas::verdict::{self, VerdictOptions};
-use rubber_atlas::EllipsoidBody;
+use rubber_atlas::AnyBody;
 use std::io::IsTerminal;
 
 #[derive(Debug, Args)]
@@ -174,38 +174,20 @@ pub(super) fn verdict(args: VerdictArgs) -> Result<()> {
         }
         return Ok(());
     }
-    match args.shape {
-        Some(ShapeKindArg::Ellipsoid) | None => {}
-        Some(shape) => return census(&args, shape),
+    // The body as every command takes it (a parameter the shape does not take, or one it
+    // needs, refused in one line): the ellipsoid's verdict, or another shape's census.
+    let body = BodyShapeArgs {
+        shape: args.shape.unwrap_or(ShapeKindArg::Ellipsoid),
+        alpha: args.alpha,
+        beta: args.beta,
+        cut: args.cut,
+        profile: args.profile.clone(),
     }
-    // The ellipsoid takes neither (they were ignored).
-    for (given, flag) in [
-        (
-            args.cut.is_some(),
-            "--cut (only truncated_ball and wheel take it)",
-        ),
-        (
-            args.profile.is_some(),
-            "--profile (only --shape profile takes it)",
-        ),
-    ] {
-        if given {
-            return Err(AtlasError::Atlas {
-                path: "options".into(),
-                reason: format!("--shape ellipsoid: takes no {flag}"),
-            }
-            .into());
-        }
-    }
-    // --shape ellipsoid lifts clap's requirement of --beta: it is still required.
-    let Some(beta) = args.beta else {
-        return Err(AtlasError::Atlas {
-            path: "options".into(),
-            reason: "--shape ellipsoid: --beta is required".into(),
-        }
-        .into());
+    .body(args.nu, args.eta)?;
+    let body = match body {
+        AnyBody::Ellipsoid(b) => b,
+        other => return census(&args, &other),
     };
-    let body = EllipsoidBody::ellipsoid(args.alpha, beta, args.nu, args.eta)?;
     let options = VerdictOptions {
         coarse_first: true,
         ..options
@@ -312,20 +294,12 @@ fn resolution(text: &str) -> std::result::Result<usize, String> {
 
 /// The census of a body other than the ellipsoid (`verdict --shape`): which integers N
 /// reaches over its plane ([`verdict::census`]).
-fn census(args: &VerdictArgs, shape: ShapeKindArg) -> Result<()> {
-    let body = BodyShapeArgs {
-        shape,
-        alpha: args.alpha,
-        beta: args.beta,
-        cut: args.cut,
-        profile: args.profile.clone(),
-    }
-    .body(args.nu, args.eta)?;
+fn census(args: &VerdictArgs, body: &AnyBody) -> Result<()> {
     let options = verdict::CensusOptions {
         tol: args.tol,
         resolution: args.resolution,
     };
-    let full = verdict::census_report(&body, &options, &crate::stop::requested)?;
+    let full = verdict::census_report(body, &options, &crate::stop::requested)?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&full)?);
         return Ok(());

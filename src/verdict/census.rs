@@ -10,7 +10,7 @@ use super::{
 use crate::body::{Body, Shape};
 use crate::cell::CellOptions;
 use crate::error::{AtlasError, Result};
-use crate::limits::{golden_max, high_energy_limit_at_small_lambda, high_energy_rotation_number};
+use crate::limits::{golden_max, high_energy_rotation_number};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::f64::consts::SQRT_2;
@@ -192,28 +192,29 @@ pub fn high_energy_scan<S: Shape>(
         }
         high_energy_rotation_number(body, l, tol)
     };
-    let mut lambdas: Vec<f64> = SMALL_LAMBDAS
-        .into_iter()
+    // λ = 0 stands for the limit λ → 0 (N∞ tends to it continuously; a wheel nearly its own
+    // mirror image had its sign change below the smallest λ > 0 sampled).
+    let mut lambdas: Vec<f64> = std::iter::once(0.0)
+        .chain(SMALL_LAMBDAS)
         .chain((1..SCAN).map(|i| SQRT_2 * i as f64 / SCAN as f64))
         .collect();
     lambdas.sort_by(f64::total_cmp);
-    let mut values = lambdas
+    let values = lambdas
         .par_iter()
         .map(|&l| at(l))
         .collect::<Result<Vec<_>>>()?;
     let mut error = values.iter().map(|v| v.error).fold(0.0, f64::max);
-    let limit = high_energy_limit_at_small_lambda(body);
-    // The extremum of sign·N∞: an interior sample refined, else the end it tends to.
+    // The extremum of sign·N∞: an interior sample refined, else the end it tends to (the
+    // λ → 0 limit is sample 0; N∞ = 0 at λ = √2).
     let mut extremum = |sign: f64| -> Result<(f64, f64)> {
         let i = (0..values.len())
             .max_by(|&a, &b| (sign * values[a].value).total_cmp(&(sign * values[b].value)))
             .expect("the scan has points");
-        let (end_small, end_top) = (sign * limit, 0.0);
-        let best = sign * values[i].value;
-        if end_small >= best && end_small >= end_top {
-            return Ok((limit, 0.0));
+        let (best, at_zero) = (sign * values[i].value, sign * values[0].value);
+        if at_zero >= best && at_zero >= 0.0 {
+            return Ok((values[0].value, 0.0));
         }
-        if end_top >= best {
+        if 0.0 >= best {
             return Ok((0.0, SQRT_2));
         }
         if i == 0 || i + 1 == values.len() {
@@ -231,19 +232,8 @@ pub fn high_energy_scan<S: Shape>(
     };
     let (n_max, lambda_at_max) = extremum(1.0)?;
     let (n_min, lambda_at_min) = extremum(-1.0)?;
-    // Sign changes between samples whose signs are beyond their errors, the limit at λ → 0
-    // among them (N∞ tends to it continuously: a wheel nearly a mirror image had its sign
-    // change below the smallest λ sampled).
+    // Sign changes between samples whose signs are beyond their errors.
     let mut zeros = Vec::new();
-    lambdas.insert(0, 0.0);
-    let limit_error = 16.0 * f64::EPSILON * limit.abs();
-    values.insert(
-        0,
-        crate::limits::Estimate {
-            value: limit,
-            error: limit_error,
-        },
-    );
     let reliable: Vec<usize> = (0..values.len())
         .filter(|&i| values[i].value.abs() > values[i].error.max(tol))
         .collect();
@@ -261,7 +251,7 @@ pub fn high_energy_scan<S: Shape>(
         }
     }
     Ok(HighEnergyScan {
-        at_small_lambda: limit,
+        at_small_lambda: values[0].value,
         n_min,
         lambda_at_min,
         n_max,
