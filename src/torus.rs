@@ -981,6 +981,8 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         // a pole comes close to the level, that is several times cheaper.
         // (Not across a kink of U: its rule converges geometrically only on an analytic
         // integrand.)
+        // (The evaluations spent on it where it gives up count in the other rules' work.)
+        let mut spent = 0;
         if fast_rules
             && component.kind == MotionKind::Libration
             && self
@@ -988,10 +990,9 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 .is_empty()
         {
             let whole = &self.pieces(energy, component, false)[0];
-            if let Some(result) =
-                cosine::integrate(self, whole, energy, component, tol, with_drift)?
-            {
-                return Ok(result);
+            match cosine::integrate(self, whole, energy, component, tol, with_drift)? {
+                Ok(result) => return Ok(result),
+                Err(work) => spent = work,
             }
         }
         let pieces = self.pieces(energy, component, true);
@@ -1148,7 +1149,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             drift,
             psi_variation: Some(psi_variation),
             saddle: [saddle_t, saddle_psi],
-            work: samples.iter().map(|s| s.evaluations).sum(),
+            work: spent + samples.iter().map(|s| s.evaluations).sum::<usize>(),
             converged,
         })
     }
@@ -1737,7 +1738,7 @@ impl DriftEstimate {
         );
         Self {
             value: fine.0,
-            error: cautious_error(d1, d2, rate).max(8.0 * EPS * fine.1),
+            error: cautious_error(d1, d2, rate).max(LEVEL_FLOOR * fine.1),
             scale: fine.1,
         }
     }
@@ -2126,9 +2127,20 @@ fn interleave(
 
 /// The error of the finest of three successive sums of a nested rule (finest first), from
 /// the level differences d₁ = |I₀ − I₁| and d₂ = |I₁ − I₂| by [`cautious_error`].
+/// Never below [`LEVEL_FLOOR`] of the finest sum.
 fn level_error(sums: [f64; 3], rate: Convergence) -> f64 {
     let (d1, d2) = ((sums[0] - sums[1]).abs(), (sums[1] - sums[2]).abs());
-    cautious_error(d1, d2, rate).max(8.0 * EPS * sums[0].abs())
+    cautious_error(d1, d2, rate).max(LEVEL_FLOOR * sums[0].abs())
+}
+
+/// The least error a level difference is trusted to show, relative to the sum: below it
+/// the differences are the integrand's rounding (bounded apart), not the rule's truncation.
+const LEVEL_FLOOR: f64 = 8.0 * EPS;
+
+/// Whether [`level_error`] of `sums` is its floor: refining cannot lower it further.
+fn at_level_floor(sums: [f64; 3], rate: Convergence) -> bool {
+    let (d1, d2) = ((sums[0] - sums[1]).abs(), (sums[1] - sums[2]).abs());
+    cautious_error(d1, d2, rate) <= LEVEL_FLOOR * sums[0].abs()
 }
 
 /// What a rule's level differences may be trusted to say about the next level.

@@ -6,8 +6,9 @@
 //! at small κ) it stops early and the tanh-sinh path of the parent module takes over.
 
 use super::{
-    interleave, level_error, root_of_ratio, sample, weighted, Component, Convergence,
-    DriftEstimate, EffectivePotential, NodeSample, PeriodIntegrals, Piece, EPS, HIDDEN_PEAK,
+    at_level_floor, interleave, level_error, root_of_ratio, sample, weighted, Component,
+    Convergence, DriftEstimate, EffectivePotential, NodeSample, PeriodIntegrals, Piece, EPS,
+    HIDDEN_PEAK, LEVEL_FLOOR,
 };
 use crate::body::{Angle, Shape};
 use crate::dd::CompensatedSum;
@@ -34,8 +35,9 @@ const LAST_INTERVALS: usize = 256;
 const _: () = assert!(LAST_INTERVALS <= FINEST_COSINE_INTERVALS);
 
 /// T, Δψ and (if `with_drift`) Δζ of a libration that is one piece (see the parent's
-/// `integrate`), or `None` when the trapezoid rule would need more than [`LAST_INTERVALS`]
-/// steps (or a turning point is too flat for the substitution to make the integrand smooth).
+/// `integrate`), or, when the trapezoid rule would need more than [`LAST_INTERVALS`] steps
+/// (or a turning point is too flat for the substitution to make the integrand smooth), the
+/// integrand evaluations spent on finding that out (the other rule's work counts them).
 pub(super) fn integrate<S: Shape>(
     v: &EffectivePotential<'_, S>,
     piece: &Piece,
@@ -43,14 +45,18 @@ pub(super) fn integrate<S: Shape>(
     component: &Component,
     tol: f64,
     with_drift: bool,
-) -> Result<Option<PeriodIntegrals>> {
+) -> Result<std::result::Result<PeriodIntegrals, usize>> {
+    let mut spent = 0;
     for map in Map::candidates(v, piece) {
-        let result = integrate_on(v, piece, &map, energy, component, tol, with_drift)?;
-        if result.is_some() {
-            return Ok(result);
+        match integrate_on(v, piece, &map, energy, component, tol, with_drift)? {
+            Ok(mut result) => {
+                result.work += spent;
+                return Ok(Ok(result));
+            }
+            Err(work) => spent += work,
         }
     }
-    Ok(None)
+    Ok(Err(spent))
 }
 
 /// [`integrate`] with one map.
@@ -62,9 +68,10 @@ fn integrate_on<S: Shape>(
     component: &Component,
     tol: f64,
     with_drift: bool,
-) -> Result<Option<PeriodIntegrals>> {
+) -> Result<std::result::Result<PeriodIntegrals, usize>> {
     let Some(mut samples) = Samples::new(v, piece, map, energy, first_intervals(tol)) else {
-        return Ok(None);
+        // (A node of the first level outside the allowed set: at most that level spent.)
+        return Ok(Err(first_intervals(tol) + 1));
     };
     loop {
         let sums = samples.level_sums();
@@ -85,15 +92,21 @@ fn integrate_on<S: Shape>(
         let extra_t = 2.0 * sums.t_rounding + saddle_t;
         let extra_psi = 2.0 * sums.psi_rounding + saddle_psi;
         let budget = |allowed: f64, extra: f64| (allowed - extra).max(0.1 * extra);
-        let mut done =
-            t_error <= budget(tol * period, extra_t) && psi_error <= budget(tol * TAU, extra_psi);
+        // A sum whose level differences are within the floor of `level_error` has nothing
+        // left for refinement to gain: where that floor with the rounding misses the
+        // tolerance (tol ≲ 1e-14), refining on to LAST_INTERVALS steps and then by the
+        // tanh-sinh rule only bought the same estimate at 2–4 times the nodes.
+        let mut done = (t_error <= budget(tol * period, extra_t) || at_level_floor(t_sums, rate))
+            && (psi_error <= budget(tol * TAU, extra_psi) || at_level_floor(psi_sums, rate));
         let period_error = t_error + extra_t;
         let psi_advance_error = psi_error + extra_psi;
         // Rounding in T and Δψ enters the drift through the phases and the weights.
         let phase = (extra_t - saddle_t) / period + extra_psi;
         // The drift (the costly part) only once T and Δψ have converged.
         let drift = (done && with_drift).then(|| samples.drift(rate));
-        done &= drift.is_none_or(|d| d.error <= budget(tol * d.scale, phase * d.scale));
+        done &= drift.is_none_or(|d| {
+            d.error <= budget(tol * d.scale, phase * d.scale) || d.error <= LEVEL_FLOOR * d.scale
+        });
         let drift = drift.map(|mut d| {
             d.error += phase * d.scale;
             d
@@ -119,7 +132,7 @@ fn integrate_on<S: Shape>(
                 d => d,
             };
             let psi_advance = 2.0 * psi_sums[0];
-            return Ok(Some(PeriodIntegrals {
+            return Ok(Ok(PeriodIntegrals {
                 period,
                 psi_advance,
                 period_error,
@@ -132,11 +145,11 @@ fn integrate_on<S: Shape>(
             }));
         }
         if hopeless {
-            return Ok(None);
+            return Ok(Err(samples.nodes.len()));
         }
         let at = |node| sample(v, piece, energy, node);
         if samples.refine(map, at).is_err() {
-            return Ok(None);
+            return Ok(Err(samples.nodes.len()));
         }
     }
 }
