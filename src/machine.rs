@@ -4,6 +4,10 @@
 
 /// Bytes as a person reads them, one format throughout: 1.5 GB, 310.0 MB.
 pub fn show_bytes(bytes: f64) -> String {
+    // (Beyond a thousand TB, in powers of ten: 1e24 cells made "932000000000000.0 TB".)
+    if bytes >= 1e15 {
+        return format!("{bytes:.1e} B");
+    }
     let units = [("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("kB", 1e3)];
     match units.iter().find(|(_, size)| bytes >= *size) {
         Some((name, size)) => format!("{:.1} {name}", bytes / size),

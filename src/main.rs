@@ -38,8 +38,12 @@ fn main() -> ExitCode {
     let args = match cli::Cli::try_parse() {
         Ok(args) => args,
         Err(e) if !e.use_stderr() => {
-            // --help and --version.
-            let _ = e.print();
+            // --help and --version, which a full disk must not lose in silence either.
+            use std::io::Write;
+            if let Err(error) = e.print().and_then(|()| std::io::stdout().flush()) {
+                eprintln!("rubber-atlas: failed printing to stdout: {error}");
+                return ExitCode::from(1);
+            }
             return ExitCode::SUCCESS;
         }
         Err(e) if e.kind() == clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {

@@ -183,6 +183,13 @@ fn check_memory(bytes: f64, allow_large: bool, remedy: &str) -> PyResult<()> {
     crate::machine::check_memory(bytes, allow_large, remedy).map_err(value_error)
 }
 
+/// What is short when a call of the package needs `bytes` of memory, by the core's rule
+/// ([`crate::machine::memory_short`]): "about X of memory (Y available)", or None.
+#[pyfunction]
+fn memory_short(bytes: f64) -> Option<String> {
+    crate::machine::memory_short(bytes)
+}
+
 /// The metadata of the variables of `fields`, in file order: name, whether it has a value
 /// per component, dtype, long_name, units, comment, flag_values and flag_meanings.
 #[pyfunction]
@@ -859,6 +866,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("COMPONENT_SLOTS", COMPONENT_SLOTS)?;
     m.add("FIELDS", Field::ALL.map(|f| f.name()).to_vec())?;
     m.add_function(wrap_pyfunction!(variables, m)?)?;
+    m.add_function(wrap_pyfunction!(memory_short, m)?)?;
     m.add_function(wrap_pyfunction!(coordinate, m)?)?;
     m.add_function(wrap_pyfunction!(provenance, m)?)?;
     m.add_function(wrap_pyfunction!(cells, m)?)?;

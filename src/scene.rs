@@ -458,11 +458,26 @@ impl Scene {
     pub fn parse(text: &str, file: &str) -> Result<Scene> {
         let reader = Reader { file };
         let root: Table = text.parse().map_err(|e: toml::de::Error| {
+            // The line, and its text (a number too large for TOML's integers named neither
+            // the key nor the value).
             let line = match e.span() {
-                Some(span) => format!(
-                    "line {}",
-                    text[..span.start.min(text.len())].matches('\n').count() + 1
-                ),
+                Some(span) => {
+                    let start = span.start.min(text.len());
+                    let number = text[..start].matches('\n').count() + 1;
+                    let content: String = text
+                        .lines()
+                        .nth(number - 1)
+                        .unwrap_or_default()
+                        .trim()
+                        .chars()
+                        .take(60)
+                        .collect();
+                    if content.is_empty() {
+                        format!("line {number}")
+                    } else {
+                        format!("line {number} `{content}`")
+                    }
+                }
                 None => "(syntax)".into(),
             };
             reader.error(&line, e.message().replace('\n', " "))

@@ -241,7 +241,9 @@ pub fn footprint(scene: &Scene, shard: Shard, threads: usize) -> Footprint {
         .iter()
         .map(|v| v.kind.bytes_per_cell(slots))
         .sum::<usize>() as f64;
-    let cells = share * unit_cells;
+    // The cells themselves, not the units' (a unit at the end of a slice, or a group of β
+    // at its end, is short): a grid of 1e4 α × 1e4 β and one cell each was 1.229e8 cells.
+    let cells = na * nb * nk * ne * share / total;
     let batch = (share.min(per_slice) * unit_cells).max((BATCH_CELLS as f64).min(cells));
     // A BTreeSet<usize> of the journal's units: about 3 words an entry.
     let journal_list = share * 24.0;

@@ -100,6 +100,35 @@ impl Start {
         ReducedSystem::new(body, self.kappa).energy(self.theta0, self.theta_dot0)
     }
 
+    /// The energy of this start among V's levels as `potential` holds them: where it lies
+    /// below V's lowest critical level by no more than V's rounding (8 eps of its scale at
+    /// θ(0) or there), the start is at rest on that level's minimum (or neutral
+    /// equilibrium), and its level is that one. V(θ(0)) and the minimum are two roundings of one level there: on a sphere
+    /// centred on its centre of mass (U ≡ 1, every θ a minimum of V at κ = 0) the start at
+    /// rest at θ(0) = π/2, κ = 1e-3 had ε = 1.0000004999999998 under the minimum 1.0000005,
+    /// and `cell --theta0` refused it as "no motion".
+    pub fn level<S: Shape>(&self, potential: &EffectivePotential<'_, S>) -> f64 {
+        let energy = self.energy(potential.body);
+        // (The lowest critical level: where U′ ≡ 0 on an arc, its points are neutral
+        // equilibria, not minima.)
+        let bottom = potential
+            .critical_points()
+            .iter()
+            .map(|p| p.value)
+            .fold(f64::INFINITY, f64::min);
+        if !bottom.is_finite() {
+            return energy;
+        }
+        let scale = potential
+            .value_scale(Site::at(self.circle_angle()).angle())
+            .max(bottom.abs());
+        if energy < bottom && bottom - energy <= 8.0 * f64::EPSILON * scale {
+            bottom
+        } else {
+            energy
+        }
+    }
+
     /// The energy of this start, refused (naming θ(0), θ̇(0) or κ) where it lies beyond 1e300
     /// in size or overflows, as every surface refuses an energy given directly.
     pub fn checked_energy<S: Shape>(&self, body: &Body<S>) -> Result<f64> {
@@ -140,8 +169,7 @@ impl Start {
         &self,
         potential: &EffectivePotential<'_, S>,
     ) -> Result<Component> {
-        let energy = self.energy(potential.body);
-        let comps = potential.components(energy)?;
+        let comps = potential.components(self.level(potential))?;
         let nearest = comps
             .into_iter()
             .min_by(|a, b| self.distance_to(a).total_cmp(&self.distance_to(b)));
@@ -368,19 +396,29 @@ impl Request {
                 at_rest_by_a_face = true;
             }
         }
+        // (A subnormal length is refused as a subnormal κ is: below 2.2e-308 the integrator's
+        // first step is below the rounding of t, and the run failed blaming the motion.)
         let positive = |name, value| {
             crate::error::check_range(
                 name,
                 value,
-                Some((0.0, false)),
+                Some((f64::MIN_POSITIVE, true)),
                 None,
-                "must be a finite number > 0",
+                "must be a finite number >= 2.2250738585072014e-308 (the least normal double)",
             )
         };
         let (t_end, period) = match self.duration {
             Duration::Periods(k) => {
                 let k = positive("periods", k)?;
                 let period = start.period(body, 1e-13)?;
+                if k * period < f64::MIN_POSITIVE {
+                    return Err(AtlasError::InvalidParameter {
+                        name: "periods",
+                        value: k,
+                        reason: "gives a length below 2.2250738585072014e-308 (the least \
+                                 normal double)",
+                    });
+                }
                 (k * period, Some(period))
             }
             Duration::Until(t) => (positive("t-end", t)?, None),

@@ -600,25 +600,29 @@ def _show_bytes(n: float) -> str:
     return f"{n:.0f} B"
 
 
-def _check_memory(cells: int, fields: list[str] | None, allow_large: bool) -> None:
-    """Refuses (unless `allow_large`) results that would take over 80 % of the memory the
-    kernel could give now: the rule of the core's own check, for the whole of a call the
-    package splits into batches."""
+def _refuse_memory(what: str, needed: float, allow_large: bool, remedy: str) -> None:
+    """Refuses (unless `allow_large`) a call that would take over 80 % of the memory the
+    kernel could give now, by the core's own rule (the machine's available memory, the
+    control group's limit and the address-space limit, whichever is least)."""
     if allow_large:
         return
-    try:
-        with open("/proc/meminfo") as f:
-            line = next(x for x in f if x.startswith("MemAvailable:"))
-        available = float(line.split()[1]) * 1024.0
-    except (OSError, StopIteration, ValueError, IndexError):
-        return
+    short = _core.memory_short(float(needed))
+    if short is not None:
+        raise ValueError(f"{what} needs {short}: {remedy}, or allow_large=True")
+
+
+def _check_memory(cells: int, fields: list[str] | None, allow_large: bool) -> None:
+    """Refuses (unless `allow_large`) results that would take over 80 % of the memory the
+    kernel could give now, for the whole of a call the package splits into batches."""
     per_cell = sum(np.dtype(m["dtype"]).itemsize * (max(_core.COMPONENT_SLOTS, len(_family_names()))
                                                    if m["per_component"] else 1)
                    for m in _core.variables(fields))
-    needed = cells * (6 * 8 + 2 * per_cell)
-    if needed > 0.8 * available:
-        raise ValueError(f"cells needs about {_show_bytes(needed)} of memory ({_show_bytes(available)} "
-                         "available): give fewer cells at a time, or allow_large=True")
+    _refuse_memory("cells", cells * (6 * 8 + 2 * per_cell), allow_large, "give fewer cells at a time")
+
+
+# Memory a body's verdict takes in this package: its JSON object as text and as Python
+# objects, and its share of the dataset (114 kB measured at resolution 8, 200 bodies).
+_VERDICT_BYTES = 128e3
 
 
 def _in_jupyter() -> bool:
@@ -1250,6 +1254,9 @@ def _text_attributes_crc32(f) -> int:
 
 def _file(path) -> Path:
     """`path` as a Path to a file that exists, refused in one line otherwise."""
+    # (Path("") is ".": an empty name was refused as the folder ".".)
+    if isinstance(path, str) and not path:
+        raise ValueError("path is empty: give a file's name")
     try:
         path = Path(path)
     except TypeError:
@@ -2051,7 +2058,7 @@ _VERDICT_OUTPUTS = ("holds", "case", "kappa_max", "kappa_max_error", "fail_margi
 
 
 def verdict(alpha, beta, nu, eta, *, tol: float = 1e-10, resolution: int = 64,
-            threads: int | None = None) -> xr.Dataset:
+            threads: int | None = None, allow_large: bool = False) -> xr.Dataset:
     """The verdict of the paper's boundedness hypothesis for each body, computed in parallel.
 
     The hypothesis: paths are bounded (case 1) for β² < 1 + α except rolling over the top at
@@ -2070,6 +2077,9 @@ def verdict(alpha, beta, nu, eta, *, tol: float = 1e-10, resolution: int = 64,
         narrower resonance regions, and costs about its square.
     threads : int, optional
         Number of threads (≥ 1); by default rayon's pool.
+    allow_large : bool, default False
+        Compute even when the bodies' results would take over 80 % of the available memory
+        (about 128 kB a body).
 
     Returns
     -------
@@ -2095,8 +2105,9 @@ def verdict(alpha, beta, nu, eta, *, tol: float = 1e-10, resolution: int = 64,
     Raises
     ------
     ValueError
-        A parameter out of range, inputs that do not broadcast, or a dimension named after
-        a variable of the result.
+        A parameter out of range, inputs that do not broadcast, a dimension named after
+        a variable of the result, or more bodies than the memory holds (without
+        `allow_large`).
     TypeError
         An input that is not real numbers (as in `cells`), `resolution` or `threads` not a
         whole number.
@@ -2118,7 +2129,10 @@ def verdict(alpha, beta, nu, eta, *, tol: float = 1e-10, resolution: int = 64,
     """
     given = {"alpha": alpha, "beta": beta, "nu": nu, "eta": eta}
     tol, resolution, threads = _real("tol", tol), _count("resolution", resolution), _optional_count("threads", threads)
-    dims, layout, coords, places = _broadcast(given, outputs=_VERDICT_OUTPUTS)
+    allow_large = _switch("allow_large", allow_large)
+    dims, layout, coords, places = _broadcast(
+        given, outputs=_VERDICT_OUTPUTS,
+        check=lambda n: _refuse_memory("verdict", n * _VERDICT_BYTES, allow_large, "give fewer bodies at a time"))
     shape = layout[0].shape
     flat = [np.asarray(a, dtype=np.float64).reshape(-1).tolist() for a in layout]
     try:

@@ -37,7 +37,8 @@ fn solve<S: Shape>(body: &Body<S>, args: &CellArgs, options: &CellOptions) -> Re
             options.validate()?;
             options.check_for(body)?;
             let potential = EffectivePotential::new(body, start.kappa);
-            let energy = start.checked_energy(body)?;
+            start.checked_energy(body)?;
+            let energy = start.level(&potential);
             let component = start.component_in(&potential)?;
             CellResult {
                 kappa: start.kappa,

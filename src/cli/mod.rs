@@ -393,9 +393,16 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Resonance(args) => resonance::resonance(args),
         Command::Verdict(args) => verdict::verdict(args),
         Command::Completions { shell } => {
+            // Into a buffer first: clap_complete panics when its writer fails (`> /dev/full`).
             let mut command = <Cli as clap::CommandFactory>::command();
-            clap_complete::generate(shell, &mut command, "rubber-atlas", &mut std::io::stdout());
-            Ok(())
+            let mut script = Vec::new();
+            clap_complete::generate(shell, &mut command, "rubber-atlas", &mut script);
+            use std::io::Write;
+            let mut stdout = std::io::stdout().lock();
+            stdout
+                .write_all(&script)
+                .and_then(|()| stdout.flush())
+                .context("failed printing to stdout")
         }
         Command::Man {
             command,
@@ -512,6 +519,12 @@ pub(crate) fn number(text: &str) -> std::result::Result<f64, String> {
     if value == 0.0 && nonzero {
         return Err(format!(
             "{text} underflows: its size is below the smallest double (4.9e-324); give 0 or a number of larger size"
+        ));
+    }
+    // (A typed inf is ±∞ and refused as such where it is; 1e309 was reported as "inf".)
+    if value.is_infinite() && !mantissa.to_ascii_lowercase().contains("inf") {
+        return Err(format!(
+            "{text} overflows: its size is above the largest double (1.8e308)"
         ));
     }
     Ok(value)

@@ -319,8 +319,12 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
 /// The search starts where the whole run's need divided by what is there says and tries 256
 /// counts, then 256 from a count a quarter larger, and so on (a shard's memory has a floor,
 /// its threads' work units, so the first guess can be short). Where even the most shards
-/// do not fit, it says that a work unit is too large for the machine.
+/// do not fit, it says that a work unit is too large for the machine. The search has
+/// [`SHARD_SEARCH`]: a count's layout takes the divisors of the count, a millisecond at
+/// 1e12 (a grid of 1e16 cells took 40 s of tries before its refusal, deaf to Ctrl-C); past
+/// that the phrase gives the least count the need implies.
 pub(super) fn shards_to_fit(scene: &Scene, out: &std::path::Path, threads: usize) -> String {
+    let deadline = std::time::Instant::now() + SHARD_SEARCH;
     let memory = rubber_atlas::machine::available_memory().map_or(f64::INFINITY, |m| 0.5 * m);
     let disk = rubber_atlas::machine::free_disk(out).unwrap_or(f64::INFINITY);
     let shape = scene.shape();
@@ -337,19 +341,44 @@ pub(super) fn shards_to_fit(scene: &Scene, out: &std::path::Path, threads: usize
     let whole = sweep::footprint(scene, Shard::WHOLE, threads);
     let needed = (whole.memory_bytes / memory).max(whole.disk_bytes / disk);
     // (as usize saturates; a count is at least 2.)
-    let mut from = (needed.ceil() as usize).clamp(2, most.max(2));
-    while from <= most {
-        if let Some(count) = (from..=most.min(from + 255)).find(|&c| fits(c)) {
+    let least = (needed.ceil() as usize).clamp(2, most.max(2));
+    let at_least = format!(
+        "split it with --shard I/N across machines, N at least {least} (each shard must fit \
+         this machine), or "
+    );
+    // (One count's layout near 1e16 alone took 10 s.)
+    if least > SHARD_SEARCH_COUNTS {
+        return at_least;
+    }
+    let mut from = least;
+    while from <= most.min(SHARD_SEARCH_COUNTS) {
+        if let Some(count) = (from..=most.min(from + 255))
+            .take_while(|_| std::time::Instant::now() < deadline)
+            .find(|&c| fits(c))
+        {
             return format!(
                 "split it with --shard I/{count} across machines (enough shards to fit), or "
             );
         }
+        if std::time::Instant::now() >= deadline {
+            return at_least;
+        }
         from = from.saturating_add(256).max(from.saturating_add(from / 4));
+    }
+    if most > SHARD_SEARCH_COUNTS {
+        return at_least;
     }
     "even a shard of one work unit (a block of kappa-rows, every energy) does not fit this \
      machine: "
         .to_string()
 }
+
+/// The time [`shards_to_fit`] may search for a shard count.
+const SHARD_SEARCH: std::time::Duration = std::time::Duration::from_millis(200);
+
+/// The largest shard count [`shards_to_fit`] tries (a count's layout takes its divisors:
+/// a millisecond here).
+const SHARD_SEARCH_COUNTS: usize = 1 << 40;
 
 pub(super) fn print_summary(summary: &sweep::Summary, out: &std::path::Path, threads: usize) {
     let [ok, no_motion, failed] = summary.cells_by_status;

@@ -985,10 +985,15 @@ fn a_run_without_out_writes_beside_its_scene_from_any_folder() {
 }
 
 /// Standard output that cannot be written (a full disk: /dev/full) is one line on stderr and
-/// exit status 1, never a panic with a backtrace.
+/// exit status 1, never a panic with a backtrace. (Adversary pass of 2026-11-27:
+/// `completions bash` panicked in clap_complete, exit 101 with a backtrace; `--help` and
+/// `--version` exited 0 in silence.)
 #[test]
 fn output_that_cannot_be_written_is_one_line_and_exit_1() {
-    let commands: [&[&str]; 3] = [
+    let commands: [&[&str]; 6] = [
+        &["completions", "bash"],
+        &["--help"],
+        &["--version"],
         &[
             "cell", "--alpha", "0.5", "--beta", "3", "--nu", "0.5", "--eta", "0.5", "--kappa",
             "0.8", "--energy", "2.5",
@@ -1591,5 +1596,178 @@ fn verdict_of_another_shape_is_a_census() {
         let said = stderr(&o);
         assert_eq!(o.status.code(), Some(2), "{all:?}: {said}");
         assert!(said.contains(words), "{all:?}: {said}");
+    }
+}
+
+/// Issue 22, adversary pass of 2026-11-27, each as it was found:
+/// - a number beyond the largest double (`--alpha 1e309`) was reported as "inf";
+/// - `--t-end 1e-320` failed at t = 0 blaming the motion ("too fast near a pole"), exit 1;
+/// - a TOML error named the line only ("line 4: number too large to fit in target type").
+#[test]
+fn adversary_pass_of_2026_11_27_command_line() {
+    let o = run(&[
+        "cell", "--alpha", "1e309", "--beta", "3", "--nu", "0.5", "--eta", "0.5", "--kappa", "0.8",
+        "--energy", "2.5",
+    ]);
+    let text = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{text}");
+    assert!(text.contains("1e309 overflows"), "{text}");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("t.csv");
+    for length in [["--t-end", "1e-320"], ["--t-end", "5e-324"]] {
+        let o = run(&trajectory_args(&[
+            length[0],
+            length[1],
+            "--out",
+            out.to_str().unwrap(),
+        ]));
+        let text = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{length:?}: {text}");
+        assert!(text.contains("invalid t-end"), "{text}");
+        assert!(!out.exists());
+    }
+    let scene = dir.path().join("s.toml");
+    std::fs::write(
+        &scene,
+        "name = \"s\"\n[body]\nnu = 0.5\neta = 99999999999999999999\n",
+    )
+    .unwrap();
+    let o = run(&["run", scene.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{text}");
+    assert!(
+        text.contains("line 4 `eta = 99999999999999999999`") && text.lines().count() == 1,
+        "{text}"
+    );
+}
+
+/// Issue 22, adversary pass of 2026-11-27: the size check of `run` counted whole work units
+/// (1e4 α × 1e4 β of one cell each was "1.229e8 cells"), and its search for a shard count
+/// that fits tried divisors of counts near 1e12 for 40 s (1e16 cells) or more, deaf to
+/// Ctrl-C. The count is the grid's, and the search gives up after 0.2 s with the least count
+/// the need implies.
+#[test]
+fn the_size_refusal_counts_the_cells_and_answers_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = |name: &str, axes: &str| {
+        let path = dir.path().join(format!("{name}.toml"));
+        std::fs::write(
+            &path,
+            format!("name = \"{name}\"\n[body]\nnu = 0.5\neta = 0.5\n[axes]\n{axes}"),
+        )
+        .unwrap();
+        path
+    };
+    let many_slices = scene(
+        "slices",
+        "alpha = { start = 0.01, stop = 0.99, num = 10000 }\n\
+         beta = { start = 0.1, stop = 10, num = 10000 }\n\
+         kappa = [0.5]\nenergy = [3.0]\n",
+    );
+    let huge = scene(
+        "huge",
+        "alpha = { start = 0.01, stop = 0.99, num = 100 }\n\
+         beta = { start = 0.1, stop = 10, num = 100 }\n\
+         kappa = { start = 0.1, stop = 2, num = 1000000 }\n\
+         energy = { start = 0.5, stop = 4.5, num = 1000000 }\n",
+    );
+    for (path, cells) in [(many_slices, "1.000e8 cells"), (huge, "1.000e16 cells")] {
+        let started = std::time::Instant::now();
+        let o = run(&["run", path.to_str().unwrap()]);
+        let took = started.elapsed().as_secs_f64();
+        let text = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{text}");
+        assert!(
+            text.contains(cells) && text.contains("--shard I/"),
+            "{text}"
+        );
+        // (A hang guard: 40 s and more before; about 0.3 s now.)
+        assert!(took < 15.0, "{took} s: {text}");
+    }
+}
+
+/// Issue 22, adversary pass of 2026-11-27: a start at rest on a body whose V is flat (a
+/// sphere given as a profile, centred on its centre of mass: U ≡ 1) had its energy V(θ0) one
+/// rounding below V's lowest critical level, and `cell --theta0` refused it as "no motion"
+/// (exit 2) for θ0 = 0.8 … 1.7, while `trajectory` followed it.
+#[test]
+fn a_start_at_rest_on_a_flat_potential_is_a_motion() {
+    let dir = tempfile::tempdir().unwrap();
+    let table = dir.path().join("ball.txt");
+    std::fs::write(&table, "0 -1\n1 0\n0 1\n").unwrap();
+    for kappa in ["0", "1e-3"] {
+        for theta0 in [
+            "0.8",
+            "1.4",
+            "1.5",
+            "1.5707963267948966",
+            "1.6",
+            "1.7",
+            "2.2",
+        ] {
+            let o = run(&[
+                "cell",
+                "--shape",
+                "profile",
+                "--profile",
+                table.to_str().unwrap(),
+                "--alpha",
+                "0",
+                "--nu",
+                "0.7",
+                "--eta",
+                "1.3",
+                "--kappa",
+                kappa,
+                "--theta0",
+                theta0,
+                "--json",
+            ]);
+            let text = String::from_utf8_lossy(&o.stderr);
+            assert!(o.status.success(), "κ {kappa}, θ0 {theta0}: {text}");
+            let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+            assert_eq!(v["components"].as_array().unwrap().len(), 1);
+            assert!(
+                v["components"][0]["rotation_number"]
+                    .as_f64()
+                    .unwrap()
+                    .abs()
+                    < 1e-12
+            );
+        }
+    }
+}
+
+/// Issue 22, adversary pass of 2026-11-27: Ctrl-C during `verdict` at resolution 4096 took
+/// 0.35–1.6 s (growing with the time into the run): the lines still queued set up V's
+/// critical points and energies before leaving, and the brackets of the coarse search ran
+/// over the lines sampled so far. Now 15–65 ms measured.
+#[test]
+fn a_verdict_at_the_highest_resolution_stops_at_once() {
+    use std::process::Stdio;
+    for args in [
+        &[
+            "verdict", "--alpha", "0.5", "--beta", "3", "--nu", "0.5", "--eta", "0.5",
+        ][..],
+        &[
+            "verdict", "--shape", "disk", "--alpha", "0.3", "--nu", "2", "--eta", "4",
+        ],
+    ] {
+        let child = Command::new(env!("CARGO_BIN_EXE_rubber-atlas"))
+            .args(args)
+            .args(["--resolution", "4096"])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_secs(6));
+        let asked = std::time::Instant::now();
+        // SAFETY: a signal to our own child process.
+        unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+        let output = child.wait_with_output().unwrap();
+        let waited = asked.elapsed().as_secs_f64();
+        assert_eq!(output.status.code(), Some(130), "{args:?}");
+        // (1.2 s and more before, at 6 s into the run.)
+        assert!(waited < 0.6, "{args:?}: {waited} s");
     }
 }
