@@ -14,6 +14,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import math
+
 import mpmath
 
 DIGITS = 50
@@ -307,11 +309,11 @@ class Cell:
 class EdgedCell(Cell):
     """V of one (body, κ) of the disk, the truncated ball or the wheel (docs/bodies.md): on each
     part of the surface U = p|sinθ| + q cosθ + r (an edge: r = 0; the sphere: p = 0, r = 1),
-    |r|² = U² + U′², J = √((cos²θ + ν sin²θ)/η + U²). κ ≠ 0 only (no faces)."""
+    |r|² = U² + U′², J = √((cos²θ + ν sin²θ)/η + U²). At κ = 0 a component that reaches a
+    flat face (θ = 0 of the cut balls, θ = π of the wheel, both poles of the disk) is of kind
+    "reaches_face": the motion ends there (docs/bodies.md), with no T."""
 
     def __init__(self, kind, alpha, cut, nu, eta, kappa, digits: int = DIGITS):
-        if kappa == 0:
-            raise ValueError("EdgedCell: kappa = 0 (a motion may reach a face) is not covered")
         super().__init__(alpha, 1, nu, eta, kappa, digits)
         self.kind = kind
         with mpmath.workdps(digits):
@@ -338,7 +340,7 @@ class EdgedCell(Cell):
 
     def potential(self, p: Point):
         s, c = p.sin_cos()
-        return self.kappa**2 / (2 * s * s) + self._u(s, c)
+        return self._u(s, c) if self.kappa == 0 else self.kappa**2 / (2 * s * s) + self._u(s, c)
 
     def g(self, p: Point):
         s, c = p.sin_cos()
@@ -349,6 +351,22 @@ class EdgedCell(Cell):
 
     def integral_factor(self, s, c):
         return mpmath.sqrt((c * c + self.nu * s * s) / self.eta + self._u(s, c) ** 2)
+
+    def faces(self) -> tuple[bool, bool]:
+        """Whether the body has a flat face at θ = 0 and at θ = π."""
+        return {"disk": (True, True), "truncated_ball": (True, False), "wheel": (True, True)}[self.kind]
+
+    def _circle(self, e, crit) -> list[Component]:
+        faces = self.faces()
+        result = []
+        for comp in super()._circle(e, crit):
+            # On the lifted circle the poles are the multiples of π: 2πm (face 0), π + 2πm.
+            first = math.ceil(comp.theta_min / math.pi - 1e-15)
+            last = math.floor(comp.theta_max / math.pi + 1e-15)
+            if any(faces[k % 2] for k in range(first, last + 1)):
+                comp = Component(comp.theta_min, comp.theta_max, "reaches_face", math.nan, 0.0, math.nan, 0.0)
+            result.append(comp)
+        return result
 
     def kinks(self) -> list[Point]:
         if self.kind == "disk":
@@ -372,6 +390,8 @@ class ProfileCell(EdgedCell):
     U = ρ_c sinθ − (z_c − α) cosθ + r. κ ≠ 0 only."""
 
     def __init__(self, rows, alpha, nu, eta, kappa, digits: int = DIGITS):
+        if kappa == 0:
+            raise ValueError("ProfileCell: kappa = 0 (its faces depend on the table) is not covered")
         EdgedCell.__init__(self, "disk", alpha, None, nu, eta, kappa, digits)
         self.kind = "profile"
         with mpmath.workdps(digits):

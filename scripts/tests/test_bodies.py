@@ -372,3 +372,38 @@ def test_the_high_energy_limit_of_edged_bodies_against_50_digits(case, make_atla
         assert ref_err < 1e-20
         assert abs(n - float(ref)) <= err, (lam, n, err, float(ref))
         assert err <= 1e-12, (lam, err)
+
+
+# κ = 0 (the reference covers it since 2026-11-27): levels ε = U(θ) of bodies whose planar
+# motions cross a kink (the truncated ball's libration round θ = π reaching past θ_c = 1.159
+# onto the edge, θ = 1.1 and 1.05) or reach a face (every other component here).
+KAPPA_ZERO = [
+    ("truncated_ball", 0.2, 0.4, 0.7, 1.3, 2.5),
+    ("truncated_ball", 0.2, 0.4, 0.7, 1.3, 1.1),
+    ("truncated_ball", 0.2, 0.4, 0.7, 1.3, 1.05),
+    ("truncated_ball", -0.3, -0.5, 0.7, 1.3, 2.9),
+    ("wheel", 0.25, 0.7, 0.7, 1.3, 0.7),
+    ("disk", 0.3, None, 2.0, 4.0, 1.0),
+]
+
+
+@pytest.mark.parametrize("case", KAPPA_ZERO, ids=[f"{c[0]}-{c[1]}-{c[5]}" for c in KAPPA_ZERO])
+def test_planar_motions_of_edged_bodies_against_50_digit_values(case):
+    """At κ = 0 the same components as the reference, on the lifted circle: those that reach a
+    face `reaches_face` with no values, the others `ok` with T within its estimate and N = 0."""
+    shape, alpha, cut, nu, eta, theta = case
+    cell, energy = level(shape, alpha, cut, nu, eta, 0.0, theta)
+    reference = cell.components(energy)
+    assert reference
+    for tol in (1e-10, 1e-12):
+        comps = run_cell(shape, alpha, cut, nu, eta, 0.0, energy, tol)["components"]
+        assert len(comps) == len(reference), (comps, reference)
+        for got, ref in zip(comps, reference):
+            where = f"{case} tol {tol}: {got} vs {ref}"
+            assert abs(got["theta_min"] - ref.theta_min) < 1e-12 and abs(got["theta_max"] - ref.theta_max) < 1e-12, where
+            if ref.kind == "reaches_face":
+                assert got["status"] == "reaches_face" and got["period"] is None, where
+                continue
+            assert got["status"] == "ok" and got["rotation_number"] == 0.0, where
+            assert ref.period_error < 1e-25, ref
+            assert abs(got["period"] - ref.period) <= got["errors"]["period"] <= tol * ref.period, where
