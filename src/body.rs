@@ -242,6 +242,13 @@ pub trait Shape: Send + Sync {
         1.0
     }
 
+    /// A bound on |U″| over every θ (∞ where the shape does not give one). With it,
+    /// B = 1/η + U² + U′² dips where U′ crosses 0 on a scale no narrower than
+    /// √(1/η) / max|U″| ([`crate::torus`]'s cosine rule needs steps below it).
+    fn curvature_bound(&self) -> f64 {
+        f64::INFINITY
+    }
+
     /// A bound on the error of U as the body is held in doubles, beyond the rounding of its
     /// evaluation: 0 where the shape's parameters are its inputs; a profile's arcs, fitted
     /// through its points, carry the fit's rounding
@@ -257,6 +264,37 @@ pub trait Shape: Send + Sync {
     /// peak sharply ([`crate::torus::EffectivePotential::splits_inside`]). None where U > 0.
     fn potential_zeros(&self) -> Vec<f64> {
         Vec::new()
+    }
+
+    /// The θ in (0, π) where U′ = 0 (the poles aside): B = 1/η + U² + U′² is least there and
+    /// the integrands, ∝ √B, may dip sharply
+    /// ([`crate::torus::EffectivePotential::splits_inside`]). This default finds the sign
+    /// changes of U′ on 4096 steps; the closed forms override it.
+    fn slope_zeros(&self) -> Vec<f64> {
+        const STEPS: usize = 4096;
+        let at = |i: usize| std::f64::consts::PI * i as f64 / STEPS as f64;
+        let slope = |theta: f64| self.potential_prime_at(Angle::new(theta));
+        let mut zeros = Vec::new();
+        let mut previous = slope(at(1));
+        for i in 2..STEPS {
+            let next = slope(at(i));
+            if previous == 0.0 {
+                zeros.push(at(i - 1));
+            } else if previous * next < 0.0 {
+                let (mut lo, mut hi) = (at(i - 1), at(i));
+                for _ in 0..60 {
+                    let mid = 0.5 * (lo + hi);
+                    if (slope(mid) > 0.0) == (previous > 0.0) {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                zeros.push(0.5 * (lo + hi));
+            }
+            previous = next;
+        }
+        zeros
     }
 
     /// U and |r|² together (shapes override this to share work between the two).
@@ -462,6 +500,35 @@ impl Shape for Ellipsoid {
     /// poles of an oblate one.
     fn angular_feature_scale(&self) -> f64 {
         self.beta.min(1.0 / self.beta)
+    }
+
+    /// U′ = sinθ ((β² − 1) cosθ / Z − α) = 0 off the poles where (β² − 1) cosθ = α Z:
+    /// cos²θ = α²β² / ((β² − 1)(β² − 1 + α²)), cosθ of the sign of α (β² − 1).
+    fn slope_zeros(&self) -> Vec<f64> {
+        let b = self.beta * self.beta - 1.0;
+        if self.alpha == 0.0 || b == 0.0 {
+            return Vec::new();
+        }
+        let c2 =
+            self.alpha * self.alpha * self.beta * self.beta / (b * (b + self.alpha * self.alpha));
+        if !(0.0..1.0).contains(&c2) {
+            return Vec::new();
+        }
+        let c = c2.sqrt() * (self.alpha * b).signum();
+        vec![c.acos()]
+    }
+
+    /// |U″| ≤ max|Z″| + |α|, with max|Z″| = (1 − β²)/β at the equator of a prolate
+    /// ellipsoid and β² − 1 at the poles of an oblate one (checked on a fine grid for β from
+    /// 1e-3 to 1e3); a part in 1e9 over for rounding.
+    fn curvature_bound(&self) -> f64 {
+        let b2 = self.beta * self.beta;
+        let z = if self.beta < 1.0 {
+            (1.0 - b2) / self.beta
+        } else {
+            b2 - 1.0
+        };
+        (z + self.alpha.abs()) * (1.0 + 1e-9)
     }
 
     /// U′/sinθ = (β² − 1) cosθ / Z − α; where its two terms cancel ([`Ellipsoid::cancels`]),

@@ -1292,10 +1292,24 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
     /// the kinks of U (its pieces are analytic), and the zero θ_U of U
     /// ([`Shape::potential_zeros`]) where the peak of 1/J there is narrow: its width, the
     /// distance of J's complex zeros from the real axis, √((cos²θ_U + ν sin²θ_U)/η)/|U′(θ_U)|,
-    /// below [`SHARP_PEAK`]. A rule's level differences cannot see a peak far narrower than
-    /// its steps: a disk with α = −72.7, η = 217 (width 5e-4) had N off by 4× its estimate.
+    /// below [`SHARP_PEAK`]; likewise a zero of U′ ([`Shape::slope_zeros`]) where the dip of
+    /// B = 1/η + U² + U′² there, √(1/η + U²)/|U″| wide, is narrower. A rule's level
+    /// differences cannot see a peak far narrower than its steps: a disk with α = −72.7,
+    /// η = 217 (width 5e-4) had N off by 4× its estimate.
     pub fn splits_inside(&self, lower: f64, upper: f64) -> Vec<Site> {
         let mut splits = self.body.shape.kinks().to_vec();
+        // A narrow dip of B = 1/η + U² + U′² where U′ crosses 0, √(1/η + U²)/|U″| wide: at a
+        // large η against a sharp curvature (a prolate ellipsoid at η = 394, 0.005 wide) the
+        // rules' level differences stepped over it (T 10× its estimate off at tol 1e-3).
+        let dip = (1.0 / self.body.eta).sqrt() / self.body.shape.curvature_bound();
+        if dip < SHARP_PEAK {
+            splits.extend(self.body.shape.slope_zeros().into_iter().filter(|&zero| {
+                let a = Angle::new(zero);
+                let u = self.body.shape.potential_at(a);
+                (1.0 / self.body.eta + u * u).sqrt()
+                    < SHARP_PEAK * self.body.shape.potential_second_at(a).abs()
+            }));
+        }
         splits.extend(
             self.body
                 .shape

@@ -256,6 +256,17 @@ impl EdgedShape {
         })
     }
 
+    /// The edges' (p, q) of U = p sinθ + q cosθ: the disk's rim, the cut balls' edges.
+    fn edges(&self) -> Vec<(f64, f64)> {
+        let (h, rho, alpha) = (self.cut, self.rho, self.alpha);
+        match self.kind {
+            EdgedKind::Disk => vec![(1.0, alpha)],
+            EdgedKind::TruncatedBall => vec![(rho, h + alpha)],
+            EdgedKind::Wheel => vec![(rho, h + alpha), (rho, alpha - h)],
+            EdgedKind::Profile(_) => vec![],
+        }
+    }
+
     /// The radius of the edge circle, ρ = √(1 − h²) (1 for the disk).
     pub fn edge_radius(&self) -> f64 {
         self.rho
@@ -276,17 +287,22 @@ impl Shape for EdgedShape {
     /// (q, p): at θ = atan2(|q|, −p sgn q) in (0, π), for q ≠ 0, where that part is the one
     /// in contact. The sphere's 1 + α cos θ is positive.
     fn potential_zeros(&self) -> Vec<f64> {
-        let (h, rho, alpha) = (self.cut, self.rho, self.alpha);
-        let edges = match self.kind {
-            EdgedKind::Disk => vec![(1.0, alpha)],
-            EdgedKind::TruncatedBall => vec![(rho, h + alpha)],
-            EdgedKind::Wheel => vec![(rho, h + alpha), (rho, alpha - h)],
-            EdgedKind::Profile(_) => vec![],
-        };
-        edges
+        self.edges()
             .into_iter()
             .filter(|&(_, q)| q != 0.0)
             .map(|(p, q)| (p, q, q.abs().atan2(-p * q.signum())))
+            .filter(|&(p, q, theta)| self.part(Angle::new(theta)) == Part { p, q, r: 0.0 })
+            .map(|(_, _, theta)| theta)
+            .collect()
+    }
+
+    /// On an edge U′ = p cosθ − q sinθ vanishes at θ = atan2(p, q), where that lies on the
+    /// edge; on the sphere (p = 0) only at the poles (or everywhere where α = 0: B is then
+    /// constant there).
+    fn slope_zeros(&self) -> Vec<f64> {
+        self.edges()
+            .into_iter()
+            .map(|(p, q)| (p, q, p.atan2(q)))
             .filter(|&(p, q, theta)| self.part(Angle::new(theta)) == Part { p, q, r: 0.0 })
             .map(|(_, _, theta)| theta)
             .collect()
@@ -426,5 +442,17 @@ impl Shape for EdgedShape {
     /// The edge parts are arcs of sinusoids: no scale below 1 (the kinks are split at).
     fn angular_feature_scale(&self) -> f64 {
         1.0
+    }
+
+    /// On a part U = p sinθ + q cosθ + r, |U″| = |p sinθ + q cosθ| ≤ √(p² + q²).
+    fn curvature_bound(&self) -> f64 {
+        let (h, rho, alpha) = (self.cut, self.rho, self.alpha);
+        let parts: &[(f64, f64)] = match self.kind {
+            EdgedKind::Disk => &[(1.0, alpha)],
+            EdgedKind::TruncatedBall => &[(rho, h + alpha), (0.0, alpha)],
+            EdgedKind::Wheel => &[(rho, h + alpha), (rho, alpha - h), (0.0, alpha)],
+            EdgedKind::Profile(_) => return f64::INFINITY,
+        };
+        parts.iter().map(|&(p, q)| p.hypot(q)).fold(0.0, f64::max) * (1.0 + 1e-9)
     }
 }

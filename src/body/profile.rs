@@ -849,4 +849,45 @@ impl Shape for ProfileShape {
     fn angular_feature_scale(&self) -> f64 {
         1.0
     }
+
+    /// On an arc U′ = ρ_a cosθ + (z_a − α) sinθ + r sin(θ − θ_a) = P cosθ + Q sinθ with
+    /// P = ρ_a − r sin θ_a and Q = z_a − α + r cos θ_a: zero at θ = atan2(P, −Q) (mod π)
+    /// where that lies on the arc.
+    fn slope_zeros(&self) -> Vec<f64> {
+        let mut zeros = Vec::new();
+        for arc in self.profile.arcs() {
+            let (sa, ca) = arc.anchor_theta.sin_cos();
+            let p = arc.anchor_rho - arc.radius * sa;
+            let q = arc.anchor_z - self.alpha + arc.radius * ca;
+            if p == 0.0 && q == 0.0 {
+                continue;
+            }
+            let root = p.atan2(-q);
+            for theta in [
+                root,
+                root + std::f64::consts::PI,
+                root - std::f64::consts::PI,
+            ] {
+                if theta > 0.0
+                    && theta < std::f64::consts::PI
+                    && theta >= arc.theta_start
+                    && theta <= arc.theta_end
+                {
+                    zeros.push(theta);
+                }
+            }
+        }
+        zeros
+    }
+
+    /// On an arc U″ = −ρ_a sinθ + (z_a − α) cosθ + r cos(θ − θ_a), so |U″| ≤
+    /// √(ρ_a² + (z_a − α)²) + r.
+    fn curvature_bound(&self) -> f64 {
+        self.profile
+            .arcs()
+            .iter()
+            .map(|arc| arc.anchor_rho.hypot(arc.anchor_z - self.alpha) + arc.radius)
+            .fold(0.0, f64::max)
+            * (1.0 + 1e-9)
+    }
 }

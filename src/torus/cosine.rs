@@ -30,6 +30,35 @@ fn first_intervals(tol: f64) -> usize {
         32
     }
 }
+/// The fewest φ-steps whose level differences are trusted on a body with a narrow feature
+/// of width w ([`Shape::angular_feature_scale`]: a prolate ellipsoid's Z round θ = π/2, an
+/// oblate one's at the poles; or B's dip where U′ crosses 0 at a large η): 4 L/w. The feature is a singularity about w off the real
+/// θ-axis, at least 2w/L off the real φ-axis, and the trapezoid sums on fewer steps can step
+/// over it and agree among themselves: at β = 0.0075, η = 0.098 (L = 1.5) the levels of 32,
+/// 64 and 128 steps put N's error at 8e-10 where it was 4.8e-7 (adversary pass of
+/// 2026-11-27). With 4 L/w steps even the coarsest level compared (a quarter of them) sees
+/// the feature, whose share of the error then falls by e^{−4} a level. Beyond
+/// [`LAST_INTERVALS`] the general rule takes the libration, cut at its minima there
+/// (`EffectivePotential::pieces`).
+fn least_intervals<S: Shape>(v: &EffectivePotential<'_, S>, piece: &Piece) -> usize {
+    let shape = &v.body.shape;
+    // B = 1/η + U² + U′² dips where U′ crosses 0, on a scale of at least √(1/η)/max|U″|:
+    // counted where that is narrow (below 0.1; wider dips the rule has always resolved:
+    // the paper's body has 0.17).
+    let dip = (1.0 / v.body.eta).sqrt() / shape.curvature_bound();
+    let scale = if dip < 0.1 {
+        shape.angular_feature_scale().min(dip)
+    } else {
+        shape.angular_feature_scale()
+    };
+    let least = 4.0 * piece.length / scale;
+    if least > LAST_INTERVALS as f64 {
+        usize::MAX
+    } else {
+        least.ceil() as usize
+    }
+}
+
 /// φ-steps on [0, π] beyond which the tanh-sinh rule is cheaper.
 const LAST_INTERVALS: usize = 256;
 const _: () = assert!(LAST_INTERVALS <= FINEST_COSINE_INTERVALS);
@@ -69,6 +98,10 @@ fn integrate_on<S: Shape>(
     tol: f64,
     with_drift: bool,
 ) -> Result<std::result::Result<PeriodIntegrals, usize>> {
+    let least = least_intervals(v, piece);
+    if least > LAST_INTERVALS {
+        return Ok(Err(0));
+    }
     let Some(mut samples) = Samples::new(v, piece, map, energy, first_intervals(tol)) else {
         // (A node of the first level outside the allowed set: at most that level spent.)
         return Ok(Err(first_intervals(tol) + 1));
@@ -96,7 +129,8 @@ fn integrate_on<S: Shape>(
         // left for refinement to gain: where that floor with the rounding misses the
         // tolerance (tol ≲ 1e-14), refining on to LAST_INTERVALS steps and then by the
         // tanh-sinh rule only bought the same estimate at 2–4 times the nodes.
-        let mut done = (t_error <= budget(tol * period, extra_t) || at_level_floor(t_sums, rate))
+        let mut done = samples.intervals >= least
+            && (t_error <= budget(tol * period, extra_t) || at_level_floor(t_sums, rate))
             && (psi_error <= budget(tol * TAU, extra_psi) || at_level_floor(psi_sums, rate));
         let period_error = t_error + extra_t;
         let psi_advance_error = psi_error + extra_psi;

@@ -718,3 +718,108 @@ fn sums_settled_to_their_floor_are_not_refined_for_a_tolerance_they_cannot_meet(
         "{work_14} nodes at 1e-14 against {work_13} at 1e-13"
     );
 }
+
+/// Issue 22, adversary pass of 2026-11-27: on prolate ellipsoids (β ≲ 0.1) the cosine rule's
+/// sums stepped over the body's narrow features and agreed among themselves, and values at
+/// status `ok` were off by up to 600 times their estimates (N 4.8e-7 against 8e-10 at β =
+/// 0.0075; the drift 29× at tol 1e-6, beyond the tolerance itself). Two features: Z's
+/// singularity β off the real axis round θ = π/2, and, at a large η, the dip of
+/// B = 1/η + U² + U′² where U′ crosses 0 (√(1/η + U²)/|U″| wide: 4e-4 at η = 632). The rule
+/// now takes at least 4 L/w steps (w the narrower), the general rule past 256, cut at such a
+/// dip. Each cell at a loose tolerance against the same cell at tol 1e-13 (the ODE method
+/// agreed with those within 3e-11): every `ok` value within the two estimates.
+#[test]
+fn narrow_features_of_prolate_bodies_are_not_stepped_over() {
+    // (α, β, ν, η, κ, ε (or None: the excess above the bottom next), excess, tol)
+    type Case = (f64, f64, f64, f64, f64, Option<f64>, f64, f64);
+    let cells: [Case; 6] = [
+        (
+            0.689851640257678,
+            0.007525424896293372,
+            0.26951797140721195,
+            0.09806078339997733,
+            0.28520289837754315,
+            Some(3.8800358826261196),
+            0.0,
+            1e-3,
+        ),
+        (
+            -0.06532678427642236,
+            0.0088822977933677,
+            0.5482669347059508,
+            0.002897600579576175,
+            0.41229477495001904,
+            Some(2.076016485493007),
+            0.0,
+            1e-6,
+        ),
+        (
+            -0.7521193580843493,
+            0.02212489348770404,
+            1.2064003574493536,
+            0.0102702403459689,
+            1.6052847765084193,
+            Some(7.107681681559434),
+            0.0,
+            1e-4,
+        ),
+        (
+            0.10171270996507364,
+            0.08083367130918145,
+            0.19119758428528347,
+            0.013701592274160066,
+            0.39170899171742674,
+            Some(0.5170184859175496),
+            0.0,
+            1e-4,
+        ),
+        (
+            -0.2811767842460152,
+            0.007786616202546827,
+            0.9768133641838146,
+            632.087069856436,
+            0.23854505709608262,
+            Some(0.03780731311708212),
+            0.0,
+            1e-3,
+        ),
+        (
+            0.4874867458616683,
+            0.10420220539101385,
+            1.3762311605970723,
+            393.89996895339783,
+            0.07359587397033265,
+            None,
+            0.9418142118818049,
+            1e-3,
+        ),
+    ];
+    for (alpha, beta, nu, eta, kappa, energy, excess, tol) in cells {
+        let b = EllipsoidBody::ellipsoid(alpha, beta, nu, eta).unwrap();
+        let energy = energy.unwrap_or_else(|| {
+            EffectivePotential::new(&b, kappa).lowest_minimum().unwrap() + excess
+        });
+        let loose = solve(&b, kappa, energy, Method::Quadrature, tol);
+        let tight = solve(&b, kappa, energy, Method::Quadrature, 1e-13);
+        assert_eq!(loose.components.len(), tight.components.len());
+        for (l, t) in loose.components.iter().zip(&tight.components) {
+            if l.status != Status::Ok {
+                continue;
+            }
+            let at = format!("β {beta}, η {eta}, κ {kappa}, ε {energy}, tol {tol}");
+            for (name, x, e, y, f) in [
+                ("T", l.period, l.errors.period, t.period, t.errors.period),
+                (
+                    "N",
+                    l.rotation_number,
+                    l.error_estimate,
+                    t.rotation_number,
+                    t.error_estimate,
+                ),
+                ("|Δζ|", l.drift, l.errors.drift, t.drift, t.errors.drift),
+            ] {
+                assert!((x - y).abs() <= e + f, "{at}: {name} {x} ± {e} against {y}");
+            }
+        }
+    }
+}
