@@ -91,21 +91,32 @@ fn main() -> ExitCode {
                 // EX_TEMPFAIL: try again once the other process is done.
                 return ExitCode::from(75);
             }
-            let bad_input = e.chain().any(|c| {
-                matches!(
-                    c.downcast_ref::<rubber_atlas::AtlasError>(),
-                    Some(
-                        rubber_atlas::AtlasError::InvalidParameter { .. }
-                            | rubber_atlas::AtlasError::InvalidInitialAngle { .. }
-                            | rubber_atlas::AtlasError::NoMotion { .. }
-                            | rubber_atlas::AtlasError::NotPeriodic { .. }
-                            | rubber_atlas::AtlasError::Output { .. }
-                            | rubber_atlas::AtlasError::Scene { .. }
-                            | rubber_atlas::AtlasError::Atlas { .. }
-                            | rubber_atlas::AtlasError::Unsupported { .. }
+            // A full disk (a quota, a file-size limit) is no bad input, whatever the error's
+            // kind (a run into a full disk exited 2: adversary pass of 2026-11-27).
+            let text = format!("{e:#}");
+            let out_of_space = [
+                "No space left on device",
+                "Disk quota exceeded",
+                "File too large",
+            ]
+            .iter()
+            .any(|m| text.contains(m));
+            let bad_input = !out_of_space
+                && e.chain().any(|c| {
+                    matches!(
+                        c.downcast_ref::<rubber_atlas::AtlasError>(),
+                        Some(
+                            rubber_atlas::AtlasError::InvalidParameter { .. }
+                                | rubber_atlas::AtlasError::InvalidInitialAngle { .. }
+                                | rubber_atlas::AtlasError::NoMotion { .. }
+                                | rubber_atlas::AtlasError::NotPeriodic { .. }
+                                | rubber_atlas::AtlasError::Output { .. }
+                                | rubber_atlas::AtlasError::Scene { .. }
+                                | rubber_atlas::AtlasError::Atlas { .. }
+                                | rubber_atlas::AtlasError::Unsupported { .. }
+                        )
                     )
-                )
-            });
+                });
             ExitCode::from(if bad_input { 2 } else { 1 })
         }
     }

@@ -437,7 +437,13 @@ pub fn read_small_text(path: &Path, what: &str) -> std::result::Result<String, S
             meta.len()
         ));
     }
-    std::fs::read_to_string(path).map_err(|e| e.to_string())
+    // (A byte-order mark, as some Windows editors write, is no part of the text: a profile
+    // table's first row was refused as "\u{feff}0 -1".)
+    let text = std::fs::read_to_string(path).map_err(|e| e.to_string())?;
+    Ok(match text.strip_prefix('\u{feff}') {
+        Some(rest) => rest.to_string(),
+        None => text,
+    })
 }
 
 impl Scene {

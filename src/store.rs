@@ -75,6 +75,15 @@ pub fn check_output(path: &Path, force: bool, inputs: &[&Path], extensions: &[&s
                 .join(", ")
         ));
     }
+    // (A finished atlas by that name was refused by open_atlas as an unfinished run's file:
+    // adversary pass of 2026-11-27.)
+    if text.to_lowercase().ends_with(".partial.h5") {
+        return refuse(
+            "ends in .partial.h5, the name of a run's unfinished file (open_atlas refuses such \
+             a file): choose another name"
+                .into(),
+        );
+    }
     if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
         if !parent.is_dir() {
             return refuse(format!("the folder {} does not exist", parent.display()));

@@ -406,11 +406,19 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
             Journal::create(&journal_dir, fingerprint, &scene.text)?
         } else if request.resume || request.update {
             matching()?
-        } else {
+        } else if matching().is_ok() {
             return Err(AtlasError::atlas(
                 &journal_dir,
                 "an interrupted run of this output left its journal here; \
                  use --resume to continue it or --force to start over",
+            ));
+        } else {
+            // (Suggesting --resume here only led to its refusal: adversary pass of 2026-11-27.)
+            return Err(AtlasError::atlas(
+                &journal_dir,
+                "an interrupted run of this output, of another scene or program version, left \
+                 its journal here; use --update to compute this scene afresh or --force to \
+                 start over",
             ));
         }
     } else {

@@ -527,9 +527,16 @@ impl AtlasFile {
                 )
             });
             if status < 0 {
+                // (HDF5's file driver leaves the system's errno of the failed write: a full
+                // disk said only "H5Dwrite_chunk failed".)
+                let system = std::io::Error::last_os_error();
+                let reason = match system.raw_os_error() {
+                    Some(code) if code != 0 => format!(": {system}"),
+                    _ => String::new(),
+                };
                 return Err(AtlasError::atlas(
                     &self.path,
-                    format!("H5Dwrite_chunk failed for {}", v.name),
+                    format!("writing {} failed{reason}", v.name),
                 ));
             }
         }

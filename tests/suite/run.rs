@@ -389,6 +389,33 @@ fn a_run_killed_at_any_point_resumes_to_the_same_arrays() {
     let again = run(&["run", s, "--out", out.to_str().unwrap()]);
     assert_eq!(again.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&again.stderr).contains("--resume"));
+    // The scene edited since: --resume would be refused, so it is not suggested (it was:
+    // adversary pass of 2026-11-27); --update computes the new scene.
+    let text = std::fs::read_to_string(&scene).unwrap();
+    std::fs::write(&scene, format!("{text}\n# edited\n")).unwrap();
+    let again = run(&["run", s, "--out", out.to_str().unwrap()]);
+    let message = String::from_utf8_lossy(&again.stderr);
+    assert_eq!(again.status.code(), Some(2), "{message}");
+    assert!(
+        message.contains("of another scene or program version")
+            && message.contains("--update")
+            && !message.contains("--resume"),
+        "{message}"
+    );
+    ok(&run(&[
+        "run",
+        s,
+        "--out",
+        out.to_str().unwrap(),
+        "--update",
+    ]));
+    // An output named as a run's unfinished file is refused (open_atlas would refuse the
+    // finished atlas by its name).
+    let partial = dir.path().join("q.h5.partial.h5");
+    let refused = run(&["run", s, "--out", partial.to_str().unwrap()]);
+    assert_eq!(refused.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("ends in .partial.h5"));
+    assert!(!partial.exists());
 }
 
 #[test]
@@ -1402,4 +1429,58 @@ fn run_interrupted(scene: &Path, out: &Path, after: Duration) -> (Output, Durati
     unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
     let output = child.wait_with_output().unwrap();
     (output, sent.elapsed())
+}
+
+/// Output that does not fit is no bad input: a run, a trajectory and a diagram whose files
+/// hit a limit on the way (here a file-size limit, `ulimit -f`, as a full disk would) exit 1
+/// with the system's reason in one line; before, a full disk was exit 2, and the atlas's own
+/// write said only "H5Dwrite_chunk failed for omega_psi" (adversary pass of 2026-11-27).
+#[test]
+fn output_that_does_not_fit_is_exit_1_with_the_systems_reason() {
+    use std::os::unix::process::CommandExt;
+    let dir = tempfile::tempdir().unwrap();
+    let scene = small_scene(dir.path());
+    let limited = |args: &[&str], bytes: u64| {
+        let mut command = Command::new(BIN);
+        command.args(args);
+        // SAFETY: only async-signal-safe calls between fork and exec.
+        unsafe {
+            command.pre_exec(move || {
+                libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+                let limit = libc::rlimit {
+                    rlim_cur: bytes,
+                    rlim_max: bytes,
+                };
+                libc::setrlimit(libc::RLIMIT_FSIZE, &limit);
+                Ok(())
+            });
+        }
+        command.output().unwrap()
+    };
+    let atlas = dir.path().join("a.h5");
+    let table = dir.path().join("t.csv");
+    let (atlas, table) = (atlas.to_str().unwrap(), table.to_str().unwrap());
+    let demo = concat!(env!("CARGO_MANIFEST_DIR"), "/atlas/demo.toml");
+    let body = "--alpha 0.5 --beta 3 --nu 0.5 --eta 0.5";
+    let cases = [
+        // A journal unit does not fit.
+        (format!("run {} --out {atlas} --quiet", scene.display()), 20_000),
+        // The units fit (13 MB in all, each below 4 MB) and the atlas does not: HDF5's write.
+        (format!("run {demo} --out {atlas} --quiet --force"), 4_000_000),
+        (
+            format!("trajectory {body} --kappa 0.8 --energy 2.5 --periods 3 --samples 100000 --out {table}"),
+            20_000,
+        ),
+        (format!("diagram {body} --samples 100000 --out {table}"), 20_000),
+    ];
+    for (line, bytes) in cases {
+        let args: Vec<&str> = line.split_whitespace().collect();
+        let o = limited(&args, bytes);
+        let text = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {text}");
+        assert!(
+            text.contains("File too large") && text.lines().count() == 1,
+            "{args:?}: {text}"
+        );
+    }
 }
