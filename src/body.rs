@@ -242,13 +242,6 @@ pub trait Shape: Send + Sync {
         1.0
     }
 
-    /// A bound on |U″| over every θ (∞ where the shape does not give one). With it,
-    /// B = 1/η + U² + U′² dips where U′ crosses 0 on a scale no narrower than
-    /// √(1/η) / max|U″| ([`crate::torus`]'s cosine rule needs steps below it).
-    fn curvature_bound(&self) -> f64 {
-        f64::INFINITY
-    }
-
     /// A bound on the error of U as the body is held in doubles, beyond the rounding of its
     /// evaluation: 0 where the shape's parameters are its inputs; a profile's arcs, fitted
     /// through its points, carry the fit's rounding
@@ -293,6 +286,9 @@ pub trait Shape: Send + Sync {
                 zeros.push(0.5 * (lo + hi));
             }
             previous = next;
+        }
+        if previous == 0.0 {
+            zeros.push(at(STEPS - 1));
         }
         zeros
     }
@@ -503,10 +499,12 @@ impl Shape for Ellipsoid {
     }
 
     /// U′ = sinθ ((β² − 1) cosθ / Z − α) = 0 off the poles where (β² − 1) cosθ = α Z:
-    /// cos²θ = α²β² / ((β² − 1)(β² − 1 + α²)), cosθ of the sign of α (β² − 1).
+    /// cos²θ = α²β² / ((β² − 1)(β² − 1 + α²)), cosθ of the sign of α (β² − 1) (π/2 at
+    /// α = 0).
     fn slope_zeros(&self) -> Vec<f64> {
         let b = self.beta * self.beta - 1.0;
-        if self.alpha == 0.0 || b == 0.0 {
+        if b == 0.0 {
+            // (The sphere: U′ = −α sinθ, zero only at the poles, or everywhere at α = 0.)
             return Vec::new();
         }
         let c2 =
@@ -516,19 +514,6 @@ impl Shape for Ellipsoid {
         }
         let c = c2.sqrt() * (self.alpha * b).signum();
         vec![c.acos()]
-    }
-
-    /// |U″| ≤ max|Z″| + |α|, with max|Z″| = (1 − β²)/β at the equator of a prolate
-    /// ellipsoid and β² − 1 at the poles of an oblate one (checked on a fine grid for β from
-    /// 1e-3 to 1e3); a part in 1e9 over for rounding.
-    fn curvature_bound(&self) -> f64 {
-        let b2 = self.beta * self.beta;
-        let z = if self.beta < 1.0 {
-            (1.0 - b2) / self.beta
-        } else {
-            b2 - 1.0
-        };
-        (z + self.alpha.abs()) * (1.0 + 1e-9)
     }
 
     /// U′/sinθ = (β² − 1) cosθ / Z − α; where its two terms cancel ([`Ellipsoid::cancels`]),

@@ -243,13 +243,16 @@ pub fn footprint(scene: &Scene, shard: Shard, threads: usize) -> Footprint {
         .sum::<usize>() as f64;
     // The cells themselves, not the units' (a unit at the end of a slice, or a group of β
     // at its end, is short): a grid of 1e4 α × 1e4 β and one cell each was 1.229e8 cells.
+    // The disk and the memory stay those of whole units (HDF5 stores a short chunk whole):
+    // bounds for the largest shard.
     let cells = na * nb * nk * ne * share / total;
-    let batch = (share.min(per_slice) * unit_cells).max((BATCH_CELLS as f64).min(cells));
+    let unit_bound = share * unit_cells;
+    let batch = (share.min(per_slice) * unit_cells).max((BATCH_CELLS as f64).min(unit_bound));
     // A BTreeSet<usize> of the journal's units: about 3 words an entry.
     let journal_list = share * 24.0;
     Footprint {
         cells,
-        disk_bytes: 2.0 * cells * bytes_per_cell,
+        disk_bytes: 2.0 * unit_bound * bytes_per_cell,
         memory_bytes: journal_list + (2.0 * batch + threads as f64 * unit_cells) * bytes_per_cell,
     }
 }
@@ -413,13 +416,19 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
                  use --resume to continue it or --force to start over",
             ));
         } else {
-            // (Suggesting --resume here only led to its refusal: adversary pass of 2026-11-27.)
-            return Err(AtlasError::atlas(
-                &journal_dir,
-                "an interrupted run of this output, of another scene or program version, left \
-                 its journal here; use --update to compute this scene afresh or --force to \
-                 start over",
-            ));
+            // (Suggesting --resume here only led to its refusal: adversary pass of 2026-11-27;
+            // --update too refuses another scene's journal, above.)
+            let reason = match Journal::scene_name_in(&journal_dir) {
+                Some(name) if name != scene.name => format!(
+                    "an interrupted run of another scene ({name:?}) left its journal here; \
+                     resume that run with its own scene, or use --force to start over"
+                ),
+                _ => "an interrupted run of this output, of another version of this scene or \
+                      of the program, left its journal here; use --update to compute this \
+                      scene afresh or --force to start over"
+                    .to_string(),
+            };
+            return Err(AtlasError::atlas(&journal_dir, reason));
         }
     } else {
         Journal::create(&journal_dir, fingerprint, &scene.text)?

@@ -227,6 +227,9 @@ pub struct EffectivePotential<'a, S: Shape> {
     /// κ.
     pub kappa: f64,
     critical: Vec<CriticalPoint>,
+    /// The dips of B = 1/η + U² + U′² ([`EffectivePotential::dip_width`]): (θ, width) at
+    /// each zero of U′ in (0, π) where B has a minimum.
+    dips: Vec<(f64, f64)>,
 }
 
 /// Number of scan cells for critical points; between scan nodes the pole-free function
@@ -241,9 +244,51 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             body,
             kappa,
             critical: Vec::new(),
+            dips: Vec::new(),
         };
         v.critical = v.find_critical_points();
+        v.dips = body
+            .shape
+            .slope_zeros()
+            .into_iter()
+            .map(|zero| (zero, v.dip_width(zero)))
+            .filter(|(_, width)| width.is_finite())
+            .collect();
         v
+    }
+
+    /// The width of the dip of B = 1/η + U² + U′² at a zero z of U′ in (0, π): with x = θ − z,
+    /// B ≈ 1/η + U² + U″(U″ + U) x², which vanishes at x = ±i √((1/η + U²)/(U″(U″ + U))):
+    /// the integrands (∝ √B) are analytic only that far off the real axis. ∞ where
+    /// U″(U″ + U) ≤ 0 (a maximum of B; on an edge U + U″ = 0 and B is constant).
+    fn dip_width(&self, zero: f64) -> f64 {
+        let a = Angle::new(zero);
+        let shape = &self.body.shape;
+        let u = shape.potential_at(a);
+        let second = shape.potential_second_at(a);
+        let curvature = second * (second + u);
+        if curvature > 0.0 {
+            ((1.0 / self.body.eta + u * u) / curvature).sqrt()
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// The narrowest dip of B as the θ-interval [`lower`, `upper`] sees it: its width where it
+    /// lies inside, else hypot(its distance outside, its width) (on the κ = 0 circle each
+    /// dip's images ±θ + 2πm too). ∞ without dips.
+    pub(crate) fn dip_scale(&self, lower: f64, upper: f64) -> f64 {
+        self.dips
+            .iter()
+            .flat_map(|&(zero, width)| {
+                lifted_inside(&[zero], lower - PI, upper + PI)
+                    .into_iter()
+                    .map(move |site| {
+                        let outside = (lower - site.theta).max(site.theta - upper).max(0.0);
+                        outside.hypot(width)
+                    })
+            })
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// The critical points, sorted by θ.
@@ -1293,23 +1338,20 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
     /// ([`Shape::potential_zeros`]) where the peak of 1/J there is narrow: its width, the
     /// distance of J's complex zeros from the real axis, √((cos²θ_U + ν sin²θ_U)/η)/|U′(θ_U)|,
     /// below [`SHARP_PEAK`]; likewise a zero of U′ ([`Shape::slope_zeros`]) where the dip of
-    /// B = 1/η + U² + U′² there, √(1/η + U²)/|U″| wide, is narrower. A rule's level
+    /// B = 1/η + U² + U′² there ([`Self::dip_width`]) is narrower. A rule's level
     /// differences cannot see a peak far narrower than its steps: a disk with α = −72.7,
     /// η = 217 (width 5e-4) had N off by 4× its estimate.
     pub fn splits_inside(&self, lower: f64, upper: f64) -> Vec<Site> {
         let mut splits = self.body.shape.kinks().to_vec();
-        // A narrow dip of B = 1/η + U² + U′² where U′ crosses 0, √(1/η + U²)/|U″| wide: at a
+        // A narrow dip of B = 1/η + U² + U′² where U′ crosses 0 ([`Self::dip_width`]): at a
         // large η against a sharp curvature (a prolate ellipsoid at η = 394, 0.005 wide) the
         // rules' level differences stepped over it (T 10× its estimate off at tol 1e-3).
-        let dip = (1.0 / self.body.eta).sqrt() / self.body.shape.curvature_bound();
-        if dip < SHARP_PEAK {
-            splits.extend(self.body.shape.slope_zeros().into_iter().filter(|&zero| {
-                let a = Angle::new(zero);
-                let u = self.body.shape.potential_at(a);
-                (1.0 / self.body.eta + u * u).sqrt()
-                    < SHARP_PEAK * self.body.shape.potential_second_at(a).abs()
-            }));
-        }
+        splits.extend(
+            self.dips
+                .iter()
+                .filter(|(_, width)| *width < SHARP_PEAK)
+                .map(|(zero, _)| *zero),
+        );
         splits.extend(
             self.body
                 .shape

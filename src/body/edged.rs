@@ -443,16 +443,4 @@ impl Shape for EdgedShape {
     fn angular_feature_scale(&self) -> f64 {
         1.0
     }
-
-    /// On a part U = p sinθ + q cosθ + r, |U″| = |p sinθ + q cosθ| ≤ √(p² + q²).
-    fn curvature_bound(&self) -> f64 {
-        let (h, rho, alpha) = (self.cut, self.rho, self.alpha);
-        let parts: &[(f64, f64)] = match self.kind {
-            EdgedKind::Disk => &[(1.0, alpha)],
-            EdgedKind::TruncatedBall => &[(rho, h + alpha), (0.0, alpha)],
-            EdgedKind::Wheel => &[(rho, h + alpha), (rho, alpha - h), (0.0, alpha)],
-            EdgedKind::Profile(_) => return f64::INFINITY,
-        };
-        parts.iter().map(|&(p, q)| p.hypot(q)).fold(0.0, f64::max) * (1.0 + 1e-9)
-    }
 }

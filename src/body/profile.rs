@@ -879,15 +879,4 @@ impl Shape for ProfileShape {
         }
         zeros
     }
-
-    /// On an arc U″ = −ρ_a sinθ + (z_a − α) cosθ + r cos(θ − θ_a), so |U″| ≤
-    /// √(ρ_a² + (z_a − α)²) + r.
-    fn curvature_bound(&self) -> f64 {
-        self.profile
-            .arcs()
-            .iter()
-            .map(|arc| arc.anchor_rho.hypot(arc.anchor_z - self.alpha) + arc.radius)
-            .fold(0.0, f64::max)
-            * (1.0 + 1e-9)
-    }
 }

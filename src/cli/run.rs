@@ -319,12 +319,13 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
 /// The search starts where the whole run's need divided by what is there says and tries 256
 /// counts, then 256 from a count a quarter larger, and so on (a shard's memory has a floor,
 /// its threads' work units, so the first guess can be short). Where even the most shards
-/// do not fit, it says that a work unit is too large for the machine. The search has
-/// [`SHARD_SEARCH`]: a count's layout takes the divisors of the count, a millisecond at
-/// 1e12 (a grid of 1e16 cells took 40 s of tries before its refusal, deaf to Ctrl-C); past
-/// that the phrase gives the least count the need implies.
+/// do not fit, it says that a work unit is too large for the machine. The search tries at
+/// most [`SHARD_SEARCH`] counts, none above [`SHARD_SEARCH_COUNTS`]: a count's layout takes
+/// the divisors of the count, a millisecond at 1e12 (a grid of 1e16 cells took 40 s of
+/// tries before its refusal, deaf to Ctrl-C); past that the phrase gives the least count
+/// the need implies. (A count of tries, not a time: the answer is the same on any machine.)
 pub(super) fn shards_to_fit(scene: &Scene, out: &std::path::Path, threads: usize) -> String {
-    let deadline = std::time::Instant::now() + SHARD_SEARCH;
+    let mut tries = 0;
     let memory = rubber_atlas::machine::available_memory().map_or(f64::INFINITY, |m| 0.5 * m);
     let disk = rubber_atlas::machine::free_disk(out).unwrap_or(f64::INFINITY);
     let shape = scene.shape();
@@ -353,14 +354,17 @@ pub(super) fn shards_to_fit(scene: &Scene, out: &std::path::Path, threads: usize
     let mut from = least;
     while from <= most.min(SHARD_SEARCH_COUNTS) {
         if let Some(count) = (from..=most.min(from + 255))
-            .take_while(|_| std::time::Instant::now() < deadline)
+            .take_while(|_| {
+                tries += 1;
+                tries <= SHARD_SEARCH
+            })
             .find(|&c| fits(c))
         {
             return format!(
                 "split it with --shard I/{count} across machines (enough shards to fit), or "
             );
         }
-        if std::time::Instant::now() >= deadline {
+        if tries > SHARD_SEARCH {
             return at_least;
         }
         from = from.saturating_add(256).max(from.saturating_add(from / 4));
@@ -373,8 +377,8 @@ pub(super) fn shards_to_fit(scene: &Scene, out: &std::path::Path, threads: usize
         .to_string()
 }
 
-/// The time [`shards_to_fit`] may search for a shard count.
-const SHARD_SEARCH: std::time::Duration = std::time::Duration::from_millis(200);
+/// The shard counts [`shards_to_fit`] may try (at most half a second at the largest).
+const SHARD_SEARCH: usize = 512;
 
 /// The largest shard count [`shards_to_fit`] tries (a count's layout takes its divisors:
 /// a millisecond here).

@@ -516,6 +516,10 @@ impl AtlasFile {
                 .iter()
                 .map(|r| r.start as u64)
                 .collect();
+            // (errno cleared first: a failure without a system call must not show an
+            // earlier call's errno.)
+            // SAFETY: errno is this thread's own.
+            unsafe { *libc::__errno_location() = 0 };
             let status = hdf5::sync::sync(|| unsafe {
                 hdf5_sys::h5d::H5Dwrite_chunk(
                     d.id(),

@@ -31,27 +31,25 @@ fn first_intervals(tol: f64) -> usize {
     }
 }
 /// The fewest φ-steps whose level differences are trusted on a body with a narrow feature
-/// of width w ([`Shape::angular_feature_scale`]: a prolate ellipsoid's Z round θ = π/2, an
-/// oblate one's at the poles; or B's dip where U′ crosses 0 at a large η): 4 L/w. The feature is a singularity about w off the real
-/// θ-axis, at least 2w/L off the real φ-axis, and the trapezoid sums on fewer steps can step
-/// over it and agree among themselves: at β = 0.0075, η = 0.098 (L = 1.5) the levels of 32,
-/// 64 and 128 steps put N's error at 8e-10 where it was 4.8e-7 (adversary pass of
-/// 2026-11-27). With 4 L/w steps even the coarsest level compared (a quarter of them) sees
-/// the feature, whose share of the error then falls by e^{−4} a level. Beyond
-/// [`LAST_INTERVALS`] the general rule takes the libration, cut at its minima there
-/// (`EffectivePotential::pieces`).
-fn least_intervals<S: Shape>(v: &EffectivePotential<'_, S>, piece: &Piece) -> usize {
-    let shape = &v.body.shape;
-    // B = 1/η + U² + U′² dips where U′ crosses 0, on a scale of at least √(1/η)/max|U″|:
-    // counted where that is narrow (below 0.1; wider dips the rule has always resolved:
-    // the paper's body has 0.17).
-    let dip = (1.0 / v.body.eta).sqrt() / shape.curvature_bound();
-    let scale = if dip < 0.1 {
-        shape.angular_feature_scale().min(dip)
-    } else {
-        shape.angular_feature_scale()
-    };
-    let least = 4.0 * piece.length / scale;
+/// of width w: the shape's own ([`Shape::angular_feature_scale`]: a prolate ellipsoid's Z
+/// round θ = π/2, an oblate one's at the poles), or a dip of B where U′ crosses 0
+/// (`EffectivePotential::dip_scale`, at a large η): 4 ℓ/w, ℓ the map's length (θ's for the
+/// plain map, s's for Mercator's, whose θ-steps are sin θ ds/dφ ≤ ds/dφ). The feature is a
+/// singularity about w off the real θ-axis, at least 2w/ℓ off the real φ-axis, and the
+/// trapezoid sums on fewer steps can step over it and agree among themselves: at
+/// β = 0.0075, η = 0.098 (L = 1.5) the levels of 32, 64 and 128 steps put N's error at 8e-10
+/// where it was 4.8e-7 (adversary pass of 2026-11-27). With 4 ℓ/w steps even the coarsest
+/// level compared (a quarter of them) sees the feature, whose share of the error then falls
+/// by e^{−4} a level. Beyond [`LAST_INTERVALS`] the general rule takes the libration, cut
+/// at a narrow dip or, on a sharply curved shape, at its minima (`EffectivePotential::pieces`).
+fn least_intervals<S: Shape>(v: &EffectivePotential<'_, S>, piece: &Piece, map: &Map) -> usize {
+    let lower = piece.left.site.theta;
+    let scale = v
+        .body
+        .shape
+        .angular_feature_scale()
+        .min(v.dip_scale(lower, lower + piece.length));
+    let least = 4.0 * map.length() / scale;
     if least > LAST_INTERVALS as f64 {
         usize::MAX
     } else {
@@ -98,7 +96,7 @@ fn integrate_on<S: Shape>(
     tol: f64,
     with_drift: bool,
 ) -> Result<std::result::Result<PeriodIntegrals, usize>> {
-    let least = least_intervals(v, piece);
+    let least = least_intervals(v, piece, map);
     if least > LAST_INTERVALS {
         return Ok(Err(0));
     }
@@ -156,7 +154,13 @@ fn integrate_on<S: Shape>(
         // Only sums already in their geometric regime (each level ten times closer), whose
         // last difference bounds the error.
         let settled = |s: [f64; 3]| (s[0] - s[1]).abs() <= 0.1 * (s[1] - s[2]).abs();
-        if done || (hopeless && beyond_tanh_sinh && settled(t_sums) && settled(psi_sums)) {
+        if done
+            || (hopeless
+                && beyond_tanh_sinh
+                && samples.intervals >= least
+                && settled(t_sums)
+                && settled(psi_sums))
+        {
             let drift = match drift {
                 None if with_drift => {
                     let mut d = samples.drift(rate);
@@ -356,6 +360,13 @@ enum Map {
 }
 
 impl Map {
+    /// The length the map's φ ∈ [0, π] covers: L in θ, or L_s in s.
+    fn length(&self) -> f64 {
+        match *self {
+            Map::Plain { length } | Map::Mercator { length, .. } => length,
+        }
+    }
+
     /// How far the map's level differences may be trusted ([`Convergence`]).
     fn convergence(&self) -> Convergence {
         match self {

@@ -1727,13 +1727,17 @@ fn a_start_at_rest_on_a_flat_potential_is_a_motion() {
             assert!(o.status.success(), "κ {kappa}, θ0 {theta0}: {text}");
             let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
             assert_eq!(v["components"].as_array().unwrap().len(), 1);
-            assert!(
-                v["components"][0]["rotation_number"]
-                    .as_f64()
-                    .unwrap()
-                    .abs()
-                    < 1e-12
+            let c = &v["components"][0];
+            assert!(c["rotation_number"].as_f64().unwrap().abs() < 1e-12, "{c}");
+            // The motion of the start: it holds θ(0) (a libration from it at κ ≠ 0, the
+            // fixed point at π/2, the neutral circle at κ = 0).
+            let theta0: f64 = theta0.parse().unwrap();
+            let (lo, hi) = (
+                c["theta_min"].as_f64().unwrap(),
+                c["theta_max"].as_f64().unwrap(),
             );
+            // (The turning point found again from ε = V(θ0) on a V this flat: 4e-9 off.)
+            assert!(lo - 1e-6 <= theta0 && theta0 <= hi + 1e-6, "{c}");
         }
     }
 }

@@ -560,11 +560,11 @@ fn a_tip_flag_that_cannot_turn_makes_no_joint() {
     assert_eq!(faced.potential_prime_over_sin_at(top), f64::NEG_INFINITY);
 }
 
-/// The zeros of U′ (where B = 1/η + U² + U′² is least) and the bound on |U″| of every shape
-/// against a scan: each sign change of U′ on 200,000 steps lies within a step of a zero the
-/// shape gives, U′ vanishes at each zero to rounding, and |U″| nowhere exceeds the bound.
+/// The zeros of U′ (where B = 1/η + U² + U′² may dip) of every shape against a scan: each
+/// sign change of U′ on 200,000 steps lies within a step of a zero the shape gives, and U′
+/// vanishes at each zero to rounding. (A centred prolate body's zero at π/2 was missing.)
 #[test]
-fn the_zeros_of_the_slope_and_the_curvature_bound_are_the_shapes() {
+fn the_zeros_of_the_slope_are_the_shapes() {
     let shapes: Vec<(String, Box<dyn Shape>)> = vec![
         (
             "prolate".into(),
@@ -573,6 +573,14 @@ fn the_zeros_of_the_slope_and_the_curvature_bound_are_the_shapes() {
         (
             "prolate mirrored".into(),
             Box::new(Ellipsoid::new(-0.7, 0.2).unwrap()),
+        ),
+        (
+            "prolate centred".into(),
+            Box::new(Ellipsoid::new(0.0, 0.15).unwrap()),
+        ),
+        (
+            "oblate centred".into(),
+            Box::new(Ellipsoid::new(0.0, 3.0).unwrap()),
         ),
         ("oblate".into(), Box::new(Ellipsoid::new(0.5, 3.0).unwrap())),
         (
@@ -600,18 +608,11 @@ fn the_zeros_of_the_slope_and_the_curvature_bound_are_the_shapes() {
     for (name, shape) in &shapes {
         let zeros = shape.slope_zeros();
         found += zeros.len();
-        let bound = shape.curvature_bound();
         let step = PI / STEPS as f64;
         let mut previous = shape.potential_prime_at(Angle::new(step));
         for i in 2..STEPS {
             let theta = i as f64 * step;
-            let a = Angle::new(theta);
-            let slope = shape.potential_prime_at(a);
-            assert!(
-                shape.potential_second_at(a).abs() <= bound,
-                "{name}: |U''| = {} above {bound} at {theta}",
-                shape.potential_second_at(a).abs()
-            );
+            let slope = shape.potential_prime_at(Angle::new(theta));
             if previous * slope < 0.0 {
                 assert!(
                     zeros.iter().any(|z| (z - theta).abs() <= 2.0 * step),

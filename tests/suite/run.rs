@@ -397,8 +397,26 @@ fn a_run_killed_at_any_point_resumes_to_the_same_arrays() {
     let message = String::from_utf8_lossy(&again.stderr);
     assert_eq!(again.status.code(), Some(2), "{message}");
     assert!(
-        message.contains("of another scene or program version")
+        message.contains("of another version of this scene")
             && message.contains("--update")
+            && !message.contains("--resume"),
+        "{message}"
+    );
+    // Another scene's journal: --update refuses it as --resume does, so neither is offered.
+    let other = dir.path().join("other.toml");
+    std::fs::write(&other, text.replace("name = \"slow\"", "name = \"other\"")).unwrap();
+    let refused = run(&[
+        "run",
+        other.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let message = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(refused.status.code(), Some(2), "{message}");
+    assert!(
+        message.contains("of another scene (\"slow\")")
+            && message.contains("--force")
+            && !message.contains("--update")
             && !message.contains("--resume"),
         "{message}"
     );
