@@ -274,21 +274,21 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         }
     }
 
-    /// The narrowest dip of B as the θ-interval [`lower`, `upper`] sees it: its width where it
-    /// lies inside, else hypot(its distance outside, its width) (on the κ = 0 circle each
-    /// dip's images ±θ + 2πm too). ∞ without dips.
-    pub(crate) fn dip_scale(&self, lower: f64, upper: f64) -> f64 {
+    /// The dips of B as the θ-interval [`lower`, `upper`] sees them: for each (on the κ = 0
+    /// circle each of its images ±θ + 2πm), the point of the interval nearest it and its
+    /// width there, hypot(its distance outside the interval, its width).
+    pub(crate) fn dips_seen(&self, lower: f64, upper: f64) -> Vec<(f64, f64)> {
         self.dips
             .iter()
             .flat_map(|&(zero, width)| {
                 lifted_inside(&[zero], lower - PI, upper + PI)
                     .into_iter()
                     .map(move |site| {
-                        let outside = (lower - site.theta).max(site.theta - upper).max(0.0);
-                        outside.hypot(width)
+                        let nearest = site.theta.clamp(lower, upper);
+                        (nearest, (site.theta - nearest).abs().hypot(width))
                     })
             })
-            .fold(f64::INFINITY, f64::min)
+            .collect()
     }
 
     /// The critical points, sorted by θ.

@@ -16,7 +16,7 @@ use crate::error::Result;
 use crate::quadrature::{real_fft, real_inverse_fft, IntervalNode, FINEST_COSINE_INTERVALS};
 use rustfft::num_complex::Complex;
 use std::cell::RefCell;
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
 use std::sync::OnceLock;
 
 /// φ-steps on [0, π] of the first level: 16, the fewest for which the level differences are
@@ -31,25 +31,39 @@ fn first_intervals(tol: f64) -> usize {
     }
 }
 /// The fewest φ-steps whose level differences are trusted on a body with a narrow feature
-/// of width w: the shape's own ([`Shape::angular_feature_scale`]: a prolate ellipsoid's Z
-/// round θ = π/2, an oblate one's at the poles), or a dip of B where U′ crosses 0
-/// (`EffectivePotential::dip_scale`, at a large η): 4 ℓ/w, ℓ the map's length (θ's for the
-/// plain map, s's for Mercator's, whose θ-steps are sin θ ds/dφ ≤ ds/dφ). The feature is a
-/// singularity about w off the real θ-axis, at least 2w/ℓ off the real φ-axis, and the
-/// trapezoid sums on fewer steps can step over it and agree among themselves: at
-/// β = 0.0075, η = 0.098 (L = 1.5) the levels of 32, 64 and 128 steps put N's error at 8e-10
-/// where it was 4.8e-7 (adversary pass of 2026-11-27). With 4 ℓ/w steps even the coarsest
-/// level compared (a quarter of them) sees the feature, whose share of the error then falls
-/// by e^{−4} a level. Beyond [`LAST_INTERVALS`] the general rule takes the libration, cut
-/// at a narrow dip or, on a sharply curved shape, at its minima (`EffectivePotential::pieces`).
+/// of width w at θ_f: the shape's own where it has one ([`Shape::angular_feature_scale`]
+/// below 1: a prolate ellipsoid's Z round θ = π/2, an oblate one's at the poles; where is
+/// not known, the worst place of the libration is taken), or a dip of B where U′ crosses 0
+/// (`EffectivePotential::dips_seen`, at a large η). The feature is a singularity about w off
+/// the real θ-axis; the map's θ-step there is at most ℓ π/(2n), ℓ = L for the plain map and
+/// sin θ_f L_s for Mercator's (dθ = sin θ ds), and the trapezoid sums on fewer than 4ℓ/w
+/// steps can step over it and agree among themselves: at β = 0.0075, η = 0.098 (L = 1.5)
+/// the levels of 32, 64 and 128 steps put N's error at 8e-10 where it was 4.8e-7
+/// (adversary pass of 2026-11-27). With 4ℓ/w steps even the coarsest level compared (a
+/// quarter of them) sees the feature, whose share of the error then falls by e^{−4} a
+/// level. Beyond [`LAST_INTERVALS`] the general rule takes the libration, cut at a narrow
+/// dip or, on a sharply curved shape, at its minima (`EffectivePotential::pieces`).
 fn least_intervals<S: Shape>(v: &EffectivePotential<'_, S>, piece: &Piece, map: &Map) -> usize {
-    let lower = piece.left.site.theta;
-    let scale = v
-        .body
-        .shape
-        .angular_feature_scale()
-        .min(v.dip_scale(lower, lower + piece.length));
-    let least = 4.0 * map.length() / scale;
+    let (lower, upper) = (piece.left.site.theta, piece.left.site.theta + piece.length);
+    // ℓ at θ: the map's θ-step there per unit of φ-step, up to the factor sin φ/2.
+    let reach = |theta: f64| match *map {
+        Map::Plain { length } => length,
+        Map::Mercator { length, .. } => length * theta.sin().abs(),
+    };
+    let widest = if lower < FRAC_PI_2 && upper > FRAC_PI_2 {
+        reach(FRAC_PI_2)
+    } else {
+        reach(lower).max(reach(upper))
+    };
+    let shape = v.body.shape.angular_feature_scale();
+    let mut least = if shape < 1.0 {
+        4.0 * widest / shape
+    } else {
+        0.0
+    };
+    for (at, width) in v.dips_seen(lower, upper) {
+        least = least.max(4.0 * reach(at) / width);
+    }
     if least > LAST_INTERVALS as f64 {
         usize::MAX
     } else {
@@ -360,13 +374,6 @@ enum Map {
 }
 
 impl Map {
-    /// The length the map's φ ∈ [0, π] covers: L in θ, or L_s in s.
-    fn length(&self) -> f64 {
-        match *self {
-            Map::Plain { length } | Map::Mercator { length, .. } => length,
-        }
-    }
-
     /// How far the map's level differences may be trusted ([`Convergence`]).
     fn convergence(&self) -> Convergence {
         match self {
