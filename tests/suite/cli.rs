@@ -1745,7 +1745,7 @@ fn a_start_at_rest_on_a_flat_potential_is_a_motion() {
 /// Issue 22, adversary pass of 2026-11-27: Ctrl-C during `verdict` at resolution 4096 took
 /// 0.35–1.6 s (growing with the time into the run): the lines still queued set up V's
 /// critical points and energies before leaving, and the brackets of the coarse search ran
-/// over the lines sampled so far. Now 15–65 ms measured.
+/// over the lines sampled so far. Now 15–65 ms measured (2 to 12 s into the run).
 #[test]
 fn a_verdict_at_the_highest_resolution_stops_at_once() {
     use std::process::Stdio;
@@ -1764,14 +1764,15 @@ fn a_verdict_at_the_highest_resolution_stops_at_once() {
             .stderr(Stdio::piped())
             .spawn()
             .unwrap();
-        std::thread::sleep(std::time::Duration::from_secs(6));
+        std::thread::sleep(std::time::Duration::from_secs(8));
         let asked = std::time::Instant::now();
         // SAFETY: a signal to our own child process.
         unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
         let output = child.wait_with_output().unwrap();
         let waited = asked.elapsed().as_secs_f64();
         assert_eq!(output.status.code(), Some(130), "{args:?}");
-        // (1.2 s and more before, at 6 s into the run.)
-        assert!(waited < 0.6, "{args:?}: {waited} s");
+        // (1.6 s before, at 8 s into the run; 15–65 ms now on an idle machine, and a loaded
+        // CI machine gets its margin.)
+        assert!(waited < 1.0, "{args:?}: {waited} s");
     }
 }
