@@ -24,7 +24,12 @@ use pyo3::types::{PyDict, PyList};
 const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(20);
 
 fn value_error(e: AtlasError) -> PyErr {
-    PyValueError::new_err(e.to_string())
+    // (In the words of the package's keywords, not the command's flags.)
+    PyValueError::new_err(
+        e.to_string()
+            .replace("beta-min", "beta_min")
+            .replace("beta-max", "beta_max"),
+    )
 }
 
 /// A trajectory error in the words of `ra.trajectory`'s keywords, not the command's flags.
@@ -800,7 +805,13 @@ fn boundaries(
     resolution: i64,
     threads: Option<i64>,
 ) -> PyResult<String> {
-    let scan = count("scan", scan, 1)?;
+    // (The library's range, said at once: "must be >= 1" for 0, then 1 refused as below 4.)
+    if !(4..=10_000).contains(&scan) {
+        return Err(bad(format!(
+            "invalid scan = {scan}: must be between 4 and 10000"
+        )));
+    }
+    let scan = scan as usize;
     let resolution = resolution_between(resolution, 32, " for the boundaries")?;
     let pool = pool(threads)?;
     let options = verdict::BoundaryOptions {

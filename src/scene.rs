@@ -508,7 +508,7 @@ impl Scene {
             return Err(reader.error(
                 "name",
                 format!(
-                    "{name:?} must be non-empty and use only letters, digits, '-', '_' and '.'"
+                    "{name:?} must be non-empty and use only ASCII letters, digits, '-', '_' and '.'"
                 ),
             ));
         }

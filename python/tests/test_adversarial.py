@@ -206,6 +206,10 @@ def test_a_request_beyond_memory_is_refused_before_its_inputs_are_materialised(c
     (lambda: ra.verdict(0.5, 3, 0.5, 0.5, resolution=2.5), TypeError, ["resolution"]),
     (lambda: ra.verdict(0.5, 3, 0.5, 0.5, threads=2**70), ValueError, ["threads"]),
     (lambda: ra.boundaries(0.5, 0.5, 0.5, scan=2**70), ValueError, ["scan"]),
+    # (scan = 0 was "must be >= 1", and then 1 was refused as below 4; beta_max was named as
+    # the command line's beta-max: adversary pass of 2026-11-27.)
+    (lambda: ra.boundaries(0.5, 0.5, 0.5, scan=0), ValueError, ["scan = 0", "between 4 and 10000"]),
+    (lambda: ra.boundaries(0.5, 0.5, 0.5, beta_min=0.8, beta_max=0.7), ValueError, ["beta_max"]),
     (lambda: ra.boundaries(0.5, 0.5, 0.5, resolution=0), ValueError, ["resolution = 0", "32 and 4096"]),
     (lambda: ra.boundaries(0.5, 0.5, 0.5, resolution=10**8), ValueError, ["resolution", "32 and 4096"]),
     (lambda: ra.verdict(0.5, 3, 0.5, 0.5, resolution=0), ValueError, ["resolution = 0", "8 and 4096"]),

@@ -171,6 +171,10 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
         })
     });
     if args.print_out {
+        // Only a path a run would write (an existing file aside, which --update, --resume or
+        // --force write over): it printed x.nc, the scene itself, a folder (adversary pass
+        // of 2026-11-27).
+        check_output(&out, true, &[&args.scene], &ATLAS_EXTENSIONS)?;
         println!("{}", out.display());
         return Ok(());
     }

@@ -1632,6 +1632,26 @@ fn adversary_pass_of_2026_11_27_command_line() {
         "name = \"s\"\n[body]\nnu = 0.5\neta = 99999999999999999999\n",
     )
     .unwrap();
+    // `run --print-out` printed paths the run refuses (exit 0): now the same refusal.
+    let demo = concat!(env!("CARGO_MANIFEST_DIR"), "/atlas/demo.toml");
+    for out in [
+        dir.path().join("x.nc"),
+        dir.path().join("x.partial.h5"),
+        dir.path().join("nodir").join("x.h5"),
+        dir.path().to_path_buf(),
+        std::path::PathBuf::from(demo),
+    ] {
+        let o = run(&["run", demo, "--print-out", "--out", out.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(2), "{out:?}");
+        assert!(o.stdout.is_empty(), "{out:?}");
+    }
+    let fine = dir.path().join("x.h5");
+    let o = run(&["run", demo, "--print-out", "--out", fine.to_str().unwrap()]);
+    assert!(o.status.success());
+    assert_eq!(
+        String::from_utf8_lossy(&o.stdout).trim(),
+        fine.to_str().unwrap()
+    );
     let o = run(&["run", scene.to_str().unwrap()]);
     let text = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{text}");
