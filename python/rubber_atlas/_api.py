@@ -2243,7 +2243,8 @@ def boundaries(alpha: float, nu: float, eta: float, *, beta_min: float = 0.05, b
     xarray.Dataset
         Along ``boundary``: ``boundary_beta`` and its error bound ``boundary_error``,
         ``quantity`` (bytes: what changes sign), and the case and verdict below and above
-        (``case_below``, ``holds_below``, ``case_above``, ``holds_above``: uint8 flags).
+        (``case_below``, ``holds_below``, ``case_above``, ``holds_above``: uint8 flags; those
+        of the scanned β next to the boundary on each side, see docs/files.md).
         Along ``scan``: ``scan_beta``, ``scan_case``, ``scan_holds``. The whole ``--json``
         object is ``attrs["boundaries_json"]``.
 
