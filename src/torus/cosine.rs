@@ -142,11 +142,19 @@ fn integrate_on<S: Shape>(
         // left for refinement to gain: where that floor with the rounding misses the
         // tolerance (tol ≲ 1e-14), refining on to LAST_INTERVALS steps and then by the
         // tanh-sinh rule only bought the same estimate at 2–4 times the nodes.
-        // The Mercator map's levels must show one rate before its last difference is taken
-        // as the error: a disk at ν = 9e-4, κ = −7e-4 (turning points 1e-4 from its faces)
+        // The Mercator map's levels must show one rate, falling fast, before its last
+        // difference is taken as the error: a disk at ν = 9e-4, κ = −7e-4 (turning points 1e-4 from its faces)
         // had Δψ's differences 1.1e-4, 4.5e-5, 1.1e-5, then 2.3e-8, and its error was 12
         // times that last one (adversary pass of 2026-11-27).
-        let trusted = one_rate || matches!(map, Map::Plain { .. });
+        // And its last two differences must fall tenfold (or to the floor): a disk at
+        // ν = 7e-4 had Δψ's 1.2e-4, 2.9e-5, 1.4e-5 (slowing down), its error 2.7 times the
+        // last.
+        let falling = |s: [f64; 3]| {
+            let (d1, d2) = ((s[0] - s[1]).abs(), (s[1] - s[2]).abs());
+            d1 <= 0.1 * d2 || d1 <= LEVEL_FLOOR * s[0].abs()
+        };
+        let trusted =
+            matches!(map, Map::Plain { .. }) || (one_rate && falling(t_sums) && falling(psi_sums));
         let mut done = samples.intervals >= least
             && trusted
             && (t_error <= budget(tol * period, extra_t) || at_level_floor(t_sums, rate))
