@@ -261,37 +261,9 @@ pub trait Shape: Send + Sync {
 
     /// The θ in (0, π) where U′ = 0 (the poles aside): B = 1/η + U² + U′² is least there and
     /// the integrands, ∝ √B, may dip sharply
-    /// ([`crate::torus::EffectivePotential::splits_inside`]). This default finds the sign
-    /// changes of U′ on 4096 steps; the closed forms override it.
-    fn slope_zeros(&self) -> Vec<f64> {
-        const STEPS: usize = 4096;
-        let at = |i: usize| std::f64::consts::PI * i as f64 / STEPS as f64;
-        let slope = |theta: f64| self.potential_prime_at(Angle::new(theta));
-        let mut zeros = Vec::new();
-        let mut previous = slope(at(1));
-        for i in 2..STEPS {
-            let next = slope(at(i));
-            if previous == 0.0 {
-                zeros.push(at(i - 1));
-            } else if previous * next < 0.0 {
-                let (mut lo, mut hi) = (at(i - 1), at(i));
-                for _ in 0..60 {
-                    let mid = 0.5 * (lo + hi);
-                    if (slope(mid) > 0.0) == (previous > 0.0) {
-                        lo = mid;
-                    } else {
-                        hi = mid;
-                    }
-                }
-                zeros.push(0.5 * (lo + hi));
-            }
-            previous = next;
-        }
-        if previous == 0.0 {
-            zeros.push(at(STEPS - 1));
-        }
-        zeros
-    }
+    /// ([`crate::torus::EffectivePotential::splits_inside`]). Every shape gives them in
+    /// closed form (no default: a shape that left them out would lose that check).
+    fn slope_zeros(&self) -> Vec<f64>;
 
     /// U and |r|² together (shapes override this to share work between the two).
     #[inline]

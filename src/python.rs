@@ -805,13 +805,16 @@ fn boundaries(
     resolution: i64,
     threads: Option<i64>,
 ) -> PyResult<String> {
-    // (The library's range, said at once: "must be >= 1" for 0, then 1 refused as below 4.)
-    if !(4..=10_000).contains(&scan) {
-        return Err(bad(format!(
-            "invalid scan = {scan}: must be between 4 and 10000"
-        )));
-    }
-    let scan = scan as usize;
+    // (A negative scan is out of the library's range too, and named as given: "must be
+    // >= 1" for 0 was followed by 1 refused as below 4.)
+    let scan = usize::try_from(scan)
+        .ok()
+        .filter(|s| verdict::BOUNDARY_SCANS.contains(s))
+        .ok_or_else(|| {
+            bad(format!(
+                "invalid scan = {scan}: must be between 4 and 10000"
+            ))
+        })?;
     let resolution = resolution_between(resolution, 32, " for the boundaries")?;
     let pool = pool(threads)?;
     let options = verdict::BoundaryOptions {

@@ -275,20 +275,25 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
     }
 
     /// The dips of B as the θ-interval [`lower`, `upper`] sees them: for each (on the κ = 0
-    /// circle each of its images ±θ + 2πm), the point of the interval nearest it and its
-    /// width there, hypot(its distance outside the interval, its width).
-    pub(crate) fn dips_seen(&self, lower: f64, upper: f64) -> Vec<(f64, f64)> {
-        self.dips
-            .iter()
-            .flat_map(|&(zero, width)| {
-                lifted_inside(&[zero], lower - PI, upper + PI)
-                    .into_iter()
-                    .map(move |site| {
-                        let nearest = site.theta.clamp(lower, upper);
-                        (nearest, (site.theta - nearest).abs().hypot(width))
-                    })
+    /// circle each of its images ±θ + 2πm; for κ ≠ 0 the images outside (0, π) are farther
+    /// than the dip itself and change nothing), the point of the interval nearest it and its
+    /// width there, hypot(its distance outside the interval, its width). No allocation: this
+    /// runs for every libration.
+    pub(crate) fn dips_seen(
+        &self,
+        lower: f64,
+        upper: f64,
+    ) -> impl Iterator<Item = (f64, f64)> + '_ {
+        let turns = ((lower - PI) / TAU).floor() as i64..=((upper + PI) / TAU).ceil() as i64;
+        self.dips.iter().flat_map(move |&(zero, width)| {
+            turns.clone().flat_map(move |m| {
+                let turn = TAU * m as f64;
+                [turn + zero, turn - zero].map(|theta| {
+                    let nearest = theta.clamp(lower, upper);
+                    (nearest, (theta - nearest).abs().hypot(width))
+                })
             })
-            .collect()
+        })
     }
 
     /// The critical points, sorted by θ.

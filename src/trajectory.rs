@@ -103,10 +103,10 @@ impl Start {
     /// The energy of this start among V's levels as `potential` holds them: where it lies
     /// below V's lowest critical level by no more than V's rounding (8 eps of its scale at
     /// θ(0) or there), the start is at rest on that level's minimum (or neutral
-    /// equilibrium), and its level is that one. V(θ(0)) and the minimum are two roundings of one level there: on a sphere
-    /// centred on its centre of mass (U ≡ 1, every θ a minimum of V at κ = 0) the start at
-    /// rest at θ(0) = π/2, κ = 1e-3 had ε = 1.0000004999999998 under the minimum 1.0000005,
-    /// and `cell --theta0` refused it as "no motion".
+    /// equilibrium), and its level is that one. V(θ(0)) and the minimum are two roundings of
+    /// one level there: on a sphere centred on its centre of mass (U ≡ 1, every θ a minimum
+    /// of V at κ = 0) the start at rest at θ(0) = π/2, κ = 1e-3 had ε = 1.0000004999999998
+    /// under the minimum 1.0000005, and `cell --theta0` refused it as "no motion".
     pub fn level<S: Shape>(&self, potential: &EffectivePotential<'_, S>) -> f64 {
         let energy = self.energy(potential.body);
         // (The lowest critical level: where U′ ≡ 0 on an arc, its points are neutral

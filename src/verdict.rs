@@ -1422,12 +1422,16 @@ pub struct Boundaries {
     pub scan: Vec<ScanPoint>,
 }
 
+/// The scan densities [`boundaries`] takes.
+pub const BOUNDARY_SCANS: std::ops::RangeInclusive<usize> = 4..=10_000;
+
 /// The β range and the scan density of [`boundaries`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BoundaryOptions {
     pub beta_min: f64,
     pub beta_max: f64,
-    /// Log-spaced β of the scan (the case line β² = 1 + α is added on both sides).
+    /// Log-spaced β of the scan (the case line β² = 1 + α is added on both sides), in
+    /// [`BOUNDARY_SCANS`].
     pub scan: usize,
     pub verdict: VerdictOptions,
 }
@@ -1593,7 +1597,7 @@ pub fn boundaries_with(
                      the extrema they are found on, by more than its error bar shows)",
         });
     }
-    if !(4..=10_000).contains(&options.scan) {
+    if !BOUNDARY_SCANS.contains(&options.scan) {
         return Err(AtlasError::InvalidParameter {
             name: "scan",
             value: options.scan as f64,

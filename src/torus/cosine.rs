@@ -138,23 +138,21 @@ fn integrate_on<S: Shape>(
         let extra_t = 2.0 * sums.t_rounding + saddle_t;
         let extra_psi = 2.0 * sums.psi_rounding + saddle_psi;
         let budget = |allowed: f64, extra: f64| (allowed - extra).max(0.1 * extra);
-        // A sum whose level differences are within the floor of `level_error` has nothing
-        // left for refinement to gain: where that floor with the rounding misses the
-        // tolerance (tol ≲ 1e-14), refining on to LAST_INTERVALS steps and then by the
-        // tanh-sinh rule only bought the same estimate at 2–4 times the nodes.
-        // The Mercator map's levels must show one rate, falling fast, before its last
-        // difference is taken as the error: a disk at ν = 9e-4, κ = −7e-4 (turning points 1e-4 from its faces)
-        // had Δψ's differences 1.1e-4, 4.5e-5, 1.1e-5, then 2.3e-8, and its error was 12
-        // times that last one (adversary pass of 2026-11-27).
-        // And its last two differences must fall tenfold (or to the floor): a disk at
-        // ν = 7e-4 had Δψ's 1.2e-4, 2.9e-5, 1.4e-5 (slowing down), its error 2.7 times the
-        // last.
-        let falling = |s: [f64; 3]| {
-            let (d1, d2) = ((s[0] - s[1]).abs(), (s[1] - s[2]).abs());
-            d1 <= 0.1 * d2 || d1 <= LEVEL_FLOOR * s[0].abs()
-        };
-        let trusted =
-            matches!(map, Map::Plain { .. }) || (one_rate && falling(t_sums) && falling(psi_sums));
+        // Where the differences may be taken as the error: the plain map's (one geometric
+        // strip); the Mercator map's only where its last four levels show one rate and the
+        // last two differences fall tenfold (`settled`) or sit on the floor. A disk at
+        // ν = 9e-4, κ = −7e-4 (turning points 1e-4 from its faces) had Δψ's 1.1e-4, 4.5e-5,
+        // 1.1e-5, then 2.3e-8, its error 12 times that last one; one at ν = 7e-4 had 1.2e-4,
+        // 2.9e-5, 1.4e-5, slowing down, its error 2.7 times the last (adversary pass of
+        // 2026-11-27).
+        let settled = |s: [f64; 3]| (s[0] - s[1]).abs() <= 0.1 * (s[1] - s[2]).abs();
+        let falling = |s: [f64; 3]| settled(s) || at_level_floor(s, Convergence::Unknown);
+        let trusted = map.convergence() == Convergence::Geometric
+            || (one_rate && falling(t_sums) && falling(psi_sums));
+        // A sum at the floor of `level_error` has nothing left for refinement to gain: where
+        // that floor with the rounding misses the tolerance (tol ≲ 1e-14), refining on to
+        // LAST_INTERVALS steps and then by the tanh-sinh rule only bought the same estimate
+        // at 2–4 times the nodes.
         let mut done = samples.intervals >= least
             && trusted
             && (t_error <= budget(tol * period, extra_t) || at_level_floor(t_sums, rate))
@@ -180,9 +178,8 @@ fn integrate_on<S: Shape>(
         // their estimates even where they have not converged: the status then says so.
         let beyond_tanh_sinh = v.kappa != 0.0
             && piece.left.site.theta.min(piece.right.site.from_pi) < HIDDEN_PEAK * piece.length;
-        // Only sums already in their geometric regime (each level ten times closer), whose
-        // last difference bounds the error.
-        let settled = |s: [f64; 3]| (s[0] - s[1]).abs() <= 0.1 * (s[1] - s[2]).abs();
+        // (Only sums already `settled`: each level ten times closer, the last difference
+        // bounding the error.)
         if done
             || (hopeless
                 && beyond_tanh_sinh
