@@ -117,6 +117,21 @@ impl DoubleDouble {
         self.add(other.neg())
     }
 
+    /// The pair (`sin`, `cos`) scaled onto the unit circle: for a pair within a few ulps of
+    /// it, δ = sin² + cos² − 1 and 1/√(1 + δ) = 1 − δ/2 + O(δ²) (δ² below 1e-30 for
+    /// |δ| ≤ 1e-15); otherwise by the root and two quotients.
+    pub fn onto_circle(sin: Self, cos: Self) -> (Self, Self) {
+        let radius_sq = sin.mul(sin).add(cos.mul(cos));
+        let delta = radius_sq.add_f64(-1.0).to_f64();
+        if delta.abs() <= 1e-15 {
+            let f = -0.5 * delta;
+            (sin.add(sin.mul_f64(f)), cos.add(cos.mul_f64(f)))
+        } else {
+            let radius = radius_sq.sqrt();
+            (sin.div(radius), cos.div(radius))
+        }
+    }
+
     /// Product (DWTimesDW).
     #[allow(clippy::should_implement_trait)]
     pub fn mul(self, other: Self) -> Self {

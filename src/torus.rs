@@ -353,7 +353,16 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
     pub fn value_double_double(&self, a: Angle) -> Option<(DoubleDouble, f64)> {
         let (sin, cos) = (DoubleDouble::from_f64(a.sin), DoubleDouble::from_f64(a.cos));
         let radius = sin.mul(sin).add(cos.mul(cos)).sqrt();
-        let (sin, cos) = (sin.div(radius), cos.div(radius));
+        self.value_double_double_on_circle(sin.div(radius), cos.div(radius))
+    }
+
+    /// [`Self::value_double_double`] at the angle whose sine and cosine are `sin` and `cos`
+    /// (a pair on the unit circle to double-double precision).
+    fn value_double_double_on_circle(
+        &self,
+        sin: DoubleDouble,
+        cos: DoubleDouble,
+    ) -> Option<(DoubleDouble, f64)> {
         let (u, error) = self.body.shape.potential_double_double(sin, cos)?;
         if self.kappa == 0.0 {
             return Some((u, error));
@@ -1039,13 +1048,15 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 .splits_inside(component.lower.theta, component.upper.theta)
                 .is_empty()
         {
-            let whole = &self.pieces(energy, component, false)[0];
-            match cosine::integrate(self, whole, energy, component, tol, with_drift)? {
+            let mut whole = self.pieces(energy, component, false);
+            self.sharpen_gaps(&mut whole, tol);
+            match cosine::integrate(self, &whole[0], energy, component, tol, with_drift)? {
                 Ok(result) => return Ok(result),
                 Err(work) => spent = work,
             }
         }
-        let pieces = self.pieces(energy, component, true);
+        let mut pieces = self.pieces(energy, component, true);
+        self.sharpen_gaps(&mut pieces, tol);
         let kinds = if fast_rules {
             self.chebyshev_kinds(component, &pieces, tol)
         } else {
@@ -1613,6 +1624,7 @@ impl<S: Shape> EffectivePotential<'_, S> {
                 } else {
                     4.0 * EPS * (self.value_scale(angle) + energy.abs())
                 },
+                sharp: None,
             }
         };
         let turning = component.kind == MotionKind::Libration;
@@ -1667,6 +1679,33 @@ impl<S: Shape> EffectivePotential<'_, S> {
                 }
             })
             .collect()
+    }
+}
+
+impl<S: Shape> EffectivePotential<'_, S> {
+    /// At a tolerance below [`SHARP_GAPS_BELOW`], where the shape gives V in double-double:
+    /// the pieces' ends in double-double, so that `sample` can compute a gap whose rounding in
+    /// double would weigh in the error (the divided difference of V cancelling) as
+    /// V(e) + excess + tilt − V(t) in double-double, to about an ulp of the gap.
+    fn sharpen_gaps(&self, pieces: &mut [Piece], tol: f64) {
+        if tol >= SHARP_GAPS_BELOW {
+            return;
+        }
+        for end in pieces.iter_mut().flat_map(|p| [&mut p.left, &mut p.right]) {
+            let (sin, cos) = DoubleDouble::onto_circle(
+                DoubleDouble::from_f64(end.angle.sin),
+                DoubleDouble::from_f64(end.angle.cos),
+            );
+            end.sharp = self
+                .value_double_double_on_circle(sin, cos)
+                .map(|(value, error)| SharpEnd {
+                    sin,
+                    cos,
+                    level: value.add_f64(end.excess),
+                    error,
+                    threshold: SHARP_GAP_ROUNDING.max(0.02 * tol),
+                });
+        }
     }
 }
 
@@ -1866,7 +1905,34 @@ struct PieceEnd {
     /// gap's zero by construction; the offset of that level from ε is bounded in
     /// [`crate::cell`]).
     excess_error: f64,
+    /// The end in double-double where the gaps are computed sharply
+    /// ([`EffectivePotential::sharpen_gaps`]).
+    sharp: Option<SharpEnd>,
 }
+
+/// An end's angle, on the unit circle, and its level V + `excess` in double-double, with the
+/// bound on that level's error (about 1e-30 of V's terms).
+#[derive(Debug, Clone, Copy)]
+struct SharpEnd {
+    sin: DoubleDouble,
+    cos: DoubleDouble,
+    level: DoubleDouble,
+    error: f64,
+    /// The relative rounding of a gap in double above which it is recomputed: the larger of
+    /// [`SHARP_GAP_ROUNDING`] and a fiftieth of the tolerance (gaps rounded below that add
+    /// at most a hundredth of the tolerance to T and Δψ).
+    threshold: f64,
+}
+
+/// Tolerances below which the gaps whose rounding in double exceeds [`SHARP_GAP_ROUNDING`] are
+/// computed in double-double ([`EffectivePotential::sharpen_gaps`]).
+const SHARP_GAPS_BELOW: f64 = 1e-11;
+
+/// The relative rounding bound of a gap in double above which it is recomputed in
+/// double-double at tight tolerances: the divided difference of V cancels where the wall's
+/// and U's slopes nearly balance (in a narrow well, next to a saddle), 20–300 eps of the gap
+/// measured on the standard slice.
+const SHARP_GAP_ROUNDING: f64 = 4.0 * EPS;
 
 #[derive(Debug, Clone, Copy)]
 struct Piece {
@@ -1877,6 +1943,16 @@ struct Piece {
     /// level that runs linearly from one end's to the other's, so it vanishes at both
     /// turning points and is continuous in between.
     tilt_rate: f64,
+}
+
+impl Piece {
+    /// The piece with its gaps computed in double only.
+    fn in_double(&self) -> Self {
+        let mut plain = *self;
+        plain.left.sharp = None;
+        plain.right.sharp = None;
+        plain
+    }
 }
 
 /// What one node contributes, already multiplied by dθ/dτ (not by the τ-step).
@@ -2279,6 +2355,22 @@ fn sample<S: Shape>(
                     * (end.excess.abs() + sx.abs() * scale + (piece.tilt_rate * signed).abs()),
         )
     };
+    let (gap, abs_err) = match end.sharp {
+        Some(sharp) if abs_err > sharp.threshold * gap => {
+            // (Within 1e-30 of V of the end the double's divided difference is the sharper.)
+            sharp_gap(
+                v,
+                &sharp,
+                end.excess_error,
+                piece.tilt_rate * signed,
+                sx,
+                cx,
+            )
+            .filter(|&(_, sharp_err)| sharp_err < abs_err)
+            .unwrap_or((gap, abs_err))
+        }
+        _ => (gap, abs_err),
+    };
     if gap <= 0.0 || !gap.is_finite() {
         return Err(AtlasError::NotPeriodic {
             reason: "a quadrature node fell outside the allowed set (ε ≤ V there)",
@@ -2286,6 +2378,28 @@ fn sample<S: Shape>(
     }
     let dt = root_of_ratio(red.reduced_inertia, 1.0, 2.0 * gap) * node.jacobian;
     Ok(weighted(v, a, &red, dt, node.jacobian, abs_err / gap))
+}
+
+/// The gap ε − V at the node `sx` = sin(t − e), `cx` = cos(t − e) from the end `sharp`, in
+/// double-double: its level plus `tilt` less V(t), with a bound on its error (the end's
+/// `excess_error`, both values' double-double errors, the tilt's rounding, and two ulps of
+/// the gap: its rounding to a double, and the node's angle, atan2(sx, cx), within 2u of
+/// t − e relative to it, which moves a gap that grows like t − e by as much).
+fn sharp_gap<S: Shape>(
+    v: &EffectivePotential<'_, S>,
+    sharp: &SharpEnd,
+    excess_error: f64,
+    tilt: f64,
+    sx: f64,
+    cx: f64,
+) -> Option<(f64, f64)> {
+    let sin = sharp.sin.mul_f64(cx).add(sharp.cos.mul_f64(sx));
+    let cos = sharp.cos.mul_f64(cx).sub(sharp.sin.mul_f64(sx));
+    let (sin, cos) = DoubleDouble::onto_circle(sin, cos);
+    let (value, error) = v.value_double_double_on_circle(sin, cos)?;
+    let gap = sharp.level.add_f64(tilt).sub(value).to_f64();
+    let bound = excess_error + sharp.error + error + EPS * (tilt.abs() + 2.0 * gap.abs());
+    Some((gap, bound))
 }
 
 /// √(a·b/c) for a, b, c > 0, also where the quotient overflows (B = 1/η + |r|² up to
@@ -2306,7 +2420,7 @@ pub(super) fn root_of_ratio(a: f64, b: f64, c: f64) -> f64 {
 /// times the L1 size of their sums. The sums themselves are compensated ([`CompensatedSum`]):
 /// they add an ulp of the sum and γ²ₙ of its L1 size (below 1e-25 for n ≤ 4096), where plain
 /// summation over n nodes could add up to n ulps of the L1 size.
-const INTEGRAND_ROUNDING: f64 = 32.0 * EPS;
+pub(super) const INTEGRAND_ROUNDING: f64 = 32.0 * EPS;
 
 /// The integrands at an angle from dt/dτ = `dt` and dθ/dτ = `jacobian`: ψ̇ dt/dτ with
 /// ψ̇ = −κ cosθ / (J sin²θ), U a dt/dτ with a = κ/(J sinθ), and U dθ/dτ.

@@ -76,6 +76,31 @@ def test_tight_quadrature_reaches_the_last_digits_away_from_saddles():
         assert abs(comp["period"] - c["period"]) < 1e-13 * c["period"]
 
 
+# Librations of the standard slice (α = 0.5, β = 3, ν = η = 0.5) that pass close to the saddle
+# beyond their lower end, integrated piece by piece: there the divided difference of V that
+# gives the gap ε − V cancels (the wall's slope and U′ nearly balance), its rounding bound in
+# double some hundred ulps of the gap, and T and N stayed `tolerance_not_reached` at tol
+# 1e-13 although their true errors are ulps. The solver recomputes such gaps in double-double.
+NEAR_SADDLE = [
+    (0.21176470588235294, 3.103921568627451),
+    (0.3529411764705882, 3.1509803921568627),
+    (0.4235294117647059, 3.1823529411764704),
+]
+
+
+@pytest.mark.parametrize("kappa, energy", NEAR_SADDLE)
+def test_librations_by_a_saddle_reach_1e_13_against_50_digits(kappa, energy):
+    import reference
+
+    (truth,) = reference.reference(0.5, 3.0, 0.5, 0.5, kappa, energy)
+    c = {"alpha": 0.5, "beta": 3.0, "kappa": kappa, "energy": energy, "theta": float(truth.theta_min)}
+    comp = cell(c, 1e-13)
+    where = f"kappa {kappa} energy {energy}"
+    assert comp["status"] == "ok", where
+    assert abs(comp["period"] - float(truth.period)) <= comp["errors"]["period"] <= 1e-13 * comp["period"], where
+    assert abs(comp["rotation_number"] - float(truth.rotation_number)) <= comp["errors"]["rotation_number"] <= 1e-13, where
+
+
 def test_ode_method_is_honest_where_it_converges():
     """The ODE method's estimates cover its true error on the regular cells."""
     for c in truth_cells():

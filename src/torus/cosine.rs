@@ -8,7 +8,7 @@
 use super::{
     at_level_floor, interleave, level_error, root_of_ratio, sample, weighted, Component,
     Convergence, DriftEstimate, EffectivePotential, NodeSample, PeriodIntegrals, Piece, EPS,
-    HIDDEN_PEAK, LEVEL_FLOOR,
+    HIDDEN_PEAK, INTEGRAND_ROUNDING, LEVEL_FLOOR,
 };
 use crate::body::{Angle, Shape};
 use crate::dd::CompensatedSum;
@@ -114,6 +114,11 @@ fn integrate_on<S: Shape>(
     if least > LAST_INTERVALS {
         return Ok(Err(0));
     }
+    // The gaps in double first; in double-double (where the piece's ends allow it) only
+    // once the rounding of the gaps is all that keeps the values from the tolerance.
+    let sharp = piece;
+    let plain = &piece.in_double();
+    let mut piece = plain;
     let Some(mut samples) = Samples::new(v, piece, map, energy, first_intervals(tol)) else {
         // (A node of the first level outside the allowed set: at most that level spent.)
         return Ok(Err(first_intervals(tol) + 1));
@@ -170,6 +175,35 @@ fn integrate_on<S: Shape>(
             d.error += phase * d.scale;
             d
         });
+        // Where the gaps' rounding is what keeps the converged sums from the tolerance, and
+        // the sums' rounding with every gap to a few ulps (½ (INTEGRAND_ROUNDING + 4 eps) of
+        // the L1 sizes of T and Δψ, over the whole period) would leave room for it: the nodes
+        // again, with the gaps in double-double.
+        if !done && std::ptr::eq(piece, plain) && sharp.left.sharp.is_some() {
+            let per_node = INTEGRAND_ROUNDING + 4.0 * EPS;
+            let floor_t = per_node * t_sums[0] + saddle_t;
+            let floor_psi = per_node * sums.psi_variation + saddle_psi;
+            let converged = samples.intervals >= least
+                && trusted
+                && t_error <= 0.5 * tol * period
+                && psi_error <= 0.5 * tol * TAU;
+            let blocked = extra_t > 0.5 * tol * period
+                || extra_psi > 0.5 * tol * TAU
+                || (with_drift && phase > 0.5 * tol);
+            let floor_phase = (floor_t - saddle_t) / period + floor_psi;
+            let within = floor_t <= 0.5 * tol * period
+                && floor_psi <= 0.5 * tol * TAU
+                && (!with_drift || floor_phase <= 0.5 * tol);
+            if converged && blocked && within {
+                piece = sharp;
+                let intervals = samples.intervals;
+                match Samples::new(v, piece, map, energy, intervals) {
+                    Some(resampled) => samples = resampled,
+                    None => return Ok(Err(samples.nodes.len() + intervals + 1)),
+                }
+                continue;
+            }
+        }
         let hopeless = samples.intervals >= LAST_INTERVALS
             || !reaches(samples.intervals, t_sums, 0.5 * tol * period)
             || !reaches(samples.intervals, psi_sums, 0.5 * tol * TAU);

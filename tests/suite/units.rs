@@ -640,4 +640,33 @@ mod double_double {
             assert!(error < 1e-28, "α = {alpha}: bound {error:e}");
         }
     }
+
+    /// A pair a few ulps off the unit circle (a rotation in double of a pair on it) scaled
+    /// onto it: the same as by the root and quotients, and on the circle to 1e-31.
+    #[test]
+    fn a_pair_is_scaled_onto_the_circle() {
+        for theta in [1e-8, 0.3, 1.2, 2.9, 3.1] {
+            let (s, c) = f64::sin_cos(theta);
+            let (ds, dc) = f64::sin_cos(0.7 * theta);
+            let (sin, cos) = (
+                DoubleDouble::from_f64(s)
+                    .mul_f64(dc)
+                    .add(DoubleDouble::from_f64(c).mul_f64(ds)),
+                DoubleDouble::from_f64(c)
+                    .mul_f64(dc)
+                    .sub(DoubleDouble::from_f64(s).mul_f64(ds)),
+            );
+            let (on_sin, on_cos) = DoubleDouble::onto_circle(sin, cos);
+            let radius = sin.mul(sin).add(cos.mul(cos)).sqrt();
+            let (sin_exact, cos_exact) = (sin.div(radius), cos.div(radius));
+            let one = on_sin
+                .mul(on_sin)
+                .add(on_cos.mul(on_cos))
+                .add_f64(-1.0)
+                .to_f64();
+            assert!(one.abs() < 1e-31, "θ = {theta}: s² + c² − 1 = {one:e}");
+            assert!(on_sin.sub(sin_exact).to_f64().abs() < 1e-31, "θ = {theta}");
+            assert!(on_cos.sub(cos_exact).to_f64().abs() < 1e-31, "θ = {theta}");
+        }
+    }
 }
