@@ -7,7 +7,7 @@
 //! cell-components per second for 1 and 2 threads, the median and the best of seven runs of
 //! each, interleaved in one process so that the ratio is meaningful on a shared machine (other
 //! load only ever slows a run down, so the best run is the machine's capacity and the median
-//! what a user sees). Then the price of accuracy (issue 23): the same slice, all outputs,
+//! what a user sees). Then the price of accuracy (issue 23): the same slice, each output set,
 //! 2 threads, at tol 1e-10, 1e-12, 1e-13 and 1e-14, seven interleaved runs each: the median
 //! time, its ratio to 1e-10's and the components `ok`. `cargo bench --bench cell_speed`.
 
@@ -79,32 +79,36 @@ fn main() {
         }
     }
     let tolerances = [1e-10, 1e-12, 1e-13, 1e-14];
-    let mut seconds = vec![Vec::new(); tolerances.len()];
-    let mut counts = vec![(0, 0); tolerances.len()];
-    for _ in 0..7 {
-        for (i, &tol) in tolerances.iter().enumerate() {
-            let options = CellOptions {
-                tol,
-                ..CellOptions::default()
-            };
-            let (components, not_ok, elapsed) = slice(2, &options);
-            counts[i] = (components, not_ok);
-            seconds[i].push(elapsed);
+    for (outputs, drift) in [("all outputs", true), ("N alone", false)] {
+        let mut seconds = vec![Vec::new(); tolerances.len()];
+        let mut counts = vec![(0, 0); tolerances.len()];
+        for _ in 0..7 {
+            for (i, &tol) in tolerances.iter().enumerate() {
+                let options = CellOptions {
+                    tol,
+                    drift,
+                    ..CellOptions::default()
+                };
+                let (components, not_ok, elapsed) = slice(2, &options);
+                counts[i] = (components, not_ok);
+                seconds[i].push(elapsed);
+            }
         }
-    }
-    let median = |times: &mut Vec<f64>| {
-        times.sort_by(f64::total_cmp);
-        times[times.len() / 2]
-    };
-    let base = median(&mut seconds[0]);
-    for ((tol, times), (components, not_ok)) in tolerances.iter().zip(&mut seconds).zip(counts) {
-        let time = median(times);
-        println!(
-            "all outputs, 2 threads, tol {tol:e}: {time:.3} s (median of 7), {:.2} x tol 1e-10, \
-             {} of {components} ok ({:.2} %)",
-            time / base,
-            components - not_ok,
-            100.0 * (components - not_ok) as f64 / components as f64
-        );
+        let median = |times: &mut Vec<f64>| {
+            times.sort_by(f64::total_cmp);
+            times[times.len() / 2]
+        };
+        let base = median(&mut seconds[0]);
+        for ((tol, times), (components, not_ok)) in tolerances.iter().zip(&mut seconds).zip(counts)
+        {
+            let time = median(times);
+            println!(
+                "{outputs}, 2 threads, tol {tol:e}: {time:.3} s (median of 7), {:.2} x tol 1e-10, \
+                 {} of {components} ok ({:.2} %)",
+                time / base,
+                components - not_ok,
+                100.0 * (components - not_ok) as f64 / components as f64
+            );
+        }
     }
 }
