@@ -508,7 +508,8 @@ impl Scene {
             return Err(reader.error(
                 "name",
                 format!(
-                    "{name:?} must be non-empty and use only ASCII letters, digits, '-', '_' and '.'"
+                    "{name:?} must be non-empty, use only ASCII letters, digits, '-', '_' and \
+                     '.', and not start with '.'"
                 ),
             ));
         }

@@ -18,7 +18,7 @@ use crate::error::{AtlasError, Result};
 use crate::family::{self, Family, Side};
 use crate::quadrature::{
     chebyshev_antiderivative, spectral_antiderivative, ChebyshevLevel, ChebyshevPiece,
-    IntervalNode, TanhSinhLevel, FINEST_LEVEL,
+    IntervalNode, TanhSinhLevel, FINEST_LEVEL, TAU_MAX,
 };
 use rustfft::num_complex::Complex;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
@@ -1171,7 +1171,9 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         let mut drift = None;
         if with_drift {
             // Rounding in T and Δψ enters the drift through the phases and the weights.
-            let phase = period_rounding / period.max(1e-300) + psi_rounding + saddle_psi;
+            // (And the tails of Δψ: a sweep by a pole cut short turns the rest of the path.)
+            let psi_tail = double * sum(&|s| s.tail(|n| n.dpsi));
+            let phase = period_rounding / period.max(1e-300) + psi_rounding + saddle_psi + psi_tail;
             let mut known = Vec::new();
             let mut result = drift_estimate(&samples, psi_advance, double, &mut known);
             for _ in 0..(MAX_LEVEL - START_LEVEL) {
@@ -2088,17 +2090,13 @@ impl PieceSamples {
         self.sum(stride_exp, |n| n.dpsi)
     }
 
-    /// Error of the sum of `f`: see [`level_error`]; for tanh-sinh plus the tail beyond
-    /// |τ| = TAU_MAX, for Clenshaw–Curtis with the geometric rate trusted where a fourth
-    /// level shows one rate ([`cosine::single_rate`]).
+    /// Error of the sum of `f`: see [`level_error`]; for tanh-sinh plus the tails beyond
+    /// |τ| = TAU_MAX ([`Self::tail`]), for Clenshaw–Curtis with the geometric rate trusted
+    /// where a fourth level shows one rate ([`cosine::single_rate`]).
     fn error(&self, f: impl Fn(&NodeSample) -> f64) -> f64 {
         let sums = [self.sum(0, &f), self.sum(1, &f), self.sum(2, &f)];
         match self.rule {
-            Rule::TanhSinh => {
-                let tail = TanhSinhLevel::new(self.level).step
-                    * (f(&self.nodes[0]).abs() + f(self.nodes.last().unwrap()).abs());
-                level_error(sums, Convergence::Unknown) + tail
-            }
+            Rule::TanhSinh => level_error(sums, Convergence::Unknown) + self.tail(f),
             Rule::Chebyshev(_) => {
                 let rate = if self.level >= 4 && cosine::single_rate(self.sum(3, &f), sums) {
                     Convergence::Geometric
@@ -2107,6 +2105,28 @@ impl PieceSamples {
                 };
                 level_error(sums, rate)
             }
+        }
+    }
+
+    /// Bound on the integral of `f` beyond the tanh-sinh rule's last nodes, |τ| > TAU_MAX
+    /// (0 for Clenshaw–Curtis, which covers its piece). Refining does not shrink it. Near an
+    /// end x ≈ L e^{−π sinh τ} and dx/dτ ≈ π cosh τ x; an integrand at most like x^{−1/2}
+    /// there (a turning point; bounded at the other ends) makes ln g, g = f dx/dτ, fall at
+    /// a rate of at least (π/2) cosh τ − 1, so the tail is at most
+    /// g(τ_max)/((π/2) cosh τ_max − 1), 1/41.9 of the last node's g (the leading terms of x
+    /// and f there are off by less than 1e-3 of them: the last node lies within 6e-38 L of
+    /// the end, a turning point at least 1e-30 L from its pole); a quarter more is taken.
+    /// Where a turning point lies by a pole (κ ≠ 0), Δψ's tail
+    /// is a share ~√(x_last/θ_end) of the sweep round it: 1e-10 of N at κ = 1e-18, where
+    /// the step times g (1/1024 of g at level 10) had put N's error at 2.7e-11 (adversary
+    /// pass of issue 22, helper 11).
+    fn tail(&self, f: impl Fn(&NodeSample) -> f64) -> f64 {
+        match self.rule {
+            Rule::TanhSinh => {
+                let decay = FRAC_PI_2 * TAU_MAX.cosh() - 1.0;
+                1.25 * (f(&self.nodes[0]).abs() + f(self.nodes.last().unwrap()).abs()) / decay
+            }
+            Rule::Chebyshev(_) => 0.0,
         }
     }
 

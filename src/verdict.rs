@@ -490,7 +490,12 @@ fn fold_windows(body: &EllipsoidBody, set: &CriticalSet) -> Vec<FoldWindow> {
         .map_or(cusp.energy, |t| body.shape.potential(t));
     let mut out = Vec::new();
     let k0 = 0.5 * cusp.kappa;
-    if let Some(low) = EffectivePotential::new(body, k0).lowest_minimum() {
+    // (Not where the cusp is born, κ_c = 0 on the case line β² = 1 + α: a window from κ = 0
+    // has no N to trace; the wide one below covers it.)
+    let narrow = (k0 >= f64::MIN_POSITIVE)
+        .then(|| EffectivePotential::new(body, k0).lowest_minimum())
+        .flatten();
+    if let Some(low) = narrow {
         let top = cusp.energy + (cusp.energy - top_of_u).max(0.05 * cusp.energy);
         out.push(((k0, 1.5 * cusp.kappa + 0.05), (low, top), 24));
     }

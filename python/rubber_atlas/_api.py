@@ -150,6 +150,12 @@ def _numbers(name: str, value) -> np.ndarray:
         raise TypeError(f"{name} is None: give a number or an array of numbers")
     if isinstance(value, np.ma.MaskedArray) and np.ma.is_masked(value):
         raise ValueError(f"{name} has masked values: give only the cells to compute")
+    if isinstance(value, (list, tuple)):
+        # numpy reads a boolean among numbers as 0 or 1 ([0.8, True] is [0.8, 1.0]).
+        flagged = _first_boolean(value)
+        if flagged is not None:
+            index, x = flagged
+            raise TypeError(f"{name}{_at(index)} is {x!r}: give real numbers")
     try:
         array = np.asarray(value.values if isinstance(value, xr.DataArray) else value)
     except ValueError:
@@ -192,6 +198,18 @@ def _numbers(name: str, value) -> np.ndarray:
     if stored.shape == array.shape:
         return array.astype(np.float64)
     return np.broadcast_to(stored.astype(np.float64), array.shape)
+
+
+def _first_boolean(items, index: tuple = ()):
+    """The index and value of the first boolean in nested lists or tuples, else None."""
+    for i, x in enumerate(items):
+        if isinstance(x, (bool, np.bool_)):
+            return index + (i,), x
+        if isinstance(x, (list, tuple)):
+            found = _first_boolean(x, index + (i,))
+            if found is not None:
+                return found
+    return None
 
 
 def _real(name: str, value) -> float:
@@ -1896,6 +1914,10 @@ def _rotation_number(value) -> float:
     if not isinstance(value, str):
         return _real("rotation_number", value)
     try:
+        # (ASCII digits without '_' separators, as the command line reads them: Python's
+        # Fraction alone takes "1_0/7" as 10/7 and other scripts' digits.)
+        if not value.isascii() or "_" in value:
+            raise ValueError(value)
         return float(Fraction(value))
     except (ValueError, ZeroDivisionError, OverflowError):
         shown = repr(value) if len(value) <= 40 else repr(value[:30]) + f" … ({len(value)} characters)"

@@ -611,3 +611,15 @@ def test_a_long_double_beyond_float64_is_refused_not_made_infinite():
 
 def test_a_subnormal_nu_is_refused_naming_nu():
     refused(ValueError, lambda: ra.cells(0.5, 3.0, 1e-310, 0.5, kappa=0.8, energy=2.5), "invalid nu = ")
+
+
+def test_sixth_round_booleans_among_numbers_and_odd_digits_are_refused():
+    """numpy reads a boolean in a list of numbers as 0 or 1, and Python's Fraction reads
+    "1_0/7" as 10/7 and digits of other scripts: each was taken silently (adversary pass of
+    2026-11-27)."""
+    refused(TypeError, lambda: ra.cells(*BODY, kappa=[0.8, True], energy=2.5), "kappa[1]", "True")
+    refused(TypeError, lambda: ra.cells(*BODY, kappa=[[0.8], [np.True_]], energy=2.5), "kappa[1, 0]")
+    refused(TypeError, lambda: ra.verdict(alpha=[0.5, True], beta=3.0, nu=0.5, eta=0.5), "alpha[1]", "True")
+    for text in ("1_0/7", "\uff11/\uff17"):
+        refused(ValueError, lambda: ra.resonance(*BODY, text), "rotation_number")
+

@@ -125,6 +125,23 @@ fn the_papers_body_holds_and_uncovered_bodies_are_said_so() {
     assert!(v.evidence.rotation_number_range[1] <= 0.0);
 }
 
+/// On the case line β² = 1 + α the cusp is born at κ_c = 0. One ulp above it (β the double
+/// after √1.5 at α = 0.5, after √1.9 at α = 0.9) the fold search opened a resonance window
+/// from κ = 0, which it refused: the verdict failed with "invalid kappa_min = 0", an input
+/// the user never gave (adversary pass of issue 22). Now an answer, here undecided.
+#[test]
+fn a_body_an_ulp_beside_the_case_line_gets_a_verdict() {
+    for (alpha, beta) in [(0.5, 1.2247448713915892), (0.9, 1.3784048752090223)] {
+        assert!(beta * beta > 1.0 + alpha);
+        let (_, v) = judge(alpha, beta);
+        assert_eq!(v.case, Case::Two, "α = {alpha}");
+        assert!(
+            v.holds.is_none() || v.kappa_max.is_some(),
+            "α = {alpha}: {v:?}"
+        );
+    }
+}
+
 #[test]
 fn boundaries_stay_put_when_the_resolution_doubles() {
     let at = |resolution: usize| {
