@@ -1463,7 +1463,13 @@ def components(ds: xr.Dataset, alpha: float | None = None, beta: float | None = 
             raise NotInDataset(f"{shown} = {_shown(value)} is not a grid value{nearest}")
         index[name] = i
     with _reading(ds):
-        one = ds.isel(index).load()
+        try:
+            one = ds.isel(index).load()
+        except IndexError:
+            # xarray (2026.9) cannot index a lazily transposed file variable.
+            raise ValueError("this dataset's variables are read lazily in another order than the file's "
+                             "(a transpose) and xarray cannot index them so: load it first (ds.load()) or "
+                             "transpose after selecting") from None
     flags = {name: flag_names(ds[name]) for name in ("status", "motion", "family")
              if name in ds and "flag_values" in ds[name].attrs}
     out = []

@@ -623,3 +623,18 @@ def test_sixth_round_booleans_among_numbers_and_odd_digits_are_refused():
     for text in ("1_0/7", "\uff11/\uff17"):
         refused(ValueError, lambda: ra.resonance(*BODY, text), "rotation_number")
 
+
+
+def test_components_of_a_lazily_transposed_atlas_are_found_or_refused_in_one_line(slice_atlas):
+    """xarray cannot index a file variable it reads lazily in another order (an IndexError of
+    its own, with a traceback): the accessor says so in one line (an adversary pass)."""
+    with ra.open_atlas(slice_atlas) as atlas:
+        dims = [d for d in atlas["period"].dims if d != "component"]
+        cell = {d: float(atlas[d].values[-1]) for d in dims}
+        expected = atlas.load().rubber.components(**cell)
+    with ra.open_atlas(slice_atlas) as atlas:
+        flipped = atlas.transpose(*reversed(dims), "component")
+        try:
+            assert flipped.rubber.components(**cell) == expected
+        except ValueError:
+            refused(ValueError, lambda: flipped.rubber.components(**cell), "transpose")

@@ -72,6 +72,26 @@ def test_cells_of_a_profile_against_50_digit_values(case, tmp_path):
     assert crossed, f"{case}: joints {joints}"
 
 
+@pytest.mark.parametrize("energy", [0.414840889864706, 0.41484088982362055])
+@pytest.mark.parametrize("tol", [1e-13, 1e-14])
+def test_a_turning_point_just_past_a_joint_at_tight_tolerances(energy, tol, tmp_path):
+    """The egg's level 1e-12 … 1e-8 above V at a joint of its arcs: at tol ≤ 1e-13 the gaps
+    computed in double-double took the joint's U from the arc beyond it, and T came out
+    2.2e-11 off with status ok and an estimate of 3.4e-13 (an adversary pass); a profile's
+    gaps stay in double."""
+    alpha, nu, eta, kappa = -0.6033, 1.961, 0.2389, 1.31e-10
+    reference = ProfileCell(EGG, alpha, nu, eta, kappa).components(energy)
+    table = write_table(tmp_path, EGG)
+    args = [BIN, "cell", "--shape", "profile", "--profile", str(table), "--alpha", repr(alpha), "--nu", repr(nu),
+            "--eta", repr(eta), "--kappa", repr(kappa), "--energy", repr(energy), "--tol", repr(tol), "--json"]
+    comps = json.loads(subprocess.run(args, check=True, capture_output=True, text=True).stdout)["components"]
+    assert len(comps) == len(reference)
+    for got, ref in zip(comps, reference):
+        where = f"{energy} tol {tol}: {got} vs {ref}"
+        assert abs(got["period"] - ref.period) <= got["errors"]["period"], where
+        assert abs(got["rotation_number"] - ref.rotation_number) <= got["errors"]["rotation_number"], where
+
+
 def test_a_table_that_is_no_convex_meridian_is_refused_in_one_line(tmp_path):
     for rows, words in [
         ([[0, -1], [1, -0.5], [0.5, 0], [1, 0.5], [0, 1]], "not convex"),
