@@ -618,17 +618,6 @@ fn level_offset_error<S: Shape>(
     // as rounded, so a measured slope times δ (ε − V(e) itself, or its a-priori bound, which
     // counts an ulp of e times V′(e)) already holds that shift.
     let far = rates.iter().zip(&sites).filter(|((x, _), _)| *x > 0.1);
-    // An end near a pole at κ ≠ 0 is a passage by it, which sweeps ψ by up to π in a sliver
-    // of time: Δψ may be the small difference of two such sweeps (κ → 0 at high energy), and
-    // the rounding of each sweep — 29 eps π measured at ε = 3e4, κ = 4e-8 against 50 digits
-    // (whole-domain seed 77), where the nodes' ψ̇ spans 20 orders of magnitude — is allowed
-    // 64 eps π. (Counting π per passage in the crude level bound's scale as well sent more
-    // cells to the measured bound, 2 % slower on the standard slice, for no cell seen.)
-    let passages = if potential.kappa == 0.0 {
-        0.0
-    } else {
-        rates[..2].iter().filter(|(x, _)| *x <= 0.1).count() as f64
-    };
     // ‖Δψ‖ in the crude slope: |Δψ| + 2T max|ψ̇| (ends and bottom, away from the poles), or,
     // where the quadrature gives it and it is smaller (ψ̇ changing sign along the orbit),
     // ∫|ψ̇| dt + 2T max|ψ̇| at the ends (each sign of ψ̇ bounded like T, and the ends moving
@@ -645,7 +634,6 @@ fn level_offset_error<S: Shape>(
             .psi_variation
             .map_or(f64::INFINITY, |v| v + 2.0 * values.period * end_rate),
     );
-    let passage_rounding = 64.0 * eps * PI * passages;
     let psi_shift = 2.0
         * eps
         * values.period
@@ -685,7 +673,7 @@ fn level_offset_error<S: Shape>(
         };
         let tilted = EnergyErrors {
             period: tilt * values.period,
-            psi_advance: tilt * psi_scale + passage_rounding,
+            psi_advance: tilt * psi_scale,
             drift: tilt * drift_scale,
         };
         let crude = EnergyErrors {

@@ -116,11 +116,9 @@ pub fn bottom_rotation_number<S: Shape>(
     )
 }
 
-/// H(x) = (√B/J − 1) / sin²θ at cosθ = x: ((1 − ν)/η + (U′/sinθ)²) / (J (√B + J)).
+/// H = (√B/J − 1) / sin²θ at the angle `a`: ((1 − ν)/η + (U′/sinθ)²) / (J (√B + J)).
 #[inline]
-fn excess_ratio<S: Shape>(body: &Body<S>, x: f64) -> (f64, f64) {
-    let sin = ((1.0 - x) * (1.0 + x)).max(0.0).sqrt();
-    let a = Angle { sin, cos: x };
+fn excess_ratio<S: Shape>(body: &Body<S>, a: Angle) -> (f64, f64) {
     let red = body.reduction_at(a);
     let q = body.shape.potential_prime_over_sin_at(a);
     let num = (1.0 - body.nu) / body.eta + q * q;
@@ -142,7 +140,12 @@ fn first_intervals<S: Shape>(body: &Body<S>) -> usize {
 /// least [`first_intervals`] until a doubling changes the value by at most `abs_tol`; returns
 /// the value and a bound on its error: that last change (for a geometrically converging
 /// rule the error of the finer sum is far below it) plus the rounding of the sum.
-fn odd_part_integral<S: Shape>(body: &Body<S>, x0: f64, abs_tol: f64) -> Estimate {
+fn odd_part_integral<S: Shape>(
+    body: &Body<S>,
+    x0: f64,
+    one_minus_x0: f64,
+    abs_tol: f64,
+) -> Estimate {
     // A body symmetric about its equator has H(x) = H(−x): the odd part vanishes, exactly.
     // (The rule's first level alone, 8/β intervals, took 9 s at α = 0, β = 2e-155.)
     if body.shape.symmetric_about_equator() {
@@ -151,10 +154,24 @@ fn odd_part_integral<S: Shape>(body: &Body<S>, x0: f64, abs_tol: f64) -> Estimat
             error: 0.0,
         };
     }
+    // sinθ at cosθ = ±x₀ sin u from 1 − x = (1 − x₀) + x₀ (1 − sin u), with 1 − x₀ from λ
+    // (`one_minus_x0`) and 1 − sin u = 2 sin²((π/2 − u)/2), not from the rounded x₀ and x:
+    // next to a pole 1 − x would carry their rounding, u/(1 − x) relative (5e-13 at
+    // θ = 0.014), and N∞ varies fast with the turning point there (dN∞/dx₀ ≈ 160 at α 0.64,
+    // β 9.45, λ = 0.045, where one ulp of λ, flipping x₀'s last bit, moved N∞ by 1.8e-14
+    // against its bound of 2.9e-15, and far out the limit then replaced a right quadrature
+    // N by its own).
+    const FRAC_PI_2_LOW: f64 = 6.123233995736766e-17;
     let g = |u: f64| -> (f64, f64) {
         let s = u.sin();
-        let (hp, ep) = excess_ratio(body, x0 * s);
-        let (hm, em) = excess_ratio(body, -x0 * s);
+        let x = x0 * s;
+        let half = 0.5 * ((FRAC_PI_2 - u) + FRAC_PI_2_LOW);
+        let one_minus_s = 2.0 * half.sin() * half.sin();
+        let sin = ((one_minus_x0 + x0 * one_minus_s) * (1.0 + x))
+            .max(0.0)
+            .sqrt();
+        let (hp, ep) = excess_ratio(body, Angle { sin, cos: x });
+        let (hm, em) = excess_ratio(body, Angle { sin, cos: -x });
         (s * (hp - hm), s * (hp.abs() + hm.abs() + ep + em))
     };
     const MAX_INTERVALS: usize = 1 << 22;
@@ -438,6 +455,12 @@ fn turning_cosine(lambda: f64) -> f64 {
         .sqrt()
 }
 
+/// 1 − x₀ = (λ²/2)/(1 + x₀) to full relative precision (1 − x₀ from the rounded x₀ would
+/// carry its rounding, u/(1 − x₀) relative: 2e-13 at λ = 0.045).
+fn one_minus_turning_cosine(lambda: f64, x0: f64) -> f64 {
+    0.5 * lambda * lambda / (1.0 + x0)
+}
+
 /// The family of the tori at large κ (and of the high-energy limit at λ > 0, where κ = λ√ε
 /// → ∞): there the κ²/(2 sin²θ) term makes V a single well round θ = π/2, on the side U
 /// descends to (U′(π/2) < 0: θ > π/2, the well of σ_sπ for α > 0), or at π/2 itself for a
@@ -473,7 +496,12 @@ pub fn high_energy_rotation_number<S: Shape>(
             error: 0.0,
         });
     }
-    let integral = odd_part_integral(body, x0, 0.25 * tol / factor);
+    let integral = odd_part_integral(
+        body,
+        x0,
+        one_minus_turning_cosine(lambda, x0),
+        0.25 * tol / factor,
+    );
     Ok(Estimate {
         value: factor * integral.value,
         error: factor * integral.error + 4.0 * f64::EPSILON * (factor * integral.value).abs(),
@@ -500,7 +528,7 @@ pub fn normalized_high_energy_rotation_number<S: Shape>(
 /// lim N∞(λ)/λ as λ → 0: how N tends to 0 at fixed κ as ε → ∞ (N ≈ slope · κ/√ε).
 pub fn high_energy_slope<S: Shape>(body: &Body<S>, tol: f64) -> Estimate {
     let factor = 1.0 / (SQRT_2 * PI);
-    let integral = odd_part_integral(body, 1.0, 0.25 * tol / factor);
+    let integral = odd_part_integral(body, 1.0, 0.0, 0.25 * tol / factor);
     Estimate {
         value: factor * integral.value,
         error: factor * integral.error,
@@ -537,10 +565,16 @@ const EXTREMA_SCAN: usize = 96;
 /// N∞(λ) and Ñ(λ) from one integral, each to the absolute accuracy `tol`.
 pub fn high_energy_pair<S: Shape>(body: &Body<S>, lambda: f64, tol: f64) -> (Estimate, Estimate) {
     // At λ = √2 the limit x₀ → 0, approached as NORMALIZED_END says.
-    let x0 = turning_cosine(lambda).max(NORMALIZED_END);
+    let exact = turning_cosine(lambda);
+    let x0 = exact.max(NORMALIZED_END);
+    let one_minus_x0 = if x0 == exact {
+        one_minus_turning_cosine(lambda, x0)
+    } else {
+        1.0 - x0
+    };
     let c = SQRT_2 * PI;
     // Ñ = I/(c x₀) and N∞ = λ x₀ I / c = λ x₀² Ñ: I to c x₀ tol/4 serves both.
-    let i = odd_part_integral(body, x0, 0.25 * c * x0 * tol);
+    let i = odd_part_integral(body, x0, one_minus_x0, 0.25 * c * x0 * tol);
     let tilde = Estimate {
         value: i.value / (c * x0),
         error: i.error / (c * x0),

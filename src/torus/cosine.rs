@@ -141,7 +141,13 @@ fn integrate_on<S: Shape>(
         // reduce (when those alone exceed it, a tenth of them: the status then says so).
         let (saddle_t, saddle_psi) = v.saddle_conditioning(energy, component, period, 2.0, 0.0);
         let extra_t = 2.0 * sums.t_rounding + saddle_t;
-        let extra_psi = 2.0 * sums.psi_rounding + saddle_psi;
+        // (The plain map places its nodes by a pole to an ulp of their distance from it: its
+        // passages are in the nodes' rounding bound.)
+        let passage_error = match map {
+            Map::Plain { .. } => 0.0,
+            Map::Mercator { .. } => v.passage_rounding(component),
+        };
+        let extra_psi = 2.0 * sums.psi_rounding + saddle_psi + passage_error;
         let budget = |allowed: f64, extra: f64| (allowed - extra).max(0.1 * extra);
         // Where the differences may be taken as the error: the plain map's (one geometric
         // strip); the Mercator map's only where its last four levels show one rate and the
@@ -165,7 +171,8 @@ fn integrate_on<S: Shape>(
         let period_error = t_error + extra_t;
         let psi_advance_error = psi_error + extra_psi;
         // Rounding in T and Δψ enters the drift through the phases and the weights.
-        let phase = (extra_t - saddle_t) / period + extra_psi;
+        // (Not the passages' term: the drift's phases left it out before it moved here.)
+        let phase = (extra_t - saddle_t) / period + extra_psi - passage_error;
         // The drift (the costly part) only once T and Δψ have converged.
         let drift = (done && with_drift).then(|| samples.drift(rate));
         done &= drift.is_none_or(|d| {
@@ -182,7 +189,7 @@ fn integrate_on<S: Shape>(
         if !done && std::ptr::eq(piece, plain) && sharp.left.sharp.is_some() {
             let per_node = INTEGRAND_ROUNDING + 4.0 * EPS;
             let floor_t = per_node * t_sums[0] + saddle_t;
-            let floor_psi = per_node * sums.psi_variation + saddle_psi;
+            let floor_psi = per_node * sums.psi_variation + saddle_psi + passage_error;
             let converged = samples.intervals >= least
                 && trusted
                 && t_error <= 0.5 * tol * period
@@ -190,7 +197,7 @@ fn integrate_on<S: Shape>(
             let blocked = extra_t > 0.5 * tol * period
                 || extra_psi > 0.5 * tol * TAU
                 || (with_drift && phase > 0.5 * tol);
-            let floor_phase = (floor_t - saddle_t) / period + floor_psi;
+            let floor_phase = (floor_t - saddle_t) / period + floor_psi - passage_error;
             let within = floor_t <= 0.5 * tol * period
                 && floor_psi <= 0.5 * tol * TAU
                 && (!with_drift || floor_phase <= 0.5 * tol);

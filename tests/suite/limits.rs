@@ -306,3 +306,31 @@ fn a_peak_of_one_over_j_below_the_rounding_of_u_has_no_error_bound() {
         }
     }
 }
+
+/// N∞ at λ and at the doubles either side agree within their bounds, and with the cell far
+/// out (ε = 2.3e215) at that λ. Next to a pole N∞ varies fast with the turning point
+/// (dN∞/dx₀ ≈ 160 here), and x₀ = cos θ₀ was rounded before 1 − x₀ was formed: one ulp of λ,
+/// flipping x₀'s last bit, moved N∞ by 1.8e-14 against bounds of 2.9e-15, and the far-out
+/// cell took that limit in place of its own right N (`cells_far_out_agree_…` found it).
+#[test]
+fn the_high_energy_limit_holds_its_turning_point_to_the_last_bit() {
+    let body =
+        rubber_atlas::EllipsoidBody::ellipsoid(0.644703252968516, 9.449489989652935, 0.5, 0.5)
+            .unwrap();
+    let lambda = 0.04464148436958257f64;
+    let at = |l: f64| high_energy_rotation_number(&body, l, 1e-13).unwrap();
+    let here = at(lambda);
+    for step in [-2i64, -1, 1, 2] {
+        let next = at(f64::from_bits((lambda.to_bits() as i64 + step) as u64));
+        assert!(
+            (here.value - next.value).abs() <= here.error + next.error,
+            "{here:?} against {next:?}"
+        );
+    }
+    let energy = 2.3362802872509113e215f64;
+    let (n, error) = cell_n(&body, lambda * energy.sqrt(), energy);
+    assert!(
+        (n - here.value).abs() <= error + here.error,
+        "{n} ± {error:e} against {here:?}"
+    );
+}
