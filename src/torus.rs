@@ -351,9 +351,8 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
     /// integrands measure V from an end's pair of rounded sine and cosine), where the shape
     /// gives U so ([`Shape::potential_double_double`]).
     pub fn value_double_double(&self, a: Angle) -> Option<(DoubleDouble, f64)> {
-        let (sin, cos) = (DoubleDouble::from_f64(a.sin), DoubleDouble::from_f64(a.cos));
-        let radius = sin.mul(sin).add(cos.mul(cos)).sqrt();
-        self.value_double_double_on_circle(sin.div(radius), cos.div(radius))
+        let (sin, cos) = on_circle(a);
+        self.value_double_double_on_circle(sin, cos)
     }
 
     /// [`Self::value_double_double`] at the angle whose sine and cosine are `sin` and `cos`
@@ -1717,10 +1716,7 @@ impl<S: Shape> EffectivePotential<'_, S> {
             return;
         }
         for end in pieces.iter_mut().flat_map(|p| [&mut p.left, &mut p.right]) {
-            let (sin, cos) = DoubleDouble::onto_circle(
-                DoubleDouble::from_f64(end.angle.sin),
-                DoubleDouble::from_f64(end.angle.cos),
-            );
+            let (sin, cos) = on_circle(end.angle);
             end.sharp = self
                 .value_double_double_on_circle(sin, cos)
                 .map(|(value, error)| SharpEnd {
@@ -2443,6 +2439,11 @@ fn sharp_gap<S: Shape>(
     let gap = sharp.level.add_f64(tilt).sub(value).to_f64();
     let bound = excess_error + sharp.error + error + EPS * (tilt.abs() + 2.0 * gap.abs());
     Some((gap, bound))
+}
+
+/// The (sine, cosine) pair of `a` in double-double, scaled onto the unit circle.
+fn on_circle(a: Angle) -> (DoubleDouble, DoubleDouble) {
+    DoubleDouble::onto_circle(DoubleDouble::from_f64(a.sin), DoubleDouble::from_f64(a.cos))
 }
 
 /// √(a·b/c) for a, b, c > 0, also where the quotient overflows (B = 1/η + |r|² up to

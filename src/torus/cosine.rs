@@ -116,10 +116,15 @@ fn integrate_on<S: Shape>(
     }
     // The gaps in double first; in double-double (where the piece's ends allow it) only
     // once the rounding of the gaps is all that keeps the values from the tolerance.
-    let sharp = piece;
-    let plain = &piece.in_double();
-    let mut piece = plain;
-    let Some(mut samples) = Samples::new(v, piece, map, energy, first_intervals(tol)) else {
+    let plain = piece.in_double();
+    let mut resampled = false;
+    // (The plain map places its nodes by a pole to an ulp of their distance from it: its
+    // passages are in the nodes' rounding bound.)
+    let passage_error = match map {
+        Map::Plain { .. } => 0.0,
+        Map::Mercator { .. } => v.passage_rounding(component),
+    };
+    let Some(mut samples) = Samples::new(v, &plain, map, energy, first_intervals(tol)) else {
         // (A node of the first level outside the allowed set: at most that level spent.)
         return Ok(Err(first_intervals(tol) + 1));
     };
@@ -141,13 +146,8 @@ fn integrate_on<S: Shape>(
         // reduce (when those alone exceed it, a tenth of them: the status then says so).
         let (saddle_t, saddle_psi) = v.saddle_conditioning(energy, component, period, 2.0, 0.0);
         let extra_t = 2.0 * sums.t_rounding + saddle_t;
-        // (The plain map places its nodes by a pole to an ulp of their distance from it: its
-        // passages are in the nodes' rounding bound.)
-        let passage_error = match map {
-            Map::Plain { .. } => 0.0,
-            Map::Mercator { .. } => v.passage_rounding(component),
-        };
-        let extra_psi = 2.0 * sums.psi_rounding + saddle_psi + passage_error;
+        let nodes_psi = 2.0 * sums.psi_rounding + saddle_psi;
+        let extra_psi = nodes_psi + passage_error;
         let budget = |allowed: f64, extra: f64| (allowed - extra).max(0.1 * extra);
         // Where the differences may be taken as the error: the plain map's (one geometric
         // strip); the Mercator map's only where its last four levels show one rate and the
@@ -172,7 +172,7 @@ fn integrate_on<S: Shape>(
         let psi_advance_error = psi_error + extra_psi;
         // Rounding in T and Δψ enters the drift through the phases and the weights.
         // (Not the passages' term: the drift's phases left it out before it moved here.)
-        let phase = (extra_t - saddle_t) / period + extra_psi - passage_error;
+        let phase = (extra_t - saddle_t) / period + nodes_psi;
         // The drift (the costly part) only once T and Δψ have converged.
         let drift = (done && with_drift).then(|| samples.drift(rate));
         done &= drift.is_none_or(|d| {
@@ -186,10 +186,11 @@ fn integrate_on<S: Shape>(
         // the sums' rounding with every gap to a few ulps (½ (INTEGRAND_ROUNDING + 4 eps) of
         // the L1 sizes of T and Δψ, over the whole period) would leave room for it: the nodes
         // again, with the gaps in double-double.
-        if !done && std::ptr::eq(piece, plain) && sharp.left.sharp.is_some() {
+        if !done && !resampled && piece.left.sharp.is_some() {
             let per_node = INTEGRAND_ROUNDING + 4.0 * EPS;
             let floor_t = per_node * t_sums[0] + saddle_t;
-            let floor_psi = per_node * sums.psi_variation + saddle_psi + passage_error;
+            let floor_nodes_psi = per_node * sums.psi_variation + saddle_psi;
+            let floor_psi = floor_nodes_psi + passage_error;
             let converged = samples.intervals >= least
                 && trusted
                 && t_error <= 0.5 * tol * period
@@ -197,12 +198,12 @@ fn integrate_on<S: Shape>(
             let blocked = extra_t > 0.5 * tol * period
                 || extra_psi > 0.5 * tol * TAU
                 || (with_drift && phase > 0.5 * tol);
-            let floor_phase = (floor_t - saddle_t) / period + floor_psi - passage_error;
+            let floor_phase = (floor_t - saddle_t) / period + floor_nodes_psi;
             let within = floor_t <= 0.5 * tol * period
                 && floor_psi <= 0.5 * tol * TAU
                 && (!with_drift || floor_phase <= 0.5 * tol);
             if converged && blocked && within {
-                piece = sharp;
+                resampled = true;
                 let intervals = samples.intervals;
                 match Samples::new(v, piece, map, energy, intervals) {
                     Some(resampled) => samples = resampled,
@@ -252,7 +253,8 @@ fn integrate_on<S: Shape>(
         if hopeless {
             return Ok(Err(samples.nodes.len()));
         }
-        let at = |node| sample(v, piece, energy, node);
+        let current = if resampled { piece } else { &plain };
+        let at = |node| sample(v, current, energy, node);
         if samples.refine(map, at).is_err() {
             return Ok(Err(samples.nodes.len()));
         }
