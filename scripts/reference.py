@@ -93,6 +93,22 @@ class Cell:
         """Where U″ jumps (none on the ellipsoid): the integrals are cut there."""
         return []
 
+    def splits(self) -> list[Point]:
+        """Where the integrals are cut besides the critical points: the kinks, and about each
+        zero of U (where 1/J peaks, as narrowly as √((cos²θ + ν sin²θ)/η)/|U′|: a disk with
+        α = 68, η = 3805 had its N 1e-9 off from a quadrature that stepped over the peak)."""
+        with mpmath.workdps(self.digits):
+            points = list(self.kinks())
+            for zero in self.potential_zeros():
+                for offset in _PEAK_OFFSETS:
+                    if 0 < zero + offset < mpmath.pi:
+                        points.append(at(zero + offset))
+            return sorted(points, key=lambda p: p.theta)
+
+    def potential_zeros(self) -> list:
+        """θ in (0, π) where U = 0 (none on the ellipsoid, whose U is positive)."""
+        return []
+
     # Critical points.
     def _scan(self):
         """Scan points in (0, π) as chart points: log-spaced towards both poles, uniform between."""
@@ -258,7 +274,7 @@ class Cell:
     def _integrate(self, e, lo: Point, hi: Point, interior, ends: bool = True):
         """(T, Δψ, error T, error Δψ) of a libration between turning points lo < hi: twice the
         integrals over [θ_min, θ_max], split at interior critical points and π/2."""
-        kinks = [k for k in self.kinks() if lo.theta < k.theta < hi.theta]
+        kinks = [k for k in self.splits() if lo.theta < k.theta < hi.theta]
         cuts = sorted([lo] + list(interior) + kinks + [hi], key=lambda p: p.theta)
         half = Point(mpmath.pi / 2, 0)
         if lo.theta < mpmath.pi / 2 < hi.theta and all(abs(c.theta - mpmath.pi / 2) > 1e-20 for c in cuts):
@@ -379,6 +395,19 @@ class EdgedCell(Cell):
                 kinks.append(at(mpmath.pi - theta_c))
             return kinks
 
+    def potential_zeros(self) -> list:
+        with mpmath.workdps(self.digits):
+            h, rho, a = self.cut, self.rho, self.alpha
+            if self.kind == "disk":
+                parts = [(rho, a, 0, 0, mpmath.pi)]
+            else:
+                theta_c = mpmath.acos(h)
+                parts = [(rho, h + a, 0, 0, theta_c), (0, a, 1, theta_c, mpmath.pi)]
+                if self.kind == "wheel":
+                    parts[1] = (0, a, 1, theta_c, mpmath.pi - theta_c)
+                    parts.append((rho, a - h, 0, mpmath.pi - theta_c, mpmath.pi))
+            return [z for p, q, r, lo, hi in parts for z in _trig_zeros(p, q, r, lo, hi)]
+
 
 class ProfileCell(EdgedCell):
     """V of one (body, κ) of a profile (docs/bodies.md, "Your own body"): the arc spline through
@@ -415,6 +444,35 @@ class ProfileCell(EdgedCell):
     def kinks(self) -> list[Point]:
         with mpmath.workdps(self.digits):
             return [at(arc[1]) for arc in self.arcs[:-1]]
+
+    def potential_zeros(self) -> list:
+        with mpmath.workdps(self.digits):
+            return [
+                z
+                for lo, hi, r, rho_c, z_c in self.arcs
+                for z in _trig_zeros(rho_c, -(z_c - self.alpha), r, lo, hi)
+            ]
+
+
+# Cuts about a zero of U (`Cell.splits`): at it and on a geometric ladder either side, so that
+# the peak of 1/J there, however narrow, lies at the ends of pieces, where the nodes crowd.
+_PEAK_OFFSETS = [0] + [sign * mpmath.mpf(10) ** (-k / 2) for k in range(3, 13) for sign in (-1, 1)]
+
+
+def _trig_zeros(a, b, r, lo, hi) -> list:
+    """The θ in (lo, hi) where a sinθ + b cosθ + r = 0."""
+    size = mpmath.sqrt(a * a + b * b)
+    if size == 0 or abs(r) > size:
+        return []
+    phase = mpmath.atan2(b, a)
+    base = mpmath.asin(-r / size)
+    found = []
+    for theta in (base - phase, mpmath.pi - base - phase):
+        for turns in (-1, 0, 1):
+            x = theta + 2 * mpmath.pi * turns
+            if lo < x < hi:
+                found.append(x)
+    return found
 
 
 def _same(x, y) -> bool:

@@ -424,7 +424,14 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         } else {
             // (κ/sinθ)² keeps κ² from underflowing at |κ| < 1e-154.
             let w = self.kappa / a.sin;
-            -w * w * (a.cos / a.sin) + up
+            let cot = a.cos / a.sin;
+            // (Where (κ/sinθ)² alone would underflow, cotθ first: by a pole it is large.)
+            let wall = if w.abs() < 1e-150 {
+                w * (w * cot)
+            } else {
+                w * w * cot
+            };
+            -wall + up
         }
     }
 
@@ -567,7 +574,17 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         // so that close pairs (near the cusp, tangencies) are not lost between scan nodes.
         // Both are evaluated divided by a power of sinθ (V′ = g/sin³θ, g′/sin²θ), which
         // keeps their signs and keeps κ² from underflowing.
-        let g = |a: Angle| self.slope(a);
+        // Where the wall's (κ/sinθ)² cotθ underflows (|κ| < 1e-154 away from the poles) and
+        // U′ is exactly 0 (a homogeneous sphere), V′ rounds to 0 at every site, and each site
+        // was taken for a critical point (3193 of them at κ = 1e-300; a sphere given as a
+        // profile then had 11 separatrix components): there the sign of V′ is the wall's,
+        // that of −cosθ.
+        let g = |a: Angle| match self.slope(a) {
+            0.0 if self.kappa != 0.0 && shape.potential_prime_at(a) == 0.0 => {
+                -a.cos * f64::MIN_POSITIVE
+            }
+            slope => slope,
+        };
         let dg = |a: Angle| {
             let w = self.kappa / a.sin;
             w * w * a.sin
@@ -2519,9 +2536,16 @@ fn divided_difference<S: Shape>(
         if sines > 1e-100 && v.kappa.abs() > 1e-100 {
             -v.kappa * v.kappa * sin_sum / (2.0 * sines * sines)
         } else {
-            // −½ (κ/sin e)(κ/sin t)(sin(t + e)/sin e)/sin t: no under- or overflow for angles
-            // near a pole at the tiniest κ.
-            -0.5 * (v.kappa / e.sin) * (v.kappa / t.sin) * (sin_sum / e.sin) / t.sin
+            // κ² and the sines' product with their binary exponents apart, so that neither
+            // under- nor overflows where the whole is a double: near a pole at the tiniest κ,
+            // and at κ = 1e-200 by a turning point at 1e-50 (a sphere of radius 1e-300 given
+            // as a profile), where (κ/sin e)(κ/sin t) = 1e-350 rounded to 0 and the turning
+            // point came out at 2.7e-58.
+            let (mk, ek) = libm::frexp(v.kappa);
+            let (me, ee) = libm::frexp(e.sin);
+            let (mt, et) = libm::frexp(t.sin);
+            let q = mk / (me * mt);
+            -0.5 * libm::scalbn(q * q * sin_sum, 2 * (ek - ee - et))
         }
     };
     (dk + du, dk.abs() + du_scale)

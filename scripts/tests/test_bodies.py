@@ -407,3 +407,31 @@ def test_planar_motions_of_edged_bodies_against_50_digit_values(case):
             assert got["status"] == "ok" and got["rotation_number"] == 0.0, where
             assert ref.period_error < 1e-25, ref
             assert abs(got["period"] - ref.period) <= got["errors"]["period"] <= tol * ref.period, where
+
+
+# Disks whose U = sinθ + α cosθ crosses 0 under a large η: 1/J peaks there, as narrowly as
+# √((cos²θ + ν sin²θ)/η)/|U′| (down to 5e-4), and a reference quadrature that is not cut there
+# steps over it (N 1e-9 off at the first, its own error bar 1e-27). (shape, α, ν, η, κ, ε, tol)
+NARROW_PEAKS = [
+    ("disk", 68.1761, 0.1523, 3805.0, 0.006834, 2102.71443018, 1e-10),
+    ("disk", -6.59146, 0.02207, 1032.0, 0.002454, 17.5938006046, 1e-13),
+    ("disk", 9.53415, 0.01281, 799.1, 0.1303, 368798.352348, 1e-10),
+    ("disk", 45.0472, 0.02447, 306.6, 0.002183, 428.165607889, 1e-13),
+]
+
+
+@pytest.mark.parametrize("case", NARROW_PEAKS, ids=[f"{c[0]}-{c[1]}" for c in NARROW_PEAKS])
+def test_a_narrow_peak_of_1_over_j_against_a_reference_cut_there(case):
+    """The reference cuts its integrals at each zero of U (and on a ladder either side), as
+    the solver does where the peak is narrow: the two agree within the solver's estimates."""
+    shape, alpha, nu, eta, kappa, energy, tol = case
+    cell = EdgedCell(shape, alpha, 0, nu, eta, kappa)
+    assert cell.potential_zeros(), case
+    reference = cell.components(energy)
+    comps = run_cell(shape, alpha, None, nu, eta, kappa, energy, tol)["components"]
+    assert len(comps) == len(reference), (comps, reference)
+    for got, ref in zip(comps, reference):
+        where = f"{case}: {got} vs {ref}"
+        assert ref.period_error < 1e-25 and ref.rotation_error < 1e-25, ref
+        assert abs(got["period"] - ref.period) <= got["errors"]["period"], where
+        assert abs(got["rotation_number"] - ref.rotation_number) <= got["errors"]["rotation_number"], where

@@ -633,3 +633,61 @@ fn the_zeros_of_the_slope_are_the_shapes() {
     }
     assert!(found >= 8, "{found} zeros");
 }
+
+/// A homogeneous sphere, as the ellipsoid β = 1 and as a table of three points, at tiny κ:
+/// where (κ/sinθ)² underflows away from the poles V′ rounds to 0 there, and every scan site
+/// was taken for a critical point (3193 of them; the table's sphere then had 11 `separatrix`
+/// components at ε = U). The one well stays at θ = π/2. Scaled to a radius of 1e-300 (U =
+/// 1e-300, ε − U = ½e-300), the wall κ²/(2 sin²θ) puts the turning point at sinθ = κ/1e-150
+/// exactly, and T = 2π √(B/(2(ε − U))) with B = 1/η + U² (the wall's share is below 1e-100),
+/// where the divided difference of the wall, (κ/sin e)(κ/sin t) = 1e-350, had rounded to 0
+/// and put the turning point at 2.7e-58 (T 4e7 times short).
+#[test]
+fn a_sphere_at_the_tiniest_kappa_has_one_well_at_the_equator() {
+    fn one_well<S: Shape>(body: &Body<S>) {
+        for kappa in [1e-300, 1e-200, 1e-160] {
+            let critical = EffectivePotential::new(body, kappa)
+                .critical_points()
+                .to_vec();
+            assert_eq!(
+                critical.len(),
+                1,
+                "κ = {kappa:e}: {} critical points",
+                critical.len()
+            );
+            assert_eq!(critical[0].site.theta, std::f64::consts::FRAC_PI_2);
+            let cell = solve_cell(body, kappa, 1.0, &CellOptions::default()).unwrap();
+            assert_eq!(cell.components.len(), 1, "κ = {kappa:e} at ε = U: {cell:?}");
+        }
+    }
+    let sphere = |radius: f64| {
+        let table = vec![vec![0.0, -radius], vec![radius, 0.0], vec![0.0, radius]];
+        Body::new(profile_shape(&table, 0.0), 1.0, 2.5).unwrap()
+    };
+    one_well(&Body::new(Ellipsoid::new(0.0, 1.0).unwrap(), 1.0, 2.5).unwrap());
+    one_well(&sphere(1.0));
+    let tiny = sphere(1e-300);
+    for kappa in [1e-300, 1e-200] {
+        let cell = solve_cell(&tiny, kappa, 1.5e-300, &CellOptions::default()).unwrap();
+        assert_eq!(cell.components.len(), 1, "{cell:?}");
+        let c = &cell.components[0];
+        let expected_min = kappa / 1e-150;
+        assert!(
+            (c.theta_min - expected_min).abs() <= 1e-14 * expected_min,
+            "κ = {kappa:e}: θ_min {} (expected {expected_min:e})",
+            c.theta_min
+        );
+        let period = TAU * (0.4f64 / 1e-300).sqrt();
+        assert!(
+            (c.period - period).abs() <= 1e-13 * period,
+            "κ = {kappa:e}: T = {:e}, expected {period:e}",
+            c.period
+        );
+        assert!(
+            (c.period - period).abs() <= c.errors.period,
+            "κ = {kappa:e}: T off by {:e}, estimate {:e}",
+            (c.period - period).abs(),
+            c.errors.period
+        );
+    }
+}
