@@ -21,7 +21,9 @@ use crate::quadrature::{
     IntervalNode, TanhSinhLevel, FINEST_LEVEL, TAU_MAX,
 };
 use rustfft::num_complex::Complex;
+use std::cell::OnceCell;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
+use std::sync::OnceLock;
 
 mod cosine;
 
@@ -230,6 +232,9 @@ pub struct EffectivePotential<'a, S: Shape> {
     /// The dips of B = 1/η + U² + U′² ([`EffectivePotential::dip_width`]): (θ, width) at
     /// each zero of U′ in (0, π) where B has a minimum.
     dips: Vec<(f64, f64)>,
+    /// The angles in (0, π) where the integrals are split ([`Self::splits_inside`]), found
+    /// once.
+    split_angles: Vec<f64>,
 }
 
 /// Number of scan cells for critical points; between scan nodes the pole-free function
@@ -245,6 +250,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             kappa,
             critical: Vec::new(),
             dips: Vec::new(),
+            split_angles: Vec::new(),
         };
         v.critical = v.find_critical_points();
         v.dips = body
@@ -254,6 +260,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             .map(|zero| (zero, v.dip_width(zero)))
             .filter(|(_, width)| width.is_finite())
             .collect();
+        v.split_angles = v.find_split_angles();
         v
     }
 
@@ -1107,9 +1114,9 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             // Half of the tolerance for the quadrature, half left for rounding (which the
             // refinement cannot reduce).
             let misses = |sample: &PieceSamples| {
-                sample.error(|n| n.dt)
+                sample.error(DT)
                     > (0.5 * tol * sample.period(0)).max(0.1 * floor_t * share / double)
-                    || double * sample.error(|n| n.dpsi) / TAU
+                    || double * sample.error(DPSI) / TAU
                         > (0.5 * tol * share).max(0.1 * floor_psi * share / TAU)
             };
             // By a pole the tanh-sinh levels must also show one rate: their sums can converge
@@ -1148,8 +1155,8 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         };
         let period = double * sum(&|s| s.period(0));
         let psi_advance = double * sum(&|s| s.psi(0));
-        let mut period_error = double * sum(&|s| s.error(|n| n.dt));
-        let mut psi_advance_error = double * sum(&|s| s.error(|n| n.dpsi));
+        let mut period_error = double * sum(&|s| s.error(DT));
+        let mut psi_advance_error = double * sum(&|s| s.error(DPSI));
         let period_rounding = double * sum(&|s| s.rounding(|n| n.dt));
         let psi_rounding = double * sum(&|s| s.rounding(|n| n.dpsi));
         let psi_variation = double * sum(&|s| s.sum(0, |n| n.dpsi.abs()));
@@ -1395,6 +1402,11 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
     /// differences cannot see a peak far narrower than its steps: a disk with α = −72.7,
     /// η = 217 (width 5e-4) had N off by 4× its estimate.
     pub fn splits_inside(&self, lower: f64, upper: f64) -> Vec<Site> {
+        lifted_inside(&self.split_angles, lower, upper)
+    }
+
+    /// The angles of [`Self::splits_inside`] in (0, π).
+    fn find_split_angles(&self) -> Vec<f64> {
         let mut splits = self.body.shape.kinks().to_vec();
         // A narrow dip of B = 1/η + U² + U′² where U′ crosses 0 ([`Self::dip_width`]): at a
         // large η against a sharp curvature (a prolate ellipsoid at η = 394, 0.005 wide) the
@@ -1416,7 +1428,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                     floor.sqrt() < SHARP_PEAK * self.body.shape.potential_prime_at(a).abs()
                 }),
         );
-        lifted_inside(&splits, lower, upper)
+        splits
     }
 }
 
@@ -1762,8 +1774,13 @@ fn drift_estimate(
     known: &mut KnownDrifts,
 ) -> DriftEstimate {
     let mut level = |stride_exp: u32| {
-        let key: Vec<u32> = samples.iter().map(|s| s.level - stride_exp).collect();
-        if let Some((_, value)) = known.iter().find(|(k, _)| *k == key) {
+        // (The pieces' levels, four bits each: a key for up to 16 pieces, none beyond.)
+        let key = (samples.len() <= 16).then(|| {
+            samples
+                .iter()
+                .fold(0u64, |key, s| (key << 4) | u64::from(s.level - stride_exp))
+        });
+        if let Some((_, value)) = known.iter().find(|(k, _)| key.is_some() && *k == key) {
             return *value;
         }
         let psi = if stride_exp == 0 {
@@ -1794,7 +1811,8 @@ fn drift_estimate(
 }
 
 /// Drift sums already made (Δζ and its path scale), by the pieces' levels.
-type KnownDrifts = Vec<(Vec<u32>, ([f64; 2], f64))>;
+type KnownDrifts = Vec<(Option<u64>, ([f64; 2], f64))>;
+const _: () = assert!(MAX_LEVEL < 16 && crate::quadrature::FINEST_CHEBYSHEV_LEVEL < 16);
 
 /// Δζ and the L1 size of its integrand from every `stride`-th node of each piece's samples.
 /// A Clenshaw–Curtis piece whose left end is θ_min ([`ChebyshevPiece::TurningLeft`]) takes
@@ -2037,6 +2055,9 @@ struct PieceSamples {
     least_level: u32,
     nodes: Vec<NodeSample>,
     evaluations: usize,
+    /// The sums of dt and of dψ on this level and the three below (`period`, `psi`), made
+    /// once per level: the refinement's tests and the results ask for them many times.
+    sums: OnceCell<[[f64; 4]; 2]>,
 }
 
 impl PieceSamples {
@@ -2063,6 +2084,7 @@ impl PieceSamples {
             least_level: 0,
             evaluations: nodes.len(),
             nodes,
+            sums: OnceCell::new(),
         })
     }
 
@@ -2086,6 +2108,7 @@ impl PieceSamples {
             least_level,
             evaluations: nodes.len(),
             nodes,
+            sums: OnceCell::new(),
         })
     }
 
@@ -2118,23 +2141,48 @@ impl PieceSamples {
         }
     }
 
+    /// The sums of dt (`part` 0) or dψ (1) on this level and the three below (a level the
+    /// rule does not have: NaN, never asked for).
+    fn level_sums(&self, part: usize) -> [f64; 4] {
+        self.sums.get_or_init(|| {
+            let levels = |f: fn(&NodeSample) -> f64| {
+                std::array::from_fn(|k| {
+                    let k = k as u32;
+                    let exists = match self.rule {
+                        Rule::TanhSinh => k < 3 || self.level >= 4,
+                        Rule::Chebyshev(_) => self.level > k,
+                    };
+                    if exists {
+                        self.sum(k, f)
+                    } else {
+                        f64::NAN
+                    }
+                })
+            };
+            [levels(|n| n.dt), levels(|n| n.dpsi)]
+        })[part]
+    }
+
     fn period(&self, stride_exp: u32) -> f64 {
-        self.sum(stride_exp, |n| n.dt)
+        self.level_sums(0)[stride_exp as usize]
     }
 
     fn psi(&self, stride_exp: u32) -> f64 {
-        self.sum(stride_exp, |n| n.dpsi)
+        self.level_sums(1)[stride_exp as usize]
     }
 
     /// Error of the sum of `f`: see [`level_error`]; for tanh-sinh plus the tails beyond
     /// |τ| = TAU_MAX ([`Self::tail`]), for Clenshaw–Curtis with the geometric rate trusted
     /// where a fourth level shows one rate ([`cosine::single_rate`]).
-    fn error(&self, f: impl Fn(&NodeSample) -> f64) -> f64 {
-        let sums = [self.sum(0, &f), self.sum(1, &f), self.sum(2, &f)];
+    fn error(&self, part: usize) -> f64 {
+        let [s0, s1, s2, s3] = self.level_sums(part);
+        let sums = [s0, s1, s2];
         match self.rule {
-            Rule::TanhSinh => level_error(sums, Convergence::Unknown) + self.tail(f),
+            Rule::TanhSinh => {
+                level_error(sums, Convergence::Unknown) + self.tail(PART_VALUES[part])
+            }
             Rule::Chebyshev(_) => {
-                let rate = if self.level >= 4 && cosine::single_rate(self.sum(3, &f), sums) {
+                let rate = if self.level >= 4 && cosine::single_rate(s3, sums) {
                     Convergence::Geometric
                 } else {
                     Convergence::Unknown
@@ -2173,12 +2221,10 @@ impl PieceSamples {
     /// die out, and what is left (a feature the coarse levels stepped over) is not seen.
     fn one_rate(&self) -> bool {
         self.level >= 4
-            && [|n: &NodeSample| n.dt, |n: &NodeSample| n.dpsi]
-                .iter()
-                .all(|f| {
-                    let sums = [self.sum(0, f), self.sum(1, f), self.sum(2, f)];
-                    cosine::single_rate(self.sum(3, f), sums)
-                })
+            && (0..2).all(|part| {
+                let [s0, s1, s2, s3] = self.level_sums(part);
+                cosine::single_rate(s3, [s0, s1, s2])
+            })
     }
 
     /// Whether the levels are a Clenshaw–Curtis rule's in one geometric regime.
@@ -2199,6 +2245,7 @@ impl PieceSamples {
         piece: &Piece,
         energy: f64,
     ) -> Result<bool> {
+        self.sums = OnceCell::new();
         self.level += 1;
         let level = self.level;
         match self.rule {
@@ -2238,34 +2285,110 @@ impl PieceSamples {
             }
             Rule::Chebyshev(kind) => {
                 let level = self.level - stride_exp;
-                let n = 1usize << level;
-                // The rates at x_j = cos(jπ/N), j = 0 … N (a half piece's continued evenly).
-                let mut values = vec![0.0; n + 1];
-                for (i, rate) in rates.enumerate() {
-                    let j = kind.chebyshev_index(level, i);
-                    values[j] = rate;
-                    if kind != ChebyshevPiece::Regular {
-                        values[n - j] = rate;
+                match chebyshev_psi_matrix(kind, level) {
+                    // (The matrix's row i against the rates: the same linear map as the
+                    // transforms, without their set-up, which dominated the drift's cost on
+                    // the few nodes of most pieces.)
+                    Some(matrix) => {
+                        let rates: Vec<f64> = rates.collect();
+                        out.extend(matrix.chunks_exact(rates.len()).map(|row| dot(row, &rates)));
                     }
+                    None => chebyshev_psi_along(kind, level, rates, out),
                 }
-                let mut q = vec![0.0; n + 1];
-                chebyshev_antiderivative(&values, &mut q);
-                let count = kind.count(level);
-                out.extend((0..count).map(|i| {
-                    let j = kind.chebyshev_index(level, i);
-                    match kind {
-                        // ∫ from x = −1 (j = N).
-                        ChebyshevPiece::Regular => q[j],
-                        // ∫ from u = 0 (j = N/2) up to u_j.
-                        ChebyshevPiece::TurningLeft => q[j] - q[n / 2],
-                        // ∫ from u = 1 (j = 0) down to u_j.
-                        ChebyshevPiece::TurningRight => q[0] - q[j],
-                    }
-                }));
             }
         }
     }
 }
+
+/// ψ from a Clenshaw–Curtis piece's left end at each node of `level` (the antiderivative of the
+/// interpolating polynomial of the `rates`, node by node), into `out`, by
+/// [`chebyshev_antiderivative`].
+fn chebyshev_psi_along(
+    kind: ChebyshevPiece,
+    level: u32,
+    rates: impl Iterator<Item = f64>,
+    out: &mut Vec<f64>,
+) {
+    let n = 1usize << level;
+    // The rates at x_j = cos(jπ/N), j = 0 … N (a half piece's continued evenly).
+    let mut values = vec![0.0; n + 1];
+    for (i, rate) in rates.enumerate() {
+        let j = kind.chebyshev_index(level, i);
+        values[j] = rate;
+        if kind != ChebyshevPiece::Regular {
+            values[n - j] = rate;
+        }
+    }
+    let mut q = vec![0.0; n + 1];
+    chebyshev_antiderivative(&values, &mut q);
+    let count = kind.count(level);
+    out.extend((0..count).map(|i| {
+        let j = kind.chebyshev_index(level, i);
+        match kind {
+            // ∫ from x = −1 (j = N).
+            ChebyshevPiece::Regular => q[j],
+            // ∫ from u = 0 (j = N/2) up to u_j.
+            ChebyshevPiece::TurningLeft => q[j] - q[n / 2],
+            // ∫ from u = 1 (j = 0) down to u_j.
+            ChebyshevPiece::TurningRight => q[0] - q[j],
+        }
+    }));
+}
+
+/// Σ aᵢ bᵢ, in four interleaved partial sums (which the compiler may keep in vector lanes).
+#[inline]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut partial = [0.0; 4];
+    let (a4, b4) = (a.chunks_exact(4), b.chunks_exact(4));
+    let tail: f64 = a4
+        .remainder()
+        .iter()
+        .zip(b4.remainder())
+        .map(|(x, y)| x * y)
+        .sum();
+    for (x, y) in a4.zip(b4) {
+        for k in 0..4 {
+            partial[k] += x[k] * y[k];
+        }
+    }
+    (partial[0] + partial[1]) + (partial[2] + partial[3]) + tail
+}
+
+/// The levels up to which [`chebyshev_psi_along`] is applied as a matrix (at most 129 nodes a
+/// piece: 17,000 entries).
+const PSI_MATRIX_LEVELS: u32 = 7;
+
+/// [`chebyshev_psi_along`] of `kind` on `level` as a row-major count × count matrix (its
+/// columns the images of the unit vectors), built once; `None` above [`PSI_MATRIX_LEVELS`].
+fn chebyshev_psi_matrix(kind: ChebyshevPiece, level: u32) -> Option<&'static [f64]> {
+    const LEVELS: usize = PSI_MATRIX_LEVELS as usize + 1;
+    static MATRICES: [[OnceLock<Vec<f64>>; LEVELS]; 3] =
+        [const { [const { OnceLock::new() }; LEVELS] }; 3];
+    let cell = MATRICES[kind as usize].get(level as usize)?;
+    Some(cell.get_or_init(|| {
+        let count = kind.count(level);
+        let mut matrix = vec![0.0; count * count];
+        let mut column = Vec::with_capacity(count);
+        for j in 0..count {
+            column.clear();
+            chebyshev_psi_along(
+                kind,
+                level,
+                (0..count).map(|i| f64::from(i == j)),
+                &mut column,
+            );
+            for (i, value) in column.iter().enumerate() {
+                matrix[i * count + j] = *value;
+            }
+        }
+        matrix
+    }))
+}
+
+/// The parts of [`PieceSamples::level_sums`]: dt and dψ.
+const DT: usize = 0;
+const DPSI: usize = 1;
+const PART_VALUES: [fn(&NodeSample) -> f64; 2] = [|n| n.dt, |n| n.dpsi];
 
 /// A level's quadrature weights.
 enum Weights {
