@@ -855,9 +855,15 @@ pub fn census(scene: &Scene, stop: &(dyn Fn() -> bool + Sync)) -> Census {
     use std::sync::Mutex;
     let [na, nb, nk, _] = scene.shape();
     let kappa_zero = scene.kappa.values.contains(&0.0);
+    // (Over every body of a grid of up to 1e12 of them: `stop` is heard between bodies, and
+    // the pass ends once every family is possible; it used to run on, deaf to Ctrl-C and
+    // SIGTERM for minutes, at 1e6 × 1e6 bodies: an adversary pass.)
     let mut possible = [false; 4];
-    for &alpha in &scene.alpha.values {
+    'bodies: for &alpha in &scene.alpha.values {
         for &second in &scene.second.values {
+            if possible == [true; 4] || stop() {
+                break 'bodies;
+            }
             // An edged body's families are not told in advance: the census is whole.
             let body = match scene.shape {
                 None => crate::family::possible_for_ellipsoid(alpha, second, kappa_zero),
@@ -871,12 +877,14 @@ pub fn census(scene: &Scene, stop: &(dyn Fn() -> bool + Sync)) -> Census {
     let early = scene.layout == crate::family::Layout::Family;
     let found = Mutex::new(Census::default());
     let done = AtomicBool::new(false);
-    (0..na * nb * nk)
+    // (`try_for_each` ends the whole iteration at the first `Err`; `for_each` visited every
+    // remaining item, each returning at once, which over 1e12 rows took hours after Ctrl-C.)
+    let _ = (0..na * nb * nk)
         .into_par_iter()
         .with_max_len(1)
-        .for_each(|i| {
+        .try_for_each(|i| {
             if done.load(Ordering::Relaxed) || stop() {
-                return;
+                return Err(());
             }
             let (slice, row) = (i / nk, i % nk);
             let body = scene.body(slice / nb, slice % nb);
@@ -894,6 +902,7 @@ pub fn census(scene: &Scene, stop: &(dyn Fn() -> bool + Sync)) -> Census {
             if early && all.covers(&possible) {
                 done.store(true, Ordering::Relaxed);
             }
+            Ok(())
         });
     found.into_inner().expect("no census panics")
 }

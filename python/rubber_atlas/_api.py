@@ -488,6 +488,10 @@ def _first_bad(name: str, values: np.ndarray, bad: np.ndarray, why: str) -> None
         raise ValueError(f"cell {i}: invalid {name} = {'NaN' if np.isnan(value) else repr(value)}: {why}")
 
 
+# The most points a profile's table may have (the core's MAX_PROFILE_POINTS).
+_MAX_PROFILE_POINTS = 2000
+
+
 def _profile_rows(profile) -> list[list[float]]:
     """The rows (ρ, z) or (ρ, z, edge) of a profile's table as lists of floats; a table of
     another form is refused naming `profile` (the core checks the meridian itself)."""
@@ -498,6 +502,14 @@ def _profile_rows(profile) -> list[list[float]]:
         if np.ma.getmaskarray(profile).any():
             raise ValueError("profile has masked values: give the points themselves (np.ma.filled)")
         profile = np.ma.getdata(profile)
+    # The count first, from the length alone: a zero-memory view (np.broadcast_to) of 1e8 rows
+    # grew to 5 GB as lists of floats before the core refused it (an adversary pass).
+    try:
+        count = len(profile)
+    except TypeError:
+        count = None
+    if count is not None and count > _MAX_PROFILE_POINTS:
+        raise ValueError(f"profile has {count} points; at most {_MAX_PROFILE_POINTS} are taken")
     if isinstance(profile, (list, tuple)) and any(
             isinstance(x, (bool, np.bool_)) for row in profile if isinstance(row, (list, tuple)) for x in row):
         raise TypeError(f"{what}, not True or False")
@@ -1458,7 +1470,9 @@ def components(ds: xr.Dataset, alpha: float | None = None, beta: float | None = 
         # (NaN in the axis is near nothing.)
         distance[np.isnan(distance)] = np.inf
         i = int(np.argmin(distance)) if distance.size else -1
-        if i < 0 or not distance[i] <= 1e-12 * max(1.0, abs(value)):
+        # (Relative to the values themselves: an absolute 1e-12 below 1 took κ = 1e-12 for a
+        # grid's 1e-13, and 5e-13 for its 0; an adversary pass.)
+        if i < 0 or not distance[i] <= 1e-12 * max(abs(value), abs(float(axis[i]))):
             nearest = f" (nearest {_shown(float(axis[i]))})" if i >= 0 else ""
             raise NotInDataset(f"{shown} = {_shown(value)} is not a grid value{nearest}")
         index[name] = i

@@ -638,3 +638,25 @@ def test_components_of_a_lazily_transposed_atlas_are_found_or_refused_in_one_lin
             assert flipped.rubber.components(**cell) == expected
         except ValueError:
             refused(ValueError, lambda: flipped.rubber.components(**cell), "transpose")
+
+
+def test_components_off_the_grid_near_zero_are_refused():
+    """A value is a grid value to 1e-12 of itself, not to 1e-12 absolutely: κ = 1e-12 was
+    taken for the grid's 1e-13 and 5e-13 for its 0, silently the wrong cell (an adversary
+    pass)."""
+    ds = ra.cells(*BODY, kappa=np.array([0.0, 1e-13]), energy=np.array([2.0, 2.5, 3.0]))
+    for kappa, nearest in ((1e-12, "1e-13"), (5e-13, "1e-13"), (1e-20, "0")):
+        refused(ValueError, lambda: ds.rubber.components(kappa=kappa, energy=2.5), "not a grid value", nearest)
+    def theta_min(kappa):
+        return [c["theta_min"] for c in ds.rubber.components(kappa=kappa, energy=2.5)]
+
+    assert theta_min(0.0) != theta_min(1e-13)
+    assert theta_min(1e-13 * (1 + 1e-14)) == theta_min(1e-13)
+
+
+def test_a_huge_profile_view_is_refused_before_it_is_copied():
+    """A zero-memory view of 1e8 rows grew to 5 GB as lists of floats before the core refused
+    it: the count is checked from the length first (an adversary pass)."""
+    view = np.broadcast_to(np.array([1.0, 0.0]), (10**8, 2))
+    refused(ValueError, lambda: ra.cells(0.0, None, 1.0, 2.5, kappa=0.5, energy=3.0, shape="profile", profile=view),
+            "100000000 points", "at most 2000")

@@ -435,3 +435,21 @@ def test_a_narrow_peak_of_1_over_j_against_a_reference_cut_there(case):
         assert ref.period_error < 1e-25 and ref.rotation_error < 1e-25, ref
         assert abs(got["period"] - ref.period) <= got["errors"]["period"], where
         assert abs(got["rotation_number"] - ref.rotation_number) <= got["errors"]["rotation_number"], where
+
+
+@pytest.mark.parametrize("tol", [0.1, 0.05])
+def test_loose_tolerances_do_not_trust_the_first_levels_of_a_piece(tol):
+    """A truncated ball's libration next to a maximum at tol 0.1: the Clenshaw–Curtis sums of
+    T on 16 … 128 intervals (61.5, 50.9, 52.27, 52.282) fell in one rate by the test, and
+    d₁ max(√r, 1/10) put T's error at 4.5e-3 where it was 6.7e-3 (and N's at 5.3e-7 for
+    7.3e-7), status `ok` (an adversary pass): the rate is trusted only once the last
+    difference is below 1e-6 of the piece's size."""
+    shape, alpha, cut, nu, eta = "truncated_ball", 0.999999, 0.6020076709670582, 1.593800703324628, 0.014844987593768618
+    kappa, energy = 0.001351764490219358, 1.7899800938357955
+    reference = EdgedCell(shape, alpha, cut, nu, eta, kappa).components(energy)
+    comps = run_cell(shape, alpha, cut, nu, eta, kappa, energy, tol)["components"]
+    assert len(comps) == len(reference) == 1, (comps, reference)
+    got, ref = comps[0], reference[0]
+    assert ref.period_error < 1e-25 and ref.rotation_error < 1e-25, ref
+    assert abs(got["period"] - ref.period) <= got["errors"]["period"], got
+    assert abs(got["rotation_number"] - ref.rotation_number) <= got["errors"]["rotation_number"], got

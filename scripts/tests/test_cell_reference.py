@@ -138,6 +138,34 @@ def test_the_sweep_cut_short_by_a_pole_is_in_the_estimate(alpha, beta, nu, eta, 
             assert comp["errors"]["rotation_number"] <= tol, where
 
 
+# Oblate ellipsoids far beyond β = 1e6: U″ = β² − 1 − α at the poles and U′ ≈ β beyond 1/β of
+# them put the wells by the poles at θ ≈ √(κ/β) … (κ²/β)^⅓, inside the first scan site
+# 1e-3 √κ of the critical-point search, which then saw only the equator: `no_motion` where
+# the body moves (β = 1e10, κ = 0.25, ε = 6e6; an adversary pass), or the equator's level
+# as the bottom of V. (α, β, κ, ε).
+FAR_OBLATE = [
+    (0.5, 1e10, 0.25, 6e6),
+    (0.5, 1e8, 1e-4, 1e3),
+    (-0.9, 1e20, 1e-8, 3e8),
+    (0.5, 1e60, 10.0, 1e41),
+]
+
+
+@pytest.mark.parametrize("alpha, beta, kappa, energy", FAR_OBLATE)
+def test_the_wells_by_the_poles_of_a_far_oblate_ellipsoid_are_found(alpha, beta, kappa, energy):
+    import reference
+
+    truths = reference.reference(alpha, beta, 0.5, 0.5, kappa, energy)
+    assert truths, "the reference finds motion"
+    comps = list(components_against_reference(alpha, beta, 0.5, 0.5, kappa, energy, 1e-10))
+    assert len(comps) == len(truths), ([c for c, _ in comps], truths)
+    for comp, truth in comps:
+        where = f"beta {beta} kappa {kappa} energy {energy}: {comp}"
+        assert abs(comp["theta_min"] - float(truth.theta_min)) <= 1e-9 * float(truth.theta_min), where
+        for name, value in (("period", truth.period), ("rotation_number", truth.rotation_number)):
+            assert abs(comp[name] - float(value)) <= comp["errors"][name], (name, where)
+
+
 def test_a_passage_by_a_pole_in_the_plain_map_adds_no_rounding_term():
     """A libration at κ = 0.0078 whose ends lie 0.01 from the poles, integrated by the plain
     cosine map (its nodes placed to an ulp of their distance from the nearer end): N's
