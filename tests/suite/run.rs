@@ -1502,3 +1502,23 @@ fn output_that_does_not_fit_is_exit_1_with_the_systems_reason() {
         );
     }
 }
+
+/// The census of a grid of 1e12 bodies stops at once when asked: its pass over the bodies and
+/// its iteration over their κ-rows both end at the first `stop` (each went on over every
+/// remaining body, minutes after a SIGINT at 1e6 × 1e6; an adversary pass). Counted, not
+/// timed: `stop` is asked a handful of times, not once a body.
+#[test]
+fn the_census_of_a_huge_grid_stops_when_asked() {
+    let scene = rubber_atlas::scene::Scene::parse(
+        "name = \"huge\"\n[body]\nnu = 0.5\neta = 0.5\n[axes]\n\
+         alpha = { start = -0.9, stop = 0.9, num = 1000000 }\n\
+         beta = { start = 0.1, stop = 10.0, num = 1000000 }\nkappa = [1.0]\nenergy = [2.0]\n",
+        "huge.toml",
+    )
+    .unwrap();
+    let asked = std::sync::atomic::AtomicUsize::new(0);
+    let stop = || asked.fetch_add(1, std::sync::atomic::Ordering::Relaxed) >= 100;
+    rubber_atlas::atlas::census(&scene, &stop);
+    let asked = asked.into_inner();
+    assert!(asked <= 1000, "stop asked {asked} times");
+}
