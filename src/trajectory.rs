@@ -336,7 +336,23 @@ impl Request {
         match self.start {
             StartAt::Energy { energy, component } => {
                 crate::error::check_energy(energy)?;
-                Start::at_energy(body, self.kappa, energy, component)
+                let start = Start::at_energy(body, self.kappa, energy, component)?;
+                // B = 1/η + U² + U′² beyond a double at the start (β = 1e150 with a turning
+                // point at 6e-151, where U′ ≈ β²θ): its energy, ½ B θ̇² + V, was NaN, and the
+                // refusal named "energy = NaN" (an adversary pass). Valid input that doubles
+                // cannot integrate: a failed computation.
+                let inertia = body.reduced_inertia(start.theta0);
+                if !inertia.is_finite() {
+                    return Err(AtlasError::Integration {
+                        time: 0.0,
+                        reason: format!(
+                            "B = 1/eta + U^2 + U'^2 overflows at the start (theta = {:e}): this \
+                             motion cannot be followed in double precision",
+                            start.theta0
+                        ),
+                    });
+                }
+                Ok(start)
             }
             StartAt::Angle { theta0, theta_dot0 } => {
                 let start = Start {

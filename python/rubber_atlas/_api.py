@@ -388,6 +388,10 @@ def _broadcast(given: dict[str, object], plane: tuple[str, str] | None = None, o
         places = {name: (a.shape, tuple(dims.index(d) for d in a.dims)) for name, a in arrays.items()}
         return dims, layout, coords, places
     shapes = {name: v.shape for name, v in values.items()}
+    # (numpy broadcasts at most 32 dimensions: beyond, its own RuntimeError; an adversary pass.)
+    for name, s in shapes.items():
+        if len(s) > 32:
+            raise ValueError(f"{name} has {len(s)} dimensions: at most 32 are taken")
     vectors = {k: s for k, s in shapes.items() if s}
     # The two axes of the plane as 1-D vectors of different lengths (a length-1 one too, which
     # numpy would broadcast), every other input a number: their grid.

@@ -660,3 +660,10 @@ def test_a_huge_profile_view_is_refused_before_it_is_copied():
     view = np.broadcast_to(np.array([1.0, 0.0]), (10**8, 2))
     refused(ValueError, lambda: ra.cells(0.0, None, 1.0, 2.5, kappa=0.5, energy=3.0, shape="profile", profile=view),
             "100000000 points", "at most 2000")
+
+
+def test_an_input_of_more_than_32_dimensions_is_refused_by_name():
+    """numpy broadcasts at most 32 dimensions: a 33-d κ raised its own RuntimeError (an
+    adversary pass)."""
+    kappa = np.full((1,) * 33, 0.8)
+    refused(ValueError, lambda: ra.cells(*BODY, kappa=kappa, energy=2.5), "kappa", "33 dimensions")

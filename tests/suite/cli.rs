@@ -1796,3 +1796,40 @@ fn a_verdict_at_the_highest_resolution_stops_at_once() {
         assert!(waited < 1.0, "{args:?}: {waited} s");
     }
 }
+
+/// A trajectory of a far oblate ellipsoid whose start lies where B = 1/η + U² + U′²
+/// overflows (β = 1e150, turning point at 6e-151): a failed computation, exit 1, in one line
+/// that says why; it was refused as "invalid energy = NaN", a value never given (an
+/// adversary pass).
+#[test]
+fn a_trajectory_whose_inertia_overflows_at_the_start_fails_saying_why() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("t.h5");
+    let o = run(&[
+        "trajectory",
+        "--alpha",
+        "0.5",
+        "--beta",
+        "1e150",
+        "--nu",
+        "0.5",
+        "--eta",
+        "0.5",
+        "--kappa",
+        "0.8",
+        "--energy",
+        "1e300",
+        "--periods",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let text = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{text}");
+    assert!(
+        text.contains("overflows at the start") && !text.contains("NaN"),
+        "{text}"
+    );
+    assert_eq!(text.trim().lines().count(), 1, "{text}");
+    assert!(!out.exists());
+}
