@@ -331,6 +331,14 @@ def _broadcast(given: dict[str, object], plane: tuple[str, str] | None = None, o
     Returns the dimensions, the arrays in that layout (views), the coordinates of the result
     (each input over the dimensions it varies along, scalar where it is one number), and
     where each input lies: {name: (its shape, the result's axis of each of its axes)}."""
+    # Each input holds at least as many values as there are cells: sized from its shape
+    # before it is read (a dask-backed κ of 3e8 cells was computed, 2.4 GB, before the
+    # refusal; an adversary pass).
+    if check is not None:
+        for v in given.values():
+            size = getattr(v, "size", None)
+            if isinstance(size, numbers.Integral) and not isinstance(size, bool) and size > 1:
+                check(int(size))
     values = {name: _numbers(name, v) for name, v in given.items()}
     if any(isinstance(v, xr.DataArray) for v in given.values()):
         arrays = {}

@@ -667,3 +667,19 @@ def test_an_input_of_more_than_32_dimensions_is_refused_by_name():
     adversary pass)."""
     kappa = np.full((1,) * 33, 0.8)
     refused(ValueError, lambda: ra.cells(*BODY, kappa=kappa, energy=2.5), "kappa", "33 dimensions")
+
+
+def test_a_huge_lazy_input_is_sized_before_it_is_read():
+    """Each input is sized from its shape before it is read: a dask-backed κ of 3e8 cells was
+    computed (2.4 GB) before the refusal (an adversary pass). Here a dask array that cannot
+    be computed at all stands for it: the refusal must come first."""
+    import dask
+    import dask.array
+    import xarray as xr
+
+    def unreadable():
+        raise AssertionError("the input was read before its size was checked")
+
+    data = dask.array.from_delayed(dask.delayed(unreadable)(), shape=(10**5, 3 * 10**4), dtype=np.float64)
+    kappa = xr.DataArray(data, dims=("a", "b"))
+    refused(ValueError, lambda: ra.cells(*BODY, kappa=kappa, energy=2.5), "GB")
