@@ -1179,7 +1179,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         let mut psi_advance_error = double * sum(&|s| s.error(DPSI));
         let period_rounding = double * sum(&|s| s.rounding(|n| n.dt));
         let psi_rounding = double * sum(&|s| s.rounding(|n| n.dpsi));
-        let psi_variation = double * sum(&|s| s.sum(0, |n| n.dpsi.abs()));
+        let psi_variation = double * sum(&|s| s.size(DPSI));
         let (saddle_t, saddle_psi) =
             self.saddle_conditioning(energy, component, period, double, 0.0);
         period_error += period_rounding + saddle_t;
@@ -2075,9 +2075,10 @@ struct PieceSamples {
     least_level: u32,
     nodes: Vec<NodeSample>,
     evaluations: usize,
-    /// The sums of dt and of dψ on this level and the three below (`period`, `psi`), made
-    /// once per level: the refinement's tests and the results ask for them many times.
-    sums: OnceCell<[[f64; 4]; 2]>,
+    /// The sums of dt and of dψ on this level and the three below (`period`, `psi`), and
+    /// their L1 sizes on this level, made once per level: the refinement's tests and the
+    /// results ask for them many times.
+    sums: OnceCell<SampleSums>,
 }
 
 impl PieceSamples {
@@ -2164,6 +2165,15 @@ impl PieceSamples {
     /// The sums of dt (`part` 0) or dψ (1) on this level and the three below (a level the
     /// rule does not have: NaN, never asked for).
     fn level_sums(&self, part: usize) -> [f64; 4] {
+        self.sample_sums().by_level[part]
+    }
+
+    /// Σ |dt| (`part` 0) or Σ |dψ| (1) times the weights on this level: the L1 sizes.
+    fn size(&self, part: usize) -> f64 {
+        self.sample_sums().size[part]
+    }
+
+    fn sample_sums(&self) -> &SampleSums {
         self.sums.get_or_init(|| {
             let levels = |f: fn(&NodeSample) -> f64| {
                 std::array::from_fn(|k| {
@@ -2179,8 +2189,11 @@ impl PieceSamples {
                     }
                 })
             };
-            [levels(|n| n.dt), levels(|n| n.dpsi)]
-        })[part]
+            SampleSums {
+                by_level: [levels(|n| n.dt), levels(|n| n.dpsi)],
+                size: [self.sum(0, |n| n.dt.abs()), self.sum(0, |n| n.dpsi.abs())],
+            }
+        })
     }
 
     fn period(&self, stride_exp: u32) -> f64 {
@@ -2207,11 +2220,8 @@ impl PieceSamples {
                 level_error(sums, Convergence::Unknown) + self.tail(PART_VALUES[part])
             }
             Rule::Chebyshev(_) => {
-                let settled = || {
-                    let size = self.sum(0, |n| PART_VALUES[part](n).abs());
-                    (s0 - s1).abs() <= GEOMETRIC_FROM * size
-                };
-                let rate = if self.level >= 4 && cosine::single_rate(s3, sums) && settled() {
+                let settled = (s0 - s1).abs() <= GEOMETRIC_FROM * self.size(part);
+                let rate = if self.level >= 4 && cosine::single_rate(s3, sums) && settled {
                     Convergence::Geometric
                 } else {
                     Convergence::Unknown
@@ -2320,7 +2330,11 @@ impl PieceSamples {
                     // the few nodes of most pieces.)
                     Some(matrix) => {
                         let rates: Vec<f64> = rates.collect();
-                        out.extend(matrix.chunks_exact(rates.len()).map(|row| dot(row, &rates)));
+                        out.extend(
+                            matrix
+                                .chunks_exact(rates.len())
+                                .map(|row| row.iter().zip(&rates).map(|(m, r)| m * r).sum::<f64>()),
+                        );
                     }
                     None => chebyshev_psi_along(kind, level, rates, out),
                 }
@@ -2364,25 +2378,6 @@ fn chebyshev_psi_along(
     }));
 }
 
-/// Σ aᵢ bᵢ, in four interleaved partial sums (which the compiler may keep in vector lanes).
-#[inline]
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut partial = [0.0; 4];
-    let (a4, b4) = (a.chunks_exact(4), b.chunks_exact(4));
-    let tail: f64 = a4
-        .remainder()
-        .iter()
-        .zip(b4.remainder())
-        .map(|(x, y)| x * y)
-        .sum();
-    for (x, y) in a4.zip(b4) {
-        for k in 0..4 {
-            partial[k] += x[k] * y[k];
-        }
-    }
-    (partial[0] + partial[1]) + (partial[2] + partial[3]) + tail
-}
-
 /// The levels up to which [`chebyshev_psi_along`] is applied as a matrix (at most 129 nodes a
 /// piece: 17,000 entries).
 const PSI_MATRIX_LEVELS: u32 = 7;
@@ -2418,6 +2413,14 @@ fn chebyshev_psi_matrix(kind: ChebyshevPiece, level: u32) -> Option<&'static [f6
 /// in the asymptotic regime where the geometric rate is trusted ([`PieceSamples::error`]):
 /// every tolerance below 1e-8 gets there before its estimate passes.
 const GEOMETRIC_FROM: f64 = 1e-6;
+
+/// What [`PieceSamples::sample_sums`] keeps for a level, by part (dt, dψ).
+struct SampleSums {
+    /// The sums on the level and the three below.
+    by_level: [[f64; 4]; 2],
+    /// The L1 sizes on the level.
+    size: [f64; 2],
+}
 
 /// The parts of [`PieceSamples::level_sums`]: dt and dψ.
 const DT: usize = 0;

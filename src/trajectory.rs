@@ -333,26 +333,10 @@ impl Request {
     /// The checked start of this request on `body`.
     pub fn start<S: Shape>(&self, body: &Body<S>) -> Result<Start> {
         crate::error::check_kappa(self.kappa)?;
-        match self.start {
+        let start = match self.start {
             StartAt::Energy { energy, component } => {
                 crate::error::check_energy(energy)?;
-                let start = Start::at_energy(body, self.kappa, energy, component)?;
-                // B = 1/η + U² + U′² beyond a double at the start (β = 1e150 with a turning
-                // point at 6e-151, where U′ ≈ β²θ): its energy, ½ B θ̇² + V, was NaN, and the
-                // refusal named "energy = NaN" (an adversary pass). Valid input that doubles
-                // cannot integrate: a failed computation.
-                let inertia = body.reduced_inertia(start.theta0);
-                if !inertia.is_finite() {
-                    return Err(AtlasError::Integration {
-                        time: 0.0,
-                        reason: format!(
-                            "B = 1/eta + U^2 + U'^2 overflows at the start (theta = {:e}): this \
-                             motion cannot be followed in double precision",
-                            start.theta0
-                        ),
-                    });
-                }
-                Ok(start)
+                Start::at_energy(body, self.kappa, energy, component)?
             }
             StartAt::Angle { theta0, theta_dot0 } => {
                 let start = Start {
@@ -361,10 +345,29 @@ impl Request {
                     theta_dot0,
                 };
                 start.check()?;
-                start.checked_energy(body)?;
-                Ok(start)
+                // (An energy beyond 1e300 is refused naming the start; NaN, from B = ∞
+                // times θ̇ = 0, is the overflow below.)
+                if !start.energy(body).is_nan() {
+                    start.checked_energy(body)?;
+                }
+                start
             }
+        };
+        // B = 1/η + U² + U′² beyond a double at the start (β = 1e150 with a turning point at
+        // 6e-151, where U′ ≈ β²θ): its energy, ½ B θ̇² + V, was NaN, and the refusal named
+        // "energy = NaN" (an adversary pass). Valid input that doubles cannot integrate: a
+        // failed computation, whichever way the start was given.
+        if !body.reduced_inertia(start.theta0).is_finite() {
+            return Err(AtlasError::Integration {
+                time: 0.0,
+                reason: format!(
+                    "B = 1/eta + U^2 + U'^2 overflows at the start (theta = {:e}): this motion \
+                     cannot be followed in double precision",
+                    start.theta0
+                ),
+            });
         }
+        Ok(start)
     }
 
     /// Checks the request and integrates it on `body`: the start and the samples.
