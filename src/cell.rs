@@ -568,7 +568,9 @@ impl EnergyErrors {
 /// where the offset is computed sharply their terms are taken at it) is used when it is far
 /// below the tolerance; otherwise, and near a pole at small κ, where the turning point is where ε and
 /// U nearly cancel and X varies on the scale of κ, the slope is measured by differences at
-/// ε ± h, h a thousandth of the scale X varies on (256 δε near a pole).
+/// ε ± h, h a thousandth of the scale X varies on (256 δε near a pole). Where the integrator
+/// placed the turning points on ε in double-double ([`PeriodIntegrals::level_residual`]) the
+/// offset is that residual alone (about 1e-30 of V), common and spread.
 fn level_offset_error<S: Shape>(
     potential: &EffectivePotential<'_, S>,
     energy: f64,
@@ -634,12 +636,16 @@ fn level_offset_error<S: Shape>(
             .psi_variation
             .map_or(f64::INFINITY, |v| v + 2.0 * values.period * end_rate),
     );
-    let psi_shift = 2.0
-        * eps
-        * values.period
-        * far
-            .map(|((_, r), s)| s.ulp_scale() * r.2.abs())
-            .fold(0.0, f64::max);
+    // (Turning points placed on ε are not rounded to doubles: no shift.)
+    let psi_shift = if values.level_residual.is_some() {
+        0.0
+    } else {
+        2.0 * eps
+            * values.period
+            * far
+                .map(|((_, r), s)| s.ulp_scale() * r.2.abs())
+                .fold(0.0, f64::max)
+    };
     let drift_scale = values.drift.map_or(0.0, |d| d.scale);
     // The crude bound of the common shift δε and the tilt's: the two ends' offsets differ by
     // at most `spread`, a level tilted across the libration by m ≤ spread / L. The response,
@@ -695,7 +701,12 @@ fn level_offset_error<S: Shape>(
     // the two ends' halves meet: the rise V(e_max) − V(e_min) the level is tilted by (see
     // `Piece::tilt_rate`) against its double-double value, plus the rise's response to the
     // rounding of the length between the ends (an ulp of each end in its chart).
+    // Sharpest, where the integrator placed the turning points on ε in double-double: the
+    // offset is their residual alone, common or spread ([`PeriodIntegrals::level_residual`]).
     let sharp = || -> Option<(f64, f64)> {
+        if let Some(residual) = values.level_residual {
+            return Some((residual + represented, 2.0 * residual + represented_spread));
+        }
         let (lower, lower_error) = potential.value_double_double(sites[0].angle())?;
         let (upper, upper_error) = potential.value_double_double(sites[1].angle())?;
         let level = DoubleDouble::from_f64(energy);
@@ -799,7 +810,7 @@ fn level_offset_error<S: Shape>(
     }
     let (mut crude, mut tilted, mut depth) =
         bounds(a_priori + represented, a_priori + represented_spread);
-    if enough(&crude, &tilted, false, raw) && saddle_small {
+    if values.level_residual.is_none() && enough(&crude, &tilted, false, raw) && saddle_small {
         return crude.plus(tilted);
     }
     let mut delta = a_priori + represented;

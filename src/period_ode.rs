@@ -293,6 +293,7 @@ pub fn integrate<S: Shape>(
         psi_variation: None,
         // (The runs' own energy drift, not a level offset: kept.)
         saddle: [0.0, 0.0],
+        level_residual: None,
         work: n1 + n2,
         converged: true,
     })

@@ -1092,14 +1092,14 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 .is_empty()
         {
             let mut whole = self.pieces(energy, component, false);
-            self.sharpen_gaps(&mut whole, tol);
+            self.sharpen_gaps(&mut whole, energy, component.kind, tol);
             match cosine::integrate(self, &whole[0], energy, component, tol, with_drift)? {
                 Ok(result) => return Ok(result),
                 Err(work) => spent = work,
             }
         }
         let mut pieces = self.pieces(energy, component, true);
-        self.sharpen_gaps(&mut pieces, tol);
+        self.sharpen_gaps(&mut pieces, energy, component.kind, tol);
         let kinds = if fast_rules {
             self.chebyshev_kinds(component, &pieces, tol)
         } else {
@@ -1255,6 +1255,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             drift,
             psi_variation: Some(psi_variation),
             saddle: [saddle_t, saddle_psi],
+            level_residual: level_residual(component, &pieces),
             work: spent + samples.iter().map(|s| s.evaluations).sum::<usize>(),
             converged,
         })
@@ -1694,6 +1695,7 @@ impl<S: Shape> EffectivePotential<'_, S> {
                     4.0 * EPS * (self.value_scale(angle) + energy.abs())
                 },
                 sharp: None,
+                placed: None,
             }
         };
         let turning = component.kind == MotionKind::Libration;
@@ -1755,8 +1757,12 @@ impl<S: Shape> EffectivePotential<'_, S> {
     /// At a tolerance below [`SHARP_GAPS_BELOW`], where the shape gives V in double-double:
     /// the pieces' ends in double-double, so that `sample` can compute a gap whose rounding in
     /// double would weigh in the error (the divided difference of V cancelling) as
-    /// V(e) + excess + tilt − V(t) in double-double, to about an ulp of the gap.
-    fn sharpen_gaps(&self, pieces: &mut [Piece], tol: f64) {
+    /// level + tilt − V(t) in double-double, to about an ulp of the gap. Each turning point is
+    /// placed on the level ε ([`Placed`]) and every other end's excess ε − V(e) is taken in
+    /// double-double, so that every end's level is ε and the pieces need no tilt; where a
+    /// turning point cannot be placed (V′ too small there for one Newton step to land within
+    /// a few ulps of it), the ends keep their double levels V(e) + excess and the tilt.
+    fn sharpen_gaps(&self, pieces: &mut [Piece], energy: f64, kind: MotionKind, tol: f64) {
         // (Not across the joints of a profile's arcs: the end at a joint takes its U from
         // either arc, which meet only to their representation, and a turning point within
         // 1e-12 … 1e-8 of V(joint) had T 2.2e-11 off with an estimate of 3.4e-13 at tol 1e-13;
@@ -1764,19 +1770,148 @@ impl<S: Shape> EffectivePotential<'_, S> {
         if tol >= SHARP_GAPS_BELOW || !self.body.shape.kinks().is_empty() {
             return;
         }
-        for end in pieces.iter_mut().flat_map(|p| [&mut p.left, &mut p.right]) {
+        let threshold = SHARP_GAP_ROUNDING.max(0.02 * tol);
+        let level = DoubleDouble::from_f64(energy);
+        let mut ends = Vec::with_capacity(2 * pieces.len());
+        for end in pieces.iter().flat_map(|p| [&p.left, &p.right]) {
             let (sin, cos) = on_circle(end.angle);
-            end.sharp = self
-                .value_double_double_on_circle(sin, cos)
-                .map(|(value, error)| SharpEnd {
-                    sin,
-                    cos,
-                    level: value.add_f64(end.excess),
-                    error,
-                    threshold: SHARP_GAP_ROUNDING.max(0.02 * tol),
+            let Some((value, error)) = self.value_double_double_on_circle(sin, cos) else {
+                return;
+            };
+            let placed = if end.excess == 0.0 {
+                self.place_on_level(end, sin, cos, value, level)
+            } else {
+                None
+            };
+            ends.push((sin, cos, value, error, placed));
+        }
+        // (Not a rotation's: its two outer ends are one critical point, held as two doubles
+        // up to an ulp of 2π apart; near a separatrix the integrand peaks there like
+        // ε − V_s to the −½, and the sliver between them, hidden under the rounding of the
+        // excess in double, was a 7e-10 error of T at ε − V_s = 1e-13 with it in
+        // double-double.)
+        let all_placed = kind == MotionKind::Libration
+            && pieces
+                .iter()
+                .flat_map(|p| [&p.left, &p.right])
+                .zip(&ends)
+                .all(|(end, e)| end.excess != 0.0 || e.4.is_some());
+        let mut ends = ends.into_iter();
+        for piece in pieces.iter_mut() {
+            for end in [&mut piece.left, &mut piece.right] {
+                let (sin, cos, value, error, placed) = ends.next().unwrap();
+                end.sharp = Some(if all_placed {
+                    if end.excess == 0.0 {
+                        end.placed = placed;
+                    } else {
+                        // (ε − V(e) in double-double, rounded once.)
+                        end.excess = level.sub(value).to_f64();
+                        end.excess_error = error + EPS * end.excess.abs();
+                    }
+                    end.level = energy;
+                    SharpEnd {
+                        sin,
+                        cos,
+                        level,
+                        error: 0.0,
+                        threshold,
+                    }
+                } else {
+                    SharpEnd {
+                        sin,
+                        cos,
+                        level: value.add_f64(end.excess),
+                        error,
+                        threshold,
+                    }
                 });
+            }
+            if all_placed {
+                // Both ends on ε: the nodes run from e + shift at either end, e the angle of
+                // the end's pair of sine and cosine (which the gaps are measured from), and no
+                // tilt. (The pairs' angles are off the sites' by up to an ulp of the sine or
+                // cosine: a 2e-14 error of T in a libration 1.7e-3 wide at θ = 2.57, once its
+                // level offset no longer hid it; whole-domain seed 12.)
+                let shift =
+                    |end: &PieceEnd| end.placed.map_or(0.0, |p| p.shift) + pair_offset(&end.site);
+                piece.length += shift(&piece.right) - shift(&piece.left);
+                piece.tilt_rate = 0.0;
+            }
         }
     }
+
+    /// The turning point `end` (its pair on the circle `sin`, `cos` and V there, `value`, in
+    /// double-double) moved onto `level` by up to three Newton steps δ = (ε − V)/V′(e), with V
+    /// at e + δ in double-double for the next step and the residual; `None` where the shift is
+    /// not below 1e-9 of e in its chart (a root finder's stopping tolerance in V, not θ,
+    /// leaves a turning point by a flat V up to a few hundred ulps off) or the residual not
+    /// below a thousandth of the offset ε − V(e) (a turning point by a flat V, next to a
+    /// critical point).
+    fn place_on_level(
+        &self,
+        end: &PieceEnd,
+        sin: DoubleDouble,
+        cos: DoubleDouble,
+        value: DoubleDouble,
+        level: DoubleDouble,
+    ) -> Option<Placed> {
+        let offset = level.sub(value).to_f64();
+        let slope = self.slope(end.angle);
+        let (mut shift, mut residual, mut error) = (0.0, offset, 0.0);
+        for _ in 0..3 {
+            shift += residual / slope;
+            if !shift.is_finite() || shift.abs() > 1e-9 * end.site.ulp_scale() {
+                return None;
+            }
+            // sin(e + δ) = sin e cos δ + cos e sin δ, cos(e + δ) = cos e cos δ − sin e sin δ,
+            // with cos δ − 1 = −δ²/2 + δ⁴/24 and sin δ = δ − δ³/6 (|δ| ≤ 1e-9: to 1e-45).
+            let square = shift * shift;
+            let cos_less_one = -0.5 * square * (1.0 - square / 12.0);
+            let sin_shift = DoubleDouble::from_f64(shift).add_f64(-shift * square / 6.0);
+            let moved_sin = sin.add(cos.mul(sin_shift)).add(sin.mul_f64(cos_less_one));
+            let moved_cos = cos.sub(sin.mul(sin_shift)).add(cos.mul_f64(cos_less_one));
+            let (moved_sin, moved_cos) = DoubleDouble::onto_circle(moved_sin, moved_cos);
+            let (moved, moved_error) = self.value_double_double_on_circle(moved_sin, moved_cos)?;
+            (residual, error) = (level.sub(moved).to_f64(), moved_error);
+            if residual.abs() <= error {
+                break;
+            }
+        }
+        let residual = residual.abs() + error;
+        let near = 2.0 * (shift * self.curvature_at(end.angle) / slope).abs();
+        (near.is_finite() && (residual <= 1e-3 * offset.abs() || offset == 0.0)).then_some(Placed {
+            shift,
+            offset,
+            residual,
+            near,
+        })
+    }
+}
+
+/// atan2(sin, cos) − θ for the pair (sin, cos) = [`Site::angle`]: the rounding of the pair as
+/// an angle, up to about an ulp of sin θ or cos θ, from both in double-double.
+fn pair_offset(site: &Site) -> f64 {
+    let a = site.angle();
+    if site.theta_exact {
+        let (sin, cos) = DoubleDouble::sin_cos(site.theta);
+        cos.mul_f64(a.sin).sub(sin.mul_f64(a.cos)).to_f64()
+    } else {
+        // The pair (sin φ, −cos φ) of π − φ: its angle is π less that of (sin φ, cos φ).
+        let (sin, cos) = DoubleDouble::sin_cos(site.from_pi);
+        -cos.mul_f64(a.sin).add(sin.mul_f64(a.cos)).to_f64()
+    }
+}
+
+/// [`PeriodIntegrals::level_residual`] of a libration cut into `pieces`: the largest residual
+/// of its turning points where both were placed on ε.
+fn level_residual(component: &Component, pieces: &[Piece]) -> Option<f64> {
+    if component.kind != MotionKind::Libration {
+        return None;
+    }
+    let ends = [&pieces.first()?.left, &pieces.last()?.right];
+    ends.iter()
+        .map(|end| end.placed.map(|p| p.residual))
+        .try_fold(0.0, |worst: f64, r| r.map(|r| worst.max(r)))
 }
 
 /// Δζ over one θ-period from θ_min (ψ = 0 there), on the current levels, and again on the
@@ -1942,6 +2077,11 @@ pub struct PeriodIntegrals {
     /// the energy (see [`EffectivePotential::saddle_conditioning`]): a libration whose level
     /// offset is known more sharply replaces them.
     pub saddle: [f64; 2],
+    /// Where a libration's turning points were placed on the level ε in double-double
+    /// ([`EffectivePotential::integrate`] below tol 1e-11 on a shape that gives V so): a bound
+    /// on |ε − V| at them, the whole offset of the level the integrals are those of. `None`:
+    /// the ends are doubles, each at its own level V(e) (see `cell::level_offset_error`).
+    pub level_residual: Option<f64>,
     /// Integrand evaluations (quadrature) or accepted steps (ODE) spent.
     pub work: usize,
     /// Whether the method reached what its estimates assume (false: the tanh-sinh levels ran
@@ -1984,6 +2124,25 @@ struct PieceEnd {
     /// The end in double-double where the gaps are computed sharply
     /// ([`EffectivePotential::sharpen_gaps`]).
     sharp: Option<SharpEnd>,
+    /// A turning point placed on the level ε in double-double ([`Placed`]); `None`: the end
+    /// is the double `angle` itself, at the level `level`.
+    placed: Option<Placed>,
+}
+
+/// A turning point e (a double) moved onto the level ε: the true end is e + `shift`, where
+/// V = ε to within `residual`, and the gap at t = e + x is ε − V(t) = `offset` − (V(t) − V(e))
+/// with `offset` = ε − V(e), both taken from V in double-double. The nodes are then placed
+/// from e + `shift`, and the integrals are those of the level ε itself: the rounding of the
+/// root to a double (an offset of up to V′ ulp(e)/2 of the level, whose effect through
+/// dX/dε near a saddle was the largest term of T's estimate at tol 1e-13) is gone.
+/// Measured from e itself, a gap is off its value from e + `shift` by at most `near` of
+/// itself: |shift V″/V′| at the end, doubled.
+#[derive(Debug, Clone, Copy)]
+struct Placed {
+    shift: f64,
+    offset: f64,
+    residual: f64,
+    near: f64,
 }
 
 /// An end's angle, on the unit circle, and its level V + `excess` in double-double, with the
@@ -2533,11 +2692,25 @@ fn sample<S: Shape>(
     energy: f64,
     node: IntervalNode,
 ) -> Result<NodeSample> {
-    // Measure from the nearer end: offset x ≥ 0 and the end's angle.
+    // Measure from the nearer end: offset x ≥ 0 and the end's angle (a placed end lies
+    // `shift` beyond its double, and its gap is measured from V there, `offset` below ε).
     let (end, signed) = if node.from_left <= node.from_right {
         (&piece.left, node.from_left)
     } else {
         (&piece.right, -node.from_right)
+    };
+    // (Nodes nearer a placed end than its shift, in the tanh-sinh rule's tails, are measured
+    // from the double: there ε − V(e) and the shift times D would cancel to their rounding,
+    // and D at e is D at e + shift to within `Placed::near`.)
+    // The gaps are those of the level V(e + shift), within `residual` of ε (bounded as a
+    // level offset in `cell::level_offset_error`): the shifted form measures from ε itself,
+    // off by that residual, which against a gap beyond the shift is below 1e-13 of it.
+    let (signed, offset, near, residual) = match end.placed {
+        Some(placed) if signed.abs() > placed.shift.abs() => {
+            (signed + placed.shift, placed.offset, 0.0, placed.residual)
+        }
+        Some(placed) => (signed, 0.0, placed.near, 0.0),
+        None => (signed, 0.0, 0.0, 0.0),
     };
     let (sx, cx) = libm::sincos(signed);
     let e = end.angle;
@@ -2562,22 +2735,23 @@ fn sample<S: Shape>(
     } else {
         // ε − V(t) = excess − sin(t − e) D(t, e) + tilt, with D the divided difference of V
         // and the tilt m·(t − e)/L that makes the two ends' levels meet (see `Piece::tilt_rate`).
+        // (At a placed end the excess is its offset ε − V(e), and no tilt.)
         let (d, scale) = divided_difference(v, a, e, sx, cx);
+        let excess = end.excess + offset;
         (
-            end.excess - sx * d + piece.tilt_rate * signed,
+            excess - sx * d + piece.tilt_rate * signed,
             end.excess_error
-                + 4.0
-                    * EPS
-                    * (end.excess.abs() + sx.abs() * scale + (piece.tilt_rate * signed).abs()),
+                + 4.0 * EPS * (excess.abs() + sx.abs() * scale + (piece.tilt_rate * signed).abs()),
         )
     };
+    let abs_err = abs_err + near * gap.abs() + residual;
     let (gap, abs_err) = match end.sharp {
-        Some(sharp) if abs_err > sharp.threshold * gap => {
+        Some(sharp) if near == 0.0 && abs_err > sharp.threshold * gap => {
             // (Within 1e-30 of V of the end the double's divided difference is the sharper.)
             sharp_gap(
                 v,
                 &sharp,
-                end.excess_error,
+                end.excess_error + residual,
                 piece.tilt_rate * signed,
                 sx,
                 cx,

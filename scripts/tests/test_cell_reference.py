@@ -138,6 +138,44 @@ def test_the_sweep_cut_short_by_a_pole_is_in_the_estimate(alpha, beta, nu, eta, 
             assert comp["errors"]["rotation_number"] <= tol, where
 
 
+# Turning points placed on the level ε in double-double (below tol 1e-11): the integrals are
+# those of ε itself, not of the levels V(e) of the rounded roots. Each case failed a step of
+# that change before it held: a libration by a saddle of the standard slice (tolerance_not_
+# reached at 1e-12 with T 3.6e-14 off, from the rounded roots' level offset through dT/dε);
+# a libration 1.7e-3 wide at θ = 2.57 (T 2e-14 off, `ok`, where the ends' pairs of sine and
+# cosine were taken for their sites); one 2e-5 wide by a pole (N 3.5e-14 off, `ok`, where the
+# limit at a turning point was taken at the double). (α, β, ν, η, κ, ε, tol)
+PLACED = [
+    (0.5, 3.0, 0.5, 0.5, 0.8235294117647058, 3.4019607843137254, 1e-12),
+    (0.999999, 60.56626390530585, 1.4997836405844263, 0.06797408392046358, -3.137518419866193,
+     48.75174155479437, 1e-12),
+    (0.5629582751261204, 288.9753546233231, 1.7698368846518233, 0.026961613830642966,
+     1.3176273195644289e-07, 1.5630155136843353, 1e-13),
+]
+
+
+@pytest.mark.parametrize("alpha, beta, nu, eta, kappa, energy, tol", PLACED)
+def test_turning_points_placed_on_the_level_give_its_integrals(alpha, beta, nu, eta, kappa, energy, tol):
+    for comp, truth in components_against_reference(alpha, beta, nu, eta, kappa, energy, tol):
+        where = f"kappa {kappa} energy {energy} {comp['family']}"
+        assert comp["status"] == "ok", where
+        assert abs(comp["period"] - float(truth.period)) <= comp["errors"]["period"] <= tol * comp["period"], where
+        error = abs(comp["rotation_number"] - float(truth.rotation_number))
+        assert error <= comp["errors"]["rotation_number"] <= tol, where
+
+
+# A rotation at κ = 0 just above its separatrix keeps its ends as doubles: they are one
+# saddle held up to an ulp of 2π apart, and the integrand peaks there as (ε − V_s)^−½; with
+# the excess in double-double (the placed ends' companion) the sliver between them was a
+# 7e-10 error of T at status `ok` (estimate 3.6e-13; whole-domain seed 12, "separatrix").
+def test_a_rotation_by_its_separatrix_is_honest_at_tight_tolerances():
+    for excess in (1e-13, 1e-10):
+        args = (-0.999999, 0.42723675960913937, 1.92385700872424, 0.41446527965102087, 0.0,
+                1.9999989999999999 + excess, 1e-13)
+        for comp, truth in components_against_reference(*args):
+            assert abs(comp["period"] - float(truth.period)) <= comp["errors"]["period"], excess
+
+
 # Oblate ellipsoids far beyond β = 1e6: U″ = β² − 1 − α at the poles and U′ ≈ β beyond 1/β of
 # them put the wells by the poles at θ ≈ √(κ/β) … (κ²/β)^⅓, inside the first scan site
 # 1e-3 √κ of the critical-point search, which then saw only the equator: `no_motion` where

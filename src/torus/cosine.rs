@@ -184,9 +184,13 @@ fn integrate_on<S: Shape>(
         });
         // Where the gaps' rounding is what keeps the converged sums from the tolerance, and
         // the sums' rounding with every gap to a few ulps (½ (INTEGRAND_ROUNDING + 4 eps) of
-        // the L1 sizes of T and Δψ, over the whole period) would leave room for it: the nodes
-        // again, with the gaps in double-double.
-        if !done && !resampled && piece.left.sharp.is_some() {
+        // the L1 sizes of T and Δψ, over the whole period) would leave room for it, or would
+        // be a quarter of it or less: the nodes again, with the gaps in double-double. (Also
+        // where the rounding alone exceeds the tolerance, which `done` accepts: a narrow well
+        // deep below a large ε, its gaps 5e-13 off in double, had T's estimate at 3e-13 of
+        // it, and 6e-15 with them in double-double.)
+        let over = extra_t > tol * period || extra_psi > tol * TAU || (with_drift && phase > tol);
+        if (!done || over) && !resampled && piece.left.sharp.is_some() {
             let per_node = INTEGRAND_ROUNDING + 4.0 * EPS;
             let floor_t = per_node * t_sums[0] + saddle_t;
             let floor_nodes_psi = per_node * sums.psi_variation + saddle_psi;
@@ -202,7 +206,8 @@ fn integrate_on<S: Shape>(
             let within = floor_t <= 0.5 * tol * period
                 && floor_psi <= 0.5 * tol * TAU
                 && (!with_drift || floor_phase <= 0.5 * tol);
-            if converged && blocked && within {
+            let improves = floor_t <= 0.25 * extra_t || floor_psi <= 0.25 * extra_psi;
+            if converged && blocked && (within || improves) {
                 resampled = true;
                 let intervals = samples.intervals;
                 match Samples::new(v, piece, map, energy, intervals) {
@@ -246,6 +251,7 @@ fn integrate_on<S: Shape>(
                 drift,
                 psi_variation: Some(2.0 * sums.psi_variation),
                 saddle: [saddle_t, saddle_psi],
+                level_residual: super::level_residual(component, std::slice::from_ref(piece)),
                 work: samples.nodes.len(),
                 converged: true,
             }));
@@ -470,9 +476,17 @@ impl Map {
             sin: a.sin,
             cos: -a.cos,
         };
+        // A placed end lies `shift` = δ beyond its double:
+        // tan((θ + δ)/2) = (t + tan(δ/2)) / (1 − t tan(δ/2)), tan(δ/2) = δ/2 to 1e-28 of it.
+        let moved = |t: f64, end: &super::PieceEnd, sign: f64| {
+            end.placed.map_or(t, |p| {
+                let half = 0.5 * sign * p.shift;
+                (t + half) / (1.0 - t * half)
+            })
+        };
         let tan_half = [
-            tan_half(piece.left.angle),
-            tan_half(mirror(piece.right.angle)),
+            moved(tan_half(piece.left.angle), &piece.left, 1.0),
+            moved(tan_half(mirror(piece.right.angle)), &piece.right, -1.0),
         ];
         Map::Mercator {
             tan_half,
@@ -554,7 +568,17 @@ pub(super) fn end_sample_with_length<S: Shape>(
     if end.excess != 0.0 {
         return None;
     }
-    let a = end.angle;
+    // (A placed end lies `shift` beyond its double: the limit is taken there, as ψ̇ ∝ 1/sin²θ
+    // and V′ move with it by shift/θ near a pole, a 3e-12 relative step of ψ̇ at θ = 3.5e-5
+    // in a shift of 5e-17; whole-domain seed 12. The shift is below 1e-9 of θ: its square is
+    // far below an ulp of the pair.)
+    let a = match end.placed {
+        Some(placed) => Angle {
+            sin: end.angle.sin + end.angle.cos * placed.shift,
+            cos: end.angle.cos - end.angle.sin * placed.shift,
+        },
+        None => end.angle,
+    };
     let red = v.body.reduction_at(a);
     let tilt = piece.tilt_rate;
     let slope = v.slope(a);
