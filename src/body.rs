@@ -166,6 +166,13 @@ pub trait Shape: Send + Sync {
         self.potential_prime(a.theta())
     }
 
+    /// The size of the terms U′ at an angle is computed from, which its rounding is a few
+    /// ulps of (where they cancel, far more than |U′|): by default |U′| itself.
+    #[inline]
+    fn potential_prime_scale_at(&self, a: Angle) -> f64 {
+        self.potential_prime_at(a).abs()
+    }
+
     /// U″ at an angle given by its sine and cosine.
     #[inline]
     fn potential_second_at(&self, a: Angle) -> f64 {
@@ -365,11 +372,20 @@ impl Ellipsoid {
         (self.beta * self.beta * a.sin * a.sin + a.cos * a.cos).sqrt()
     }
 
+    /// β² − 1 as (β − 1)(β + 1): within two ulps of itself (β − 1 is exact by Sterbenz's lemma
+    /// for β in [½, 2]), where β·β − 1 loses the digits of β² below an ulp of 1 (near a sphere,
+    /// β = 0.9989: 5e-14 of itself, a systematic error of U′ and of T at tight tolerances; a
+    /// shallow well of whole-domain seed 77 had T 1.1e-14 off).
+    #[inline]
+    pub fn beta_squared_less_one(&self) -> f64 {
+        (self.beta - 1.0) * (self.beta + 1.0)
+    }
+
     /// Z′(θ) = (β² − 1) sinθ cosθ / Z.
     #[inline]
     pub fn centre_height_prime(&self, theta: f64) -> f64 {
         let (s, c) = theta.sin_cos();
-        (self.beta * self.beta - 1.0) * s * c / self.centre_height(theta)
+        self.beta_squared_less_one() * s * c / self.centre_height(theta)
     }
 }
 
@@ -417,7 +433,7 @@ impl Shape for Ellipsoid {
     #[inline]
     fn potential_prime(&self, theta: f64) -> f64 {
         let (s, c) = theta.sin_cos();
-        -self.alpha * s + (self.beta * self.beta - 1.0) * s * c / self.centre_height(theta)
+        -self.alpha * s + self.beta_squared_less_one() * s * c / self.centre_height(theta)
     }
 
     // U(θ) = Z(θ) + α cosθ; U″(θ) = −α cosθ + (β² − 1) [cos 2θ / Z − sinθ cosθ Z′ / Z²];
@@ -439,6 +455,22 @@ impl Shape for Ellipsoid {
         a.sin * self.potential_prime_over_sin_at(a)
     }
 
+    /// |sinθ| times the sizes of the two terms of [`Shape::potential_prime_over_sin_at`]: they
+    /// cancel where β² − 1 ≈ α at a pole (U″ = β² − 1 − α there), where U′ in double is off
+    /// by thousands of ulps of itself (a libration round θ = 0 at α = 0.5, β² − 1 − α = 3e-4:
+    /// the limit of the integrand at its turning points, weighted half a step, put T 1.6
+    /// times its estimate off at tol 1e-12; an adversary pass).
+    #[inline]
+    fn potential_prime_scale_at(&self, a: Angle) -> f64 {
+        let z = self.centre_height_at(a);
+        let terms = if self.cancels(a) {
+            (1.0 - self.alpha.abs()) + (self.lift(a, z) + self.beta * self.beta * a.cos.abs()) / z
+        } else {
+            (self.beta_squared_less_one() * a.cos / z).abs() + self.alpha.abs()
+        };
+        a.sin.abs() * terms
+    }
+
     /// U″ = −α cosθ + (β² − 1) [(cos²θ − sin²θ) / Z − sinθ cosθ Z′ / Z²]. Where Z and
     /// α cosθ cancel ([`Ellipsoid::cancels`]), U = L + (1 − |α|) c with c = |cosθ| and
     /// L = Z − c, and U″ = L″ − (1 − |α|) c with
@@ -453,12 +485,12 @@ impl Shape for Ellipsoid {
             let c = a.cos.abs();
             let lift = self.lift(a, z);
             let (c2, s2) = (c * c, a.sin * a.sin);
-            let lift_second =
-                (c * lift * (z * z + z * c + c2) + b2 * c2 * c2 + b2 * (1.0 - b2) * s2 * s2)
-                    / (z * z * z);
+            let lift_second = (c * lift * (z * z + z * c + c2) + b2 * c2 * c2
+                - b2 * self.beta_squared_less_one() * s2 * s2)
+                / (z * z * z);
             return lift_second - (1.0 - self.alpha.abs()) * c;
         }
-        let b = self.beta * self.beta - 1.0;
+        let b = self.beta_squared_less_one();
         let zp = b * a.sin * a.cos / z;
         -self.alpha * a.cos
             + b * ((a.cos * a.cos - a.sin * a.sin) / z - a.sin * a.cos * zp / (z * z))
@@ -474,7 +506,7 @@ impl Shape for Ellipsoid {
     /// cos²θ = α²β² / ((β² − 1)(β² − 1 + α²)), cosθ of the sign of α (β² − 1) (π/2 at
     /// α = 0).
     fn slope_zeros(&self) -> Vec<f64> {
-        let b = self.beta * self.beta - 1.0;
+        let b = self.beta_squared_less_one();
         if b == 0.0 {
             // (The sphere: U′ = −α sinθ, zero only at the poles, or everywhere at α = 0.)
             return Vec::new();
@@ -500,7 +532,7 @@ impl Shape for Ellipsoid {
             return self.alpha.signum()
                 * ((1.0 - self.alpha.abs()) - (lift + b2 * a.cos.abs()) / z);
         }
-        (b2 - 1.0) * a.cos / z - self.alpha
+        self.beta_squared_less_one() * a.cos / z - self.alpha
     }
 
     #[inline]
@@ -531,7 +563,7 @@ impl Shape for Ellipsoid {
         let b2 = self.beta * self.beta;
         let sin_sum = x.sin * y.cos + x.cos * y.sin;
         let (zx, zy) = (self.centre_height_at(x), self.centre_height_at(y));
-        let shape = (b2 - 1.0) * sin_sum / (zx + zy);
+        let shape = self.beta_squared_less_one() * sin_sum / (zx + zy);
         if self.cancels(x) && self.cancels(y) {
             let cdd = self.alpha.signum() * (x.sin + y.sin) / (1.0 + cos_diff);
             let e = shape + cdd;

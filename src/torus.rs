@@ -1128,7 +1128,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         // quadrature much below that bound (a worst case; a tenth of it) would buy nothing.
         let provisional = double * samples.iter().map(|s| s.period(0)).sum::<f64>();
         let (floor_t, floor_psi) =
-            self.saddle_conditioning(energy, component, provisional, double, 0.0);
+            self.placed_saddle_conditioning(energy, component, provisional, double, &pieces);
         let mut converged = true;
         for (piece, sample) in pieces.iter().zip(samples.iter_mut()) {
             // Half of the tolerance for the quadrature, half left for rounding (which the
@@ -1181,7 +1181,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         let psi_rounding = double * sum(&|s| s.rounding(|n| n.dpsi));
         let psi_variation = double * sum(&|s| s.size(DPSI));
         let (saddle_t, saddle_psi) =
-            self.saddle_conditioning(energy, component, period, double, 0.0);
+            self.placed_saddle_conditioning(energy, component, period, double, &pieces);
         period_error += period_rounding + saddle_t;
         psi_advance_error += psi_rounding + saddle_psi + self.passage_rounding(component);
         // A turning point nearer its pole than the rule's last node (e^{−π sinh τ_max} of the
@@ -1220,7 +1220,18 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             let mut known = Vec::new();
             let mut result = drift_estimate(&samples, psi_advance, double, &mut known);
             for _ in 0..(MAX_LEVEL - START_LEVEL) {
-                if result.error <= tol.max(0.1 * phase) * result.scale
+                // (What the tolerance leaves after the phases' rounding, which is added below,
+                // as for T and Δψ: refined only to the tolerance itself, 25 librations by the
+                // saddle of the standard slice missed 1e-13 by that rounding. Where it leaves
+                // less than a tenth of that rounding, the tolerance itself, as before: the
+                // drift misses it anyway, and refining further only cost work at 1e-14.)
+                let room = tol - phase;
+                let target = if room > 0.1 * phase {
+                    room
+                } else {
+                    tol.max(0.1 * phase)
+                };
+                if result.error <= target * result.scale
                     || samples.iter().any(|s| s.level >= MAX_LEVEL)
                 {
                     break;
@@ -1295,6 +1306,29 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         self.saddle_terms(energy, component, period, double, |p| {
             energy_error.max(4.0 * EPS * (p.scale + energy.abs()))
         })
+    }
+
+    /// [`Self::saddle_conditioning`] of the quadrature's `pieces`: where their turning points
+    /// were placed on ε ([`PeriodIntegrals::level_residual`]), at twice that residual, the
+    /// whole offset of their level (the rounding of V at the nodes is in the nodes' bounds);
+    /// otherwise at the a-priori error of the energy. (Taken at the a-priori error, the term
+    /// set how far the drift was refined, 0.1 of it, and was then replaced by the residual's
+    /// in `cell`: 58 librations by the saddle of the standard slice missed tol 1e-13 by their
+    /// drift alone.)
+    fn placed_saddle_conditioning(
+        &self,
+        energy: f64,
+        component: &Component,
+        period: f64,
+        double: f64,
+        pieces: &[Piece],
+    ) -> (f64, f64) {
+        match level_residual(component, pieces) {
+            Some(residual) => {
+                self.saddle_conditioning_within(energy, component, period, double, 2.0 * residual)
+            }
+            None => self.saddle_conditioning(energy, component, period, double, 0.0),
+        }
     }
 
     /// [`Self::saddle_conditioning`] for an energy known to within `delta` (a libration's
@@ -1863,14 +1897,7 @@ impl<S: Shape> EffectivePotential<'_, S> {
             if !shift.is_finite() || shift.abs() > 1e-9 * end.site.ulp_scale() {
                 return None;
             }
-            // sin(e + δ) = sin e cos δ + cos e sin δ, cos(e + δ) = cos e cos δ − sin e sin δ,
-            // with cos δ − 1 = −δ²/2 + δ⁴/24 and sin δ = δ − δ³/6 (|δ| ≤ 1e-9: to 1e-45).
-            let square = shift * shift;
-            let cos_less_one = -0.5 * square * (1.0 - square / 12.0);
-            let sin_shift = DoubleDouble::from_f64(shift).add_f64(-shift * square / 6.0);
-            let moved_sin = sin.add(cos.mul(sin_shift)).add(sin.mul_f64(cos_less_one));
-            let moved_cos = cos.sub(sin.mul(sin_shift)).add(cos.mul_f64(cos_less_one));
-            let (moved_sin, moved_cos) = DoubleDouble::onto_circle(moved_sin, moved_cos);
+            let (moved_sin, moved_cos) = turned(sin, cos, shift);
             let (moved, moved_error) = self.value_double_double_on_circle(moved_sin, moved_cos)?;
             (residual, error) = (level.sub(moved).to_f64(), moved_error);
             if residual.abs() <= error {
@@ -1886,6 +1913,18 @@ impl<S: Shape> EffectivePotential<'_, S> {
             near,
         })
     }
+}
+
+/// The pair (`sin`, `cos`) of an angle turned by a small `step` (|step| ≤ 1e-9), in
+/// double-double: sin(e + δ) = sin e cos δ + cos e sin δ, cos(e + δ) = cos e cos δ − sin e sin δ,
+/// with cos δ − 1 = −δ²/2 + δ⁴/24 and sin δ = δ − δ³/6 (to 1e-45), scaled onto the circle.
+fn turned(sin: DoubleDouble, cos: DoubleDouble, step: f64) -> (DoubleDouble, DoubleDouble) {
+    let square = step * step;
+    let cos_less_one = -0.5 * square * (1.0 - square / 12.0);
+    let sin_step = DoubleDouble::from_f64(step).add_f64(-step * square / 6.0);
+    let moved_sin = sin.add(cos.mul(sin_step)).add(sin.mul_f64(cos_less_one));
+    let moved_cos = cos.sub(sin.mul(sin_step)).add(cos.mul_f64(cos_less_one));
+    DoubleDouble::onto_circle(moved_sin, moved_cos)
 }
 
 /// atan2(sin, cos) − θ for the pair (sin, cos) = [`Site::angle`]: the rounding of the pair as

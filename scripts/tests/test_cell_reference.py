@@ -164,6 +164,30 @@ def test_turning_points_placed_on_the_level_give_its_integrals(alpha, beta, nu, 
         assert error <= comp["errors"]["rotation_number"] <= tol, where
 
 
+# Two roundings of the ellipsoid's shape functions that the level offset's bound had hidden,
+# each `ok` with T off by more than its estimate once the turning points were placed (an
+# adversary pass): β² − 1 taken as β·β − 1 near a sphere (β = 1 − 4e-9: T 1e-9 off relative,
+# 1.8e5 times its estimate; β = 0.9989: 1.1e-14 off, whole-domain seed 77), and the limit at
+# the turning points of a libration round a pole where β² − 1 ≈ α, U′'s two terms cancelling
+# to 3e-4 of themselves (1.6 times the estimate). (α, β, ν, η, κ, ε, tol)
+SHAPE_ROUNDING = [
+    (0.0, 0.9999999959040269, 0.001, 1000.0, 0.0, 0.9999999959138163, 1e-12),
+    (0.0, 0.9989258374274291, 1.049935914348227, 443.4523094901721, 3.517807329883907e-06,
+     0.9989258375174738, 1e-13),
+    (0.5, 1.224867345878728, 1.0, 1.0, 0.0, 1.5000000299850076, 1e-12),
+    (0.5, 1.224867345878728, 1.0, 1.0, 0.0, 1.5000000299850076, 1e-14),
+]
+
+
+@pytest.mark.parametrize("alpha, beta, nu, eta, kappa, energy, tol", SHAPE_ROUNDING)
+def test_the_shape_functions_rounding_is_in_the_estimate(alpha, beta, nu, eta, kappa, energy, tol):
+    for comp, truth in components_against_reference(alpha, beta, nu, eta, kappa, energy, tol):
+        where = f"beta {beta} energy {energy} tol {tol} {comp['family']}"
+        assert abs(comp["period"] - float(truth.period)) <= comp["errors"]["period"], where
+        error = abs(comp["rotation_number"] - float(truth.rotation_number))
+        assert error <= comp["errors"]["rotation_number"], where
+
+
 # A rotation at κ = 0 just above its separatrix keeps its ends as doubles: they are one
 # saddle held up to an ulp of 2π apart, and the integrand peaks there as (ε − V_s)^−½; with
 # the excess in double-double (the placed ends' companion) the sliver between them was a

@@ -144,7 +144,13 @@ fn integrate_on<S: Shape>(
         // The quadrature gets what the tolerance leaves of the whole error estimate after the
         // rounding of the gap and the conditioning near a saddle, which refining cannot
         // reduce (when those alone exceed it, a tenth of them: the status then says so).
-        let (saddle_t, saddle_psi) = v.saddle_conditioning(energy, component, period, 2.0, 0.0);
+        let (saddle_t, saddle_psi) = v.placed_saddle_conditioning(
+            energy,
+            component,
+            period,
+            2.0,
+            std::slice::from_ref(piece),
+        );
         let extra_t = 2.0 * sums.t_rounding + saddle_t;
         let nodes_psi = 2.0 * sums.psi_rounding + saddle_psi;
         let extra_psi = nodes_psi + passage_error;
@@ -189,7 +195,9 @@ fn integrate_on<S: Shape>(
         // where the rounding alone exceeds the tolerance, which `done` accepts: a narrow well
         // deep below a large ε, its gaps 5e-13 off in double, had T's estimate at 3e-13 of
         // it, and 6e-15 with them in double-double.)
-        let over = extra_t > tol * period || extra_psi > tol * TAU || (with_drift && phase > tol);
+        let over = t_error + extra_t > tol * period
+            || psi_error + extra_psi > tol * TAU
+            || drift.is_some_and(|d| d.error > tol * d.scale);
         if (!done || over) && !resampled && piece.left.sharp.is_some() {
             let per_node = INTEGRAND_ROUNDING + 4.0 * EPS;
             let floor_t = per_node * t_sums[0] + saddle_t;
@@ -199,15 +207,30 @@ fn integrate_on<S: Shape>(
                 && trusted
                 && t_error <= 0.5 * tol * period
                 && psi_error <= 0.5 * tol * TAU;
-            let blocked = extra_t > 0.5 * tol * period
-                || extra_psi > 0.5 * tol * TAU
-                || (with_drift && phase > 0.5 * tol);
             let floor_phase = (floor_t - saddle_t) / period + floor_nodes_psi;
-            let within = floor_t <= 0.5 * tol * period
-                && floor_psi <= 0.5 * tol * TAU
-                && (!with_drift || floor_phase <= 0.5 * tol);
+            // (Each of T, Δψ and the drift that misses the tolerance would meet it with the
+            // floor; one that meets it needs no room: with N alone at tol 1e-14, T missing and
+            // Δψ's floor a hair above half the tolerance had kept 300 librations of the
+            // standard slice from it.)
+            let frees = |error: f64, extra: f64, floor: f64, allowed: f64| {
+                error + extra <= allowed || error + floor <= allowed
+            };
+            let drift_freed = match drift {
+                Some(d) => {
+                    let quadrature = d.error / d.scale.max(f64::MIN_POSITIVE) - phase;
+                    frees(quadrature, phase, floor_phase, tol)
+                }
+                None => !with_drift || phase <= 0.5 * tol || floor_phase <= 0.5 * tol,
+            };
+            let blocked = over || !done;
+            let within = frees(t_error, extra_t, floor_t, tol * period)
+                && frees(psi_error, extra_psi, floor_psi, tol * TAU)
+                && drift_freed;
             let improves = floor_t <= 0.25 * extra_t || floor_psi <= 0.25 * extra_psi;
-            if converged && blocked && (within || improves) {
+            // (Only to sharpen an estimate where the drift can still meet the tolerance: at
+            // 1e-14 its phases' floor misses it, and resampling every component there for T's
+            // estimate alone took the work to 1.53 times that at 1e-13.)
+            if converged && blocked && (within || (improves && drift_freed)) {
                 resampled = true;
                 let intervals = samples.intervals;
                 match Samples::new(v, piece, map, energy, intervals) {
@@ -585,13 +608,54 @@ pub(super) fn end_sample_with_length<S: Shape>(
     let g = if left { tilt - slope } else { slope - tilt };
     let w = v.kappa / a.sin;
     let terms =
-        w * w * (a.cos / a.sin).abs() + v.body.shape.potential_prime_at(a).abs() + tilt.abs();
+        w * w * (a.cos / a.sin).abs() + v.body.shape.potential_prime_scale_at(a) + tilt.abs();
     let g_error = 8.0 * EPS * terms;
+    // Where the wall's slope and U′ nearly cancel (a turning point by a saddle, a narrow
+    // well below a large ε), g in double is off by up to 8 ulps of their sizes, and the
+    // limit, weighted half a step, carried most of T's rounding bound at tol 1e-14. At a
+    // placed end the slope comes from V in double-double instead.
+    let (g, g_error) = match (end.placed, end.sharp) {
+        (Some(placed), Some(sharp)) if g_error > 4.0 * EPS * g.abs() => {
+            sharp_slope(v, piece, &placed, &sharp, left)
+                .filter(|&(_, sharp_error)| sharp_error < g_error)
+                .unwrap_or((g, g_error))
+        }
+        _ => (g, g_error),
+    };
     if g.is_nan() || g <= 1e3 * g_error {
         return None;
     }
     let dt = root_of_ratio(red.reduced_inertia, end_length, 2.0 * g);
     Some(weighted(v, a, &red, dt, 0.0, g_error / g))
+}
+
+/// |V′| at the placed end e + shift of `piece` (`left` or right) from V in double-double: with
+/// V at e + shift and a step x = 1e-12 min(θ_e, π − θ_e, L) inwards, |V′| = −ΔV/x + V″x/2 (V″
+/// in double), within the double-double errors over x, an ulp of the V″ term, and a
+/// millionth of it for the terms beyond (V‴ below 3e6 V″/min(θ_e, π − θ_e, L)). `None`
+/// where V is not given so or the difference is not a descent.
+fn sharp_slope<S: Shape>(
+    v: &EffectivePotential<'_, S>,
+    piece: &Piece,
+    placed: &super::Placed,
+    sharp: &super::SharpEnd,
+    left: bool,
+) -> Option<(f64, f64)> {
+    let end = if left { &piece.left } else { &piece.right };
+    let chart = end.site.theta.abs().min(end.site.from_pi.abs());
+    let step = 1e-12 * chart.min(piece.length);
+    let inwards = if left { step } else { -step };
+    let (sin, cos) = super::turned(sharp.sin, sharp.cos, placed.shift);
+    let (at_end, end_error) = v.value_double_double_on_circle(sin, cos)?;
+    let (sin, cos) = super::turned(sharp.sin, sharp.cos, placed.shift + inwards);
+    let (inside, inside_error) = v.value_double_double_on_circle(sin, cos)?;
+    let fall = -inside.sub(at_end).to_f64();
+    let curvature = v.curvature_at(end.angle);
+    let g = fall / step + 0.5 * curvature * step;
+    let error = 2.0 * (end_error + inside_error) / step
+        + EPS * fall.abs() / step
+        + (EPS + 1e-6) * (curvature * step).abs();
+    (g.is_finite() && fall > 0.0 && g > 0.0).then_some((g, error))
 }
 
 /// ν (the mean of ψ̇ dt/dφ over the circle, Δψ/2π) and ψ̃ at every `stride`-th node

