@@ -1127,8 +1127,9 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         // Near a saddle the conditioning of ε (below) may exceed the tolerance: refining the
         // quadrature much below that bound (a worst case; a tenth of it) would buy nothing.
         let provisional = double * samples.iter().map(|s| s.period(0)).sum::<f64>();
+        let residual = level_residual(component, &pieces);
         let (floor_t, floor_psi) =
-            self.placed_saddle_conditioning(energy, component, provisional, double, &pieces);
+            self.placed_saddle_conditioning(energy, component, provisional, double, residual);
         let mut converged = true;
         for (piece, sample) in pieces.iter().zip(samples.iter_mut()) {
             // Half of the tolerance for the quadrature, half left for rounding (which the
@@ -1181,7 +1182,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         let psi_rounding = double * sum(&|s| s.rounding(|n| n.dpsi));
         let psi_variation = double * sum(&|s| s.size(DPSI));
         let (saddle_t, saddle_psi) =
-            self.placed_saddle_conditioning(energy, component, period, double, &pieces);
+            self.placed_saddle_conditioning(energy, component, period, double, residual);
         period_error += period_rounding + saddle_t;
         psi_advance_error += psi_rounding + saddle_psi + self.passage_rounding(component);
         // A turning point nearer its pole than the rule's last node (e^{−π sinh τ_max} of the
@@ -1266,7 +1267,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             drift,
             psi_variation: Some(psi_variation),
             saddle: [saddle_t, saddle_psi],
-            level_residual: level_residual(component, &pieces),
+            level_residual: residual,
             work: spent + samples.iter().map(|s| s.evaluations).sum::<usize>(),
             converged,
         })
@@ -1308,8 +1309,8 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         })
     }
 
-    /// [`Self::saddle_conditioning`] of the quadrature's `pieces`: where their turning points
-    /// were placed on ε ([`PeriodIntegrals::level_residual`]), at twice that residual, the
+    /// [`Self::saddle_conditioning`] of the quadrature's pieces: where their turning points
+    /// were placed on ε (`residual`, [`PeriodIntegrals::level_residual`]), at twice it, the
     /// whole offset of their level (the rounding of V at the nodes is in the nodes' bounds);
     /// otherwise at the a-priori error of the energy. (Taken at the a-priori error, the term
     /// set how far the drift was refined, 0.1 of it, and was then replaced by the residual's
@@ -1321,9 +1322,9 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         component: &Component,
         period: f64,
         double: f64,
-        pieces: &[Piece],
+        residual: Option<f64>,
     ) -> (f64, f64) {
-        match level_residual(component, pieces) {
+        match residual {
             Some(residual) => {
                 self.saddle_conditioning_within(energy, component, period, double, 2.0 * residual)
             }
@@ -1891,26 +1892,34 @@ impl<S: Shape> EffectivePotential<'_, S> {
     ) -> Option<Placed> {
         let offset = level.sub(value).to_f64();
         let slope = self.slope(end.angle);
-        let (mut shift, mut residual, mut error) = (0.0, offset, 0.0);
+        let mut shift = 0.0;
+        let mut moved = (sin, cos, value, 0.0);
+        let mut residual = offset;
         for _ in 0..3 {
             shift += residual / slope;
             if !shift.is_finite() || shift.abs() > 1e-9 * end.site.ulp_scale() {
                 return None;
             }
             let (moved_sin, moved_cos) = turned(sin, cos, shift);
-            let (moved, moved_error) = self.value_double_double_on_circle(moved_sin, moved_cos)?;
-            (residual, error) = (level.sub(moved).to_f64(), moved_error);
+            let (value, error) = self.value_double_double_on_circle(moved_sin, moved_cos)?;
+            moved = (moved_sin, moved_cos, value, error);
+            residual = level.sub(value).to_f64();
             if residual.abs() <= error {
                 break;
             }
         }
-        let residual = residual.abs() + error;
+        let (moved_sin, moved_cos, moved_value, moved_error) = moved;
+        let residual = residual.abs() + moved_error;
         let near = 2.0 * (shift * self.curvature_at(end.angle) / slope).abs();
         (near.is_finite() && (residual <= 1e-3 * offset.abs() || offset == 0.0)).then_some(Placed {
             shift,
             offset,
             residual,
             near,
+            sin: moved_sin,
+            cos: moved_cos,
+            value: moved_value,
+            value_error: moved_error,
         })
     }
 }
@@ -2175,13 +2184,18 @@ struct PieceEnd {
 /// root to a double (an offset of up to V′ ulp(e)/2 of the level, whose effect through
 /// dX/dε near a saddle was the largest term of T's estimate at tol 1e-13) is gone.
 /// Measured from e itself, a gap is off its value from e + `shift` by at most `near` of
-/// itself: |shift V″/V′| at the end, doubled.
+/// itself: |shift V″/V′| at the end, doubled. `sin`, `cos` are the pair of e + `shift` and
+/// `value` V there, in double-double, within `value_error`.
 #[derive(Debug, Clone, Copy)]
 struct Placed {
     shift: f64,
     offset: f64,
     residual: f64,
     near: f64,
+    sin: DoubleDouble,
+    cos: DoubleDouble,
+    value: DoubleDouble,
+    value_error: f64,
 }
 
 /// An end's angle, on the unit circle, and its level V + `excess` in double-double, with the

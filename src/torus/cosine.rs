@@ -124,6 +124,7 @@ fn integrate_on<S: Shape>(
         Map::Plain { .. } => 0.0,
         Map::Mercator { .. } => v.passage_rounding(component),
     };
+    let residual = super::level_residual(component, std::slice::from_ref(piece));
     let Some(mut samples) = Samples::new(v, &plain, map, energy, first_intervals(tol)) else {
         // (A node of the first level outside the allowed set: at most that level spent.)
         return Ok(Err(first_intervals(tol) + 1));
@@ -144,13 +145,8 @@ fn integrate_on<S: Shape>(
         // The quadrature gets what the tolerance leaves of the whole error estimate after the
         // rounding of the gap and the conditioning near a saddle, which refining cannot
         // reduce (when those alone exceed it, a tenth of them: the status then says so).
-        let (saddle_t, saddle_psi) = v.placed_saddle_conditioning(
-            energy,
-            component,
-            period,
-            2.0,
-            std::slice::from_ref(piece),
-        );
+        let (saddle_t, saddle_psi) =
+            v.placed_saddle_conditioning(energy, component, period, 2.0, residual);
         let extra_t = 2.0 * sums.t_rounding + saddle_t;
         let nodes_psi = 2.0 * sums.psi_rounding + saddle_psi;
         let extra_psi = nodes_psi + passage_error;
@@ -222,7 +218,6 @@ fn integrate_on<S: Shape>(
                 }
                 None => !with_drift || phase <= 0.5 * tol || floor_phase <= 0.5 * tol,
             };
-            let blocked = over || !done;
             let within = frees(t_error, extra_t, floor_t, tol * period)
                 && frees(psi_error, extra_psi, floor_psi, tol * TAU)
                 && drift_freed;
@@ -230,7 +225,7 @@ fn integrate_on<S: Shape>(
             // (Only to sharpen an estimate where the drift can still meet the tolerance: at
             // 1e-14 its phases' floor misses it, and resampling every component there for T's
             // estimate alone took the work to 1.53 times that at 1e-13.)
-            if converged && blocked && (within || (improves && drift_freed)) {
+            if converged && (within || (improves && drift_freed)) {
                 resampled = true;
                 let intervals = samples.intervals;
                 match Samples::new(v, piece, map, energy, intervals) {
@@ -274,7 +269,7 @@ fn integrate_on<S: Shape>(
                 drift,
                 psi_variation: Some(2.0 * sums.psi_variation),
                 saddle: [saddle_t, saddle_psi],
-                level_residual: super::level_residual(component, std::slice::from_ref(piece)),
+                level_residual: residual,
                 work: samples.nodes.len(),
                 converged: true,
             }));
@@ -615,8 +610,8 @@ pub(super) fn end_sample_with_length<S: Shape>(
     // limit, weighted half a step, carried most of T's rounding bound at tol 1e-14. At a
     // placed end the slope comes from V in double-double instead.
     let (g, g_error) = match (end.placed, end.sharp) {
-        (Some(placed), Some(sharp)) if g_error > 4.0 * EPS * g.abs() => {
-            sharp_slope(v, piece, &placed, &sharp, left)
+        (Some(placed), Some(_)) if g_error > 4.0 * EPS * g.abs() => {
+            sharp_slope(v, piece, &placed, left)
                 .filter(|&(_, sharp_error)| sharp_error < g_error)
                 .unwrap_or((g, g_error))
         }
@@ -638,16 +633,14 @@ fn sharp_slope<S: Shape>(
     v: &EffectivePotential<'_, S>,
     piece: &Piece,
     placed: &super::Placed,
-    sharp: &super::SharpEnd,
     left: bool,
 ) -> Option<(f64, f64)> {
     let end = if left { &piece.left } else { &piece.right };
     let chart = end.site.theta.abs().min(end.site.from_pi.abs());
     let step = 1e-12 * chart.min(piece.length);
     let inwards = if left { step } else { -step };
-    let (sin, cos) = super::turned(sharp.sin, sharp.cos, placed.shift);
-    let (at_end, end_error) = v.value_double_double_on_circle(sin, cos)?;
-    let (sin, cos) = super::turned(sharp.sin, sharp.cos, placed.shift + inwards);
+    let (at_end, end_error) = (placed.value, placed.value_error);
+    let (sin, cos) = super::turned(placed.sin, placed.cos, inwards);
     let (inside, inside_error) = v.value_double_double_on_circle(sin, cos)?;
     let fall = -inside.sub(at_end).to_f64();
     let curvature = v.curvature_at(end.angle);
