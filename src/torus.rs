@@ -1304,7 +1304,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         double: f64,
         energy_error: f64,
     ) -> (f64, f64) {
-        self.saddle_terms(energy, component, period, double, |p| {
+        self.saddle_terms(energy, component, period, double, false, |p| {
             energy_error.max(4.0 * EPS * (p.scale + energy.abs()))
         })
     }
@@ -1342,16 +1342,23 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         double: f64,
         delta: f64,
     ) -> (f64, f64) {
-        self.saddle_terms(energy, component, period, double, |_| delta)
+        self.saddle_terms(energy, component, period, double, true, |_| delta)
     }
 
-    /// The saddle terms with the energy error `delta` at each saddle.
+    /// The saddle terms with the energy error `delta` at each saddle; where `sharp` (an
+    /// offset computed in double-double, far below an ulp of V), each saddle's distance from
+    /// ε is taken in double-double too ([`Self::saddle_distance`]), and a level offset that
+    /// may reach across the saddle makes the terms infinite: the integrals are then of a
+    /// motion on the separatrix's other side (ε 5e-17 above a saddle whose level rounded
+    /// to an ulp above it: two librations of T 2.1e5 ± 4e3 where the truth is one
+    /// rotation of T 2.05e5; adversary pass).
     fn saddle_terms(
         &self,
         energy: f64,
         component: &Component,
         period: f64,
         double: f64,
+        sharp: bool,
         delta: impl Fn(&CriticalPoint) -> f64,
     ) -> (f64, f64) {
         let (mut saddle_t, mut saddle_psi) = (0.0, 0.0);
@@ -1362,10 +1369,25 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             .map(|p| (*p, double))
             .chain(component.neighbours.iter().flatten().map(|p| (*p, 1.0)))
             .filter(|(p, _)| p.kind != CriticalKind::Minimum)
-            .map(|(p, passes)| (p, passes, gap(&p)));
-        for (p, passes, gap) in saddles.chain(self.near_shoulders(energy, component, double)) {
+            .map(|(p, passes)| (p, passes, gap(&p), sharp));
+        let shoulders = self
+            .near_shoulders(energy, component, double)
+            .into_iter()
+            .map(|(p, passes, gap)| (p, passes, gap, false));
+        for (p, passes, gap, sharp) in saddles.chain(shoulders) {
             let a = p.site.angle();
             let b = self.body.reduction_at(a).reduced_inertia;
+            // The distance left once the offset is spent: (ε − V_s) ± δ must keep its sign.
+            let gap = if sharp {
+                let (distance, error) = self.saddle_distance(energy, &p);
+                let room = distance - error - delta(&p);
+                if room.is_nan() || room <= 0.0 {
+                    return (f64::INFINITY, f64::INFINITY);
+                }
+                room
+            } else {
+                gap
+            };
             // dT/dε ≈ 1/(λ |ε − V_s|) per passage; never more than T/|ε − V_s| (a flat or
             // degenerate point, λ = 0, has no logarithm).
             let lambda = (p.curvature.abs() / b).sqrt();
@@ -1375,6 +1397,37 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             saddle_psi += dt * self.psi_rate(a).abs();
         }
         (saddle_t, saddle_psi)
+    }
+
+    /// |ε − V_s| for the critical point `p` and a bound on its error: V at the point in
+    /// double-double where the shape gives it (about 1e-30 of V's terms), plus how far the
+    /// extremum may lie beyond V at the rounded site, V′²/(2|V″|) with V′ there bounded by
+    /// its value and rounding; else in double, with 4 ulps of V's terms.
+    fn saddle_distance(&self, energy: f64, p: &CriticalPoint) -> (f64, f64) {
+        let a = p.site.angle();
+        let plain = (
+            (energy - p.value).abs(),
+            4.0 * EPS * (p.scale + energy.abs()),
+        );
+        let Some((value, error)) = self.value_double_double(a) else {
+            return plain;
+        };
+        let distance = DoubleDouble::from_f64(energy).sub(value).to_f64();
+        let wall = if self.kappa == 0.0 {
+            0.0
+        } else {
+            let w = self.kappa / a.sin;
+            (w * w * a.cos / a.sin).abs()
+        };
+        let slope_scale = self.body.shape.potential_prime_scale_at(a) + wall;
+        let slope = self.slope(a).abs() + 4.0 * EPS * slope_scale;
+        let beyond = slope * slope / (2.0 * p.curvature.abs());
+        let error = error + EPS * distance.abs() + beyond;
+        if error.is_finite() {
+            (distance.abs(), error)
+        } else {
+            plain
+        }
     }
 
     /// The kinks inside the component (passed `double` times a period) or between an end and
@@ -1803,6 +1856,17 @@ impl<S: Shape> EffectivePotential<'_, S> {
         // 1e-12 … 1e-8 of V(joint) had T 2.2e-11 off with an estimate of 3.4e-13 at tol 1e-13;
         // an adversary pass.)
         if tol >= SHARP_GAPS_BELOW || !self.body.shape.kinks().is_empty() {
+            // (In double too the gaps vanish at the pairs' angles: where that rounding, up to
+            // an ulp of the larger of sin θ and cos θ at each end, could weigh in against the
+            // tolerance relative to the length, the length is taken between the pairs.)
+            if kind == MotionKind::Libration {
+                for piece in pieces.iter_mut() {
+                    if 4.0 * EPS > 1e-3 * tol * piece.length {
+                        piece.length +=
+                            pair_offset(&piece.right.site) - pair_offset(&piece.left.site);
+                    }
+                }
+            }
             return;
         }
         let threshold = SHARP_GAP_ROUNDING.max(0.02 * tol);
@@ -1871,6 +1935,11 @@ impl<S: Shape> EffectivePotential<'_, S> {
                     |end: &PieceEnd| end.placed.map_or(0.0, |p| p.shift) + pair_offset(&end.site);
                 piece.length += shift(&piece.right) - shift(&piece.left);
                 piece.tilt_rate = 0.0;
+            } else if kind == MotionKind::Libration {
+                // (The gaps vanish at the ends' pairs, whatever their levels: a libration
+                // 6.9e-10 wide at θ = 6e-6, its turning points too far off ε to be placed,
+                // had T 1.8 times its estimate off with the length between the doubles.)
+                piece.length += pair_offset(&piece.right.site) - pair_offset(&piece.left.site);
             }
         }
     }
