@@ -594,7 +594,12 @@ impl Shape for Ellipsoid {
         let z = self.centre_height_at(a);
         let b2 = self.beta * self.beta;
         let (u, w) = self.height_and_offset_at(a, z);
-        (u, (b2 * b2 * a.sin * a.sin + w * w) / (z * z))
+        // |r|² = (β⁴ sin²θ + w²)/Z², each part scaled by 1/Z before squaring: β⁴ overflows
+        // beyond β = 1e77, where |r| is still below 1e154 (the diagram's N at the bottom came
+        // out +inf there, from B = inf).
+        let inv_z = 1.0 / z;
+        let (horizontal, vertical) = (b2 * a.sin * inv_z, w * inv_z);
+        (u, horizontal * horizontal + vertical * vertical)
     }
 }
 

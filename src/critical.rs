@@ -191,7 +191,9 @@ pub struct CriticalSet {
 pub fn fixed_point_kappa_sq(body: &EllipsoidBody, theta0: f64) -> f64 {
     let (a, b) = (body.shape.alpha, body.shape.beta);
     let s2 = theta0.sin().powi(2);
-    s2 * s2 * ((b * b - 1.0) / body.shape.centre_height(theta0) - a / theta0.cos())
+    // (sin²θ0 times the bracket first: at β = 1e80 the bracket is 1e160 and sin⁴θ0 alone
+    // underflows below θ0 = 1e-77, where κ² is still 1e-150.)
+    s2 * (s2 * ((b * b - 1.0) / body.shape.centre_height(theta0) - a / theta0.cos()))
 }
 
 /// ε on the fixed-point curve (`s1`):
@@ -445,6 +447,29 @@ fn sample_branches<S: Shape>(
                     .map(|&t| (t, true)),
             )
             .collect();
+        // A body whose shape turns on a scale w far below the grid's step (an oblate
+        // ellipsoid's 1/β at the poles, a prolate one's β at the equator) has its curve's
+        // features there: at β = 1e10, N at the bottom peaks at 1.7e9 at θ0 = 1.4e-10, which
+        // the grid (and its climbs, evenly in κ) stepped over, reporting 3.8e4 as the top of
+        // the range. Probes are added eight a decade from each end of the half in towards
+        // the grid, from a thousandth of w up.
+        let step = (hi - lo) / samples as f64;
+        let finest = 1e-3 * curve.body.shape.angular_feature_scale().min(1.0);
+        if finest < step {
+            let decades = (step / finest).log10();
+            let per_decade = 8.0;
+            let count = (decades * per_decade).ceil() as usize;
+            for j in 1..=count {
+                let d = step * 10f64.powf(-(j as f64) / per_decade);
+                // (Not where κ² underflows: κ = 0 off an equilibrium is no permanent
+                // rotation, and its N would be 0 where the branch tends to ±1/2.)
+                for t in [lo + d, hi - d] {
+                    if t > lo && t < hi && (curve.kappa_sq)(t) >= f64::MIN_POSITIVE {
+                        probes.push((t, false));
+                    }
+                }
+            }
+        }
         probes.sort_by(|a, b| a.0.total_cmp(&b.0));
         probes.dedup_by(|a, b| a.0 == b.0);
         probes.push((last, false));
@@ -472,6 +497,9 @@ fn sample_branches<S: Shape>(
         if (curve.pole_ends)(pole) && !pts.is_empty() {
             pts.push((curve.point)(pole));
         }
+        pts.sort_by(|a, b| a.theta0.total_cmp(&b.theta0));
+        pts.dedup_by(|a, b| a.theta0 == b.theta0);
+        pts.extend(peaks_of_rotation_number(curve, &pts, kappa_max));
         pts.sort_by(|a, b| a.theta0.total_cmp(&b.theta0));
         pts.dedup_by(|a, b| a.theta0 == b.theta0);
         // Runs of equal stability; a flip inside a half is the cusp (V″ = 0 on the curve).
@@ -521,6 +549,60 @@ fn sample_branches<S: Shape>(
         }
     }
     Ok((branches, cusps))
+}
+
+/// The largest and the smallest N at the bottom among the sampled points `pts` (sorted by
+/// θ0), where either is a peak between two stable neighbours, located to about 1e-10 of θ0
+/// between them by golden-section steps on the curve: the branch's range of N is then its
+/// own, not its samples' (at β = 1e10 the samples' top, eight a decade, was 4e-4 below the
+/// peak's 1.6924e9).
+fn peaks_of_rotation_number<S: Shape>(
+    curve: &Curve<'_, S>,
+    pts: &[FixedPoint],
+    kappa_max: f64,
+) -> Vec<FixedPoint> {
+    let n_of = |p: &FixedPoint| p.rotation_number.filter(|n| n.is_finite());
+    let mut found = Vec::new();
+    for sign in [1.0, -1.0] {
+        let best = (1..pts.len().saturating_sub(1))
+            .filter(|&i| pts[i - 1..=i + 1].iter().all(|p| n_of(p).is_some()))
+            .max_by(|&i, &j| {
+                let (a, b) = (sign * n_of(&pts[i]).unwrap(), sign * n_of(&pts[j]).unwrap());
+                a.total_cmp(&b)
+            });
+        let Some(i) = best else { continue };
+        let height = |p: &FixedPoint| sign * n_of(p).unwrap_or(f64::NEG_INFINITY);
+        if height(&pts[i]) < height(&pts[i - 1]) || height(&pts[i]) < height(&pts[i + 1]) {
+            continue;
+        }
+        // Golden-section search on (θ_{i−1}, θ_{i+1}) for the largest sign·N.
+        let ratio = 0.5 * (5f64.sqrt() - 1.0);
+        let (mut a, mut b) = (pts[i - 1].theta0, pts[i + 1].theta0);
+        let at = |t: f64| {
+            let p = (curve.point)(t);
+            (height(&p), p)
+        };
+        let mut x1 = b - ratio * (b - a);
+        let mut x2 = a + ratio * (b - a);
+        let (mut f1, mut p1) = at(x1);
+        let (mut f2, mut p2) = at(x2);
+        while b - a > 1e-10 * b.abs().max(f64::MIN_POSITIVE) {
+            if f1 >= f2 {
+                (b, x2, f2, p2) = (x2, x1, f1, p1);
+                x1 = b - ratio * (b - a);
+                (f1, p1) = at(x1);
+            } else {
+                (a, x1, f1, p1) = (x1, x2, f2, p2);
+                x2 = a + ratio * (b - a);
+                (f2, p2) = at(x2);
+            }
+        }
+        let top = if f1 >= f2 { p1 } else { p2 };
+        if top.stable && top.kappa <= kappa_max && height(&top) > height(&pts[i]) {
+            found.push(top);
+        }
+    }
+    found
 }
 
 /// The points of a branch between two probes of the curve, (θ, κ²) each, where κ climbs

@@ -31,6 +31,13 @@ pub enum AtlasError {
     /// or of motion that is not periodic in θ.
     #[error("no θ-period: {reason}")]
     NotPeriodic { reason: &'static str },
+    /// A value the computation could not resolve in double precision: a failed computation
+    /// (the command's exit 1), not a bad input.
+    #[error("{what} could not be computed: {reason}")]
+    Unresolved {
+        what: &'static str,
+        reason: &'static str,
+    },
     /// Writing an output file failed.
     #[error("cannot write {path}: {reason}")]
     Output { path: String, reason: String },

@@ -35,7 +35,10 @@ fn value_error(e: AtlasError) -> PyErr {
 /// A trajectory error in the words of `ra.trajectory`'s keywords, not the command's flags.
 fn trajectory_error(e: AtlasError) -> PyErr {
     // A computation that failed (the command's exit 1), not a bad input.
-    let failed = matches!(e, AtlasError::Integration { .. });
+    let failed = matches!(
+        e,
+        AtlasError::Integration { .. } | AtlasError::Unresolved { .. }
+    );
     let text = e
         .to_string()
         .replace("give --t-end", "give t_end=")

@@ -287,7 +287,17 @@ impl Start {
                          asymptotic to one): its period is infinite; give --t-end",
             });
         }
-        Ok(potential.integrate(energy, &comp, tol, false)?.period)
+        // (A node where ε − V rounds to ≤ 0 inside the turning points: κ and ε so large that
+        // their difference has no digit left there. A failed computation, not a bad input:
+        // at β = 1e150, ε = 1e300 it exited 2.)
+        match potential.integrate(energy, &comp, tol, false) {
+            Ok(integrals) => Ok(integrals.period),
+            Err(AtlasError::NotPeriodic { .. }) => Err(AtlasError::Unresolved {
+                what: "the theta-period",
+                reason: "epsilon - V has no digit left in double precision inside the turning                          points (kappa and the energy too large); give --t-end",
+            }),
+            Err(e) => Err(e),
+        }
     }
 }
 

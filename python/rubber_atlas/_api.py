@@ -1903,7 +1903,9 @@ def trajectory(alpha: float, beta: float, nu: float, eta: float, kappa: float, e
     RuntimeError
         The integration failed: its steps fell below the rounding of t (a motion too fast
         for `tol`, e.g. near a pole at tiny κ in the reduced model), or the energy drifted
-        beyond what the samples allow (the command exits 1 for these).
+        beyond what the samples allow, or (with `periods`) the θ-period could not be
+        computed in double precision at an extreme κ or ε (give `t_end`; the command exits
+        1 for these).
     TypeError
         A parameter that is not one number, `component` or `samples` not a whole number,
         `allow_large` not True or False.

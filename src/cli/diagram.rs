@@ -41,9 +41,11 @@ pub struct DiagramArgs {
     /// Overwrite an existing --out file.
     #[arg(long)]
     pub force: bool,
-    /// Samples of θ0 per half (θ0 < π/2, θ0 > π/2) of the fixed-point curves: written by
-    /// --out; with --json or the text, each branch's ranges of θ0, κ, ε and N are found over
-    /// them (the default is plenty there; more only costs time).
+    /// Samples of θ0 per half (θ0 < π/2, θ0 > π/2) of the fixed-point curves, evenly in θ0
+    /// (plus eight a decade towards the poles and π/2 where the body turns on a finer scale,
+    /// as a far oblate or prolate ellipsoid): written by --out; with --json or the text,
+    /// each branch's ranges of θ0, κ, ε and N are found over them, N's extremes located
+    /// between samples (the default is plenty there; more only costs time).
     #[arg(long, default_value_t = 2000, allow_hyphen_values = true)]
     pub samples: usize,
     #[command(flatten)]
@@ -193,14 +195,20 @@ pub(super) fn print_diagram(set: &CriticalSet) {
     for b in &set.branches {
         let bottom = b
             .rotation_number_range
-            .map(|[lo, hi]| format!("  N at the bottom in [{lo:.6}, {hi:.6}]"))
+            .map(|[lo, hi]| {
+                format!(
+                    "  N at the bottom in [{}, {}]",
+                    digits(lo, 6),
+                    digits(hi, 6)
+                )
+            })
             .unwrap_or_default();
         println!(
-            "  branch {:<10} {:<8} theta0 in [{:.6}, {:.6}]  kappa in [{}, {}]  eps in [{}, {}]{bottom}",
+            "  branch {:<10} {:<8} theta0 in [{}, {}]  kappa in [{}, {}]  eps in [{}, {}]{bottom}",
             b.name,
             if b.stable { "stable" } else { "unstable" },
-            b.theta0_range[0],
-            b.theta0_range[1],
+            digits(b.theta0_range[0], 6),
+            digits(b.theta0_range[1], 6),
             digits(b.kappa_range[0], 6),
             digits(b.kappa_range[1], 6),
             digits(b.energy_range[0], 6),

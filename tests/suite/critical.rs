@@ -497,3 +497,23 @@ fn the_smallest_kappa_max_keeps_every_branch_by_a_pole() {
         assert!(CriticalSet::of_edged(&body, 400, tiny * 0.1, &|| false).is_err());
     }
 }
+
+/// A far oblate body's N at the bottom peaks within 1/β of a pole, far inside the grid's
+/// first step: the range of `sigma_s0` reaches that peak (at β = 1e10 the grid and its climbs
+/// had stopped at 3.8e4; at β = 1e80, B = 1/η + β⁴ sin²θ/Z² + … overflowed in β⁴ and N was
+/// +inf). References: N = −ψ̇/ω0 along the curve of permanent rotations, maximised by
+/// golden-section search in mpmath at 50 and 120 digits (α = ν = η = 0.5).
+#[test]
+fn the_peak_of_n_at_the_bottom_by_a_far_oblate_pole_is_in_its_range() {
+    for (beta, peak) in [(1e10, 1693385652.57088), (1e80, 1.69338565257088e79)] {
+        let body = EllipsoidBody::ellipsoid(0.5, beta, 0.5, 0.5).unwrap();
+        let set = CriticalSet::of(&body, 2000, 3.0).unwrap();
+        let branch = set.branches.iter().find(|b| b.name == "sigma_s0").unwrap();
+        let [low, high] = branch.rotation_number_range.unwrap();
+        assert_eq!(low, 0.5, "beta {beta}");
+        assert!(
+            ((high - peak) / peak).abs() < 1e-9,
+            "beta {beta}: {high} against {peak}"
+        );
+    }
+}
