@@ -190,6 +190,13 @@ impl Progress for Reporter {
         }
     }
 
+    fn dropped(&self, cells: u64) {
+        self.done.fetch_sub(cells, Ordering::Relaxed);
+        if let Mode::Bar(bar) = &self.mode {
+            bar.set_position(bar.position().saturating_sub(cells));
+        }
+    }
+
     fn laying_out(&self) {
         match &self.mode {
             Mode::Bar(bar) => {

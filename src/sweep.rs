@@ -25,6 +25,9 @@ pub trait Progress: Sync {
     /// A unit counted as done at [`Progress::begin`] (`cells` cells, listed in the journal)
     /// turned out damaged and is computed again.
     fn retract(&self, _cells: u64) {}
+    /// A unit stopped part way (the run was asked to stop) is dropped: the `cells` of it
+    /// already counted by [`Progress::advance`] are not done after all.
+    fn dropped(&self, _cells: u64) {}
     /// The component axis is being laid out from the grid's critical points (the census,
     /// before [`Progress::begin`]; long only for grids of very many bodies and κ-rows).
     fn laying_out(&self) {}
@@ -490,7 +493,14 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
                         return Ok(None);
                     }
                     let rows: Vec<usize> = u.rows.clone().collect();
-                    // A unit stopped part way is dropped: a resumed run computes it again.
+                    // A unit stopped part way is dropped: a resumed run computes it again, and
+                    // its cells counted so far are taken back (the progress line had counted
+                    // them as done after Ctrl-C; an adversary pass).
+                    let counted = std::sync::atomic::AtomicUsize::new(0);
+                    let advance_unit = |cells: usize| {
+                        counted.fetch_add(cells, std::sync::atomic::Ordering::Relaxed);
+                        advance(cells);
+                    };
                     let Some(block) = compute_rows(
                         scene,
                         &variables,
@@ -498,9 +508,10 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
                         u.alpha_index,
                         u.betas.clone(),
                         &rows,
-                        &advance,
+                        &advance_unit,
                         &|| progress.interrupted(),
                     ) else {
+                        progress.dropped(counted.into_inner() as u64);
                         return Ok(None);
                     };
                     let mut part = Summary::default();

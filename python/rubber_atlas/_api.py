@@ -151,6 +151,9 @@ def _numbers(name: str, value) -> np.ndarray:
     if isinstance(value, np.ma.MaskedArray) and np.ma.is_masked(value):
         raise ValueError(f"{name} has masked values: give only the cells to compute")
     if isinstance(value, (list, tuple)):
+        masked = _first_masked(value)
+        if masked is not None:
+            raise ValueError(f"{name}{_at(masked)} is masked: give only the cells to compute")
         # numpy reads a boolean among numbers as 0 or 1 ([0.8, True] is [0.8, 1.0]).
         flagged = _first_boolean(value)
         if flagged is not None:
@@ -200,16 +203,34 @@ def _numbers(name: str, value) -> np.ndarray:
     return np.broadcast_to(stored.astype(np.float64), array.shape)
 
 
-def _first_boolean(items, index: tuple = ()):
-    """The index and value of the first boolean in nested lists or tuples, else None."""
+def _first_in(items, test, index: tuple = ()):
+    """The index and value of the first item that passes `test` in nested lists or tuples,
+    else None."""
     for i, x in enumerate(items):
-        if isinstance(x, (bool, np.bool_)):
+        if test(x):
             return index + (i,), x
         if isinstance(x, (list, tuple)):
-            found = _first_boolean(x, index + (i,))
+            found = _first_in(x, test, index + (i,))
             if found is not None:
                 return found
     return None
+
+
+def _first_boolean(items):
+    """The index and value of the first boolean in nested lists or tuples, else None."""
+    return _first_in(items, lambda x: isinstance(x, (bool, np.bool_)))
+
+
+def _is_masked(x) -> bool:
+    """Whether `x` is numpy's masked constant or an array with a masked value."""
+    return x is np.ma.masked or (np.ma.isMaskedArray(x) and bool(np.ma.is_masked(x)))
+
+
+def _first_masked(items):
+    """The index of the first masked value in nested lists or tuples, else None: numpy
+    reads them as their data, silently (an adversary pass: ``kappa=[np.ma.masked, 0.8]``)."""
+    found = _first_in(items, _is_masked)
+    return None if found is None else found[0]
 
 
 def _real(name: str, value) -> float:
@@ -525,6 +546,10 @@ def _profile_rows(profile) -> list[list[float]]:
     if isinstance(profile, (list, tuple)) and any(
             isinstance(x, (bool, np.bool_)) for row in profile if isinstance(row, (list, tuple)) for x in row):
         raise TypeError(f"{what}, not True or False")
+    if isinstance(profile, (list, tuple)):
+        masked = _first_masked(profile)
+        if masked is not None:
+            raise ValueError(f"profile{_at(masked)} is masked: give the points themselves (np.ma.filled)")
     try:
         array = np.asarray(profile)
     except (ValueError, TypeError):
@@ -1354,7 +1379,7 @@ def flag_names(variable: xr.DataArray) -> dict[int, str]:
     Raises
     ------
     ValueError
-        The variable has no ``flag_values``.
+        The variable has no ``flag_values``, or they are not one whole number per meaning.
     TypeError
         `variable` is not a DataArray.
 
@@ -1370,8 +1395,15 @@ def flag_names(variable: xr.DataArray) -> dict[int, str]:
                         f"{type(variable).__name__}")
     if "flag_values" not in variable.attrs:
         raise ValueError(f"{variable.name} is not a flag variable (it has no flag_values)")
+    meanings = variable.attrs.get("flag_meanings")
+    if not isinstance(meanings, str):
+        raise ValueError(f"{variable.name} is not a flag variable (its flag_meanings are not one text)")
     values = np.atleast_1d(variable.attrs["flag_values"])
-    names = variable.attrs["flag_meanings"].split()
+    names = meanings.split()
+    # (Flag values as text, or not whole numbers, raised int()'s own words: an adversary pass.)
+    if values.dtype.kind not in "iub" or values.ndim != 1 or len(values) != len(names):
+        raise ValueError(f"{variable.name} is not a flag variable (its flag_values are not one whole "
+                         f"number per meaning: {values.tolist()!r} for {len(names)} meanings)")
     return {int(v): n for v, n in zip(values, names)}
 
 

@@ -431,6 +431,12 @@ class RubberAccessor:
             if axis.dtype.kind not in "iuf" or not np.isfinite(axis).all():
                 raise ValueError(f"the axis {d} has values that are not finite numbers: plot_slice draws over "
                                  "finite axes")
+        # An axis given out of order (cells over an unsorted κ) drew a wrong mesh with only
+        # matplotlib's warning (an adversary pass): the slice is drawn in the axes' order.
+        unsorted = [d for d, axis in zip(plane, (x, y)) if d in cut.coords and (np.diff(axis) < 0).any()]
+        if unsorted:
+            cut = cut.sortby(unsorted)
+            x, y = (cut[d].values if d in cut.coords else np.arange(cut.sizes[d]) for d in plane)
         panels = []  # (title, N over the plane)
         if "rotation_number" in cut:
             if "family" in cut:

@@ -290,6 +290,21 @@ def test_plot_slice_on_empty_thin_and_motionless_slices(slice_atlas, tmp_path):
     refused(ValueError, lambda: bare.rubber.plot_slice(), "fields")
 
 
+def test_plot_slice_draws_an_unsorted_axis_in_its_order():
+    # Cells over an unsorted κ drew a wrong mesh with only matplotlib's warning (an adversary
+    # pass): the slice is drawn sorted, with no warning, and its mesh runs up in κ.
+    import matplotlib
+    matplotlib.use("Agg")
+    kappa = xr.DataArray([0.9, 0.3, 0.6, 0.1], dims="kappa")
+    cells = ra.cells(*BODY, kappa, xr.DataArray(np.linspace(1.5, 3.5, 3), dims="energy"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fig = cells.rubber.plot_slice()
+    mesh = fig.axes[0].collections[0]
+    corners = mesh.get_coordinates()[0, :, 0]
+    assert (np.diff(corners) > 0).all(), corners
+
+
 def test_plot_trajectory_refuses_an_empty_table():
     import matplotlib
     matplotlib.use("Agg")

@@ -211,6 +211,8 @@ def test_diagram_trajectory_and_resonance_take_a_profile():
     (lambda: ra.cells(0.0, None, 1, 1, 0.5, 1.5, shape="profile",
                       profile=np.ma.masked_array([[0, -1], [1, 0], [0, 1]], mask=[[0, 0], [0, 1], [0, 0]])),
      ValueError, "masked"),
+    (lambda: ra.cells(0.0, None, 1, 1, 0.5, 1.5, shape="profile", profile=[[0, -1], [1, np.ma.masked], [0, 1]]),
+     ValueError, "profile[1, 1] is masked"),
     (lambda: ra.cells(0.0, None, 1, 1, 0.5, 1.5, shape="profile", profile=[[0, -1], [0.8], [1, 0, 1], [0, 1]]),
      ValueError, "row 1 has 1 value;"),
     (lambda: ra.cells(0.0, None, 1, 1, 0.5, 1.5, shape="profile", profile=[[0, -1], [0.8, -0.5], [0.9, 0, 1],

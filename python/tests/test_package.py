@@ -173,12 +173,22 @@ def test_inputs_that_would_be_misread_are_refused():
         ra.cells(0.5, 3.0, 0.5, 0.5, np.array([0.5 + 1j]), 2.5)
     with pytest.raises(ValueError, match="masked"):
         ra.cells(0.5, 3.0, 0.5, 0.5, np.ma.masked_array([0.5, 0.7], mask=[0, 1]), 2.5)
+    # Masked values inside lists were read as their data, silently (an adversary pass).
+    with pytest.raises(ValueError, match=r"kappa\[1\] is masked"):
+        ra.cells(0.5, 3.0, 0.5, 0.5, [0.5, np.ma.masked], 2.5)
+    with pytest.raises(ValueError, match=r"energy\[0\] is masked"):
+        ra.cells(0.5, 3.0, 0.5, 0.5, [0.5], [np.ma.masked_array([2.5], mask=[1])])
     cells = ra.cells(0.5, 3.0, 0.5, 0.5, [0.5, 0.7], 2.5)
     for index in (1.7, -1, 2):
         with pytest.raises(KeyError, match="not an index"):
             cells.rubber.components(cell=index)
     with pytest.raises(ValueError, match="not a flag variable"):
         cells.rubber.flags("theta_min")
+    # Flag values as text raised int()'s own words (an adversary pass).
+    texts = cells.status.copy()
+    texts.attrs["flag_values"] = ["a", "b"]
+    with pytest.raises(ValueError, match="not one whole number per meaning"):
+        ra.flag_names(texts)
     with pytest.raises(ValueError, match="plot_slice draws an atlas"):
         cells.rubber.plot_slice()
 

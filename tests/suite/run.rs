@@ -1522,3 +1522,62 @@ fn the_census_of_a_huge_grid_stops_when_asked() {
     let asked = asked.into_inner();
     assert!(asked <= 1000, "stop asked {asked} times");
 }
+
+/// A run stopped part way takes back the cells of the units it drops: what the progress
+/// says is done is what the journal keeps (after Ctrl-C the progress line had counted the
+/// dropped unit's cells as done; an adversary pass).
+#[test]
+fn a_stopped_run_counts_only_the_cells_it_keeps() {
+    use rubber_atlas::sweep::{Progress, RunRequest};
+    use std::sync::atomic::{AtomicU64, Ordering};
+    struct Counting {
+        done: AtomicU64,
+        stop_after: u64,
+    }
+    impl Progress for Counting {
+        fn begin(&self, _total: u64, done: u64) {
+            self.done.store(done, Ordering::SeqCst);
+        }
+        fn advance(&self, cells: u64) {
+            self.done.fetch_add(cells, Ordering::SeqCst);
+        }
+        fn retract(&self, cells: u64) {
+            self.done.fetch_sub(cells, Ordering::SeqCst);
+        }
+        fn dropped(&self, cells: u64) {
+            self.done.fetch_sub(cells, Ordering::SeqCst);
+        }
+        fn interrupted(&self) -> bool {
+            self.done.load(Ordering::SeqCst) >= self.stop_after
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let scene = rubber_atlas::scene::Scene::parse(
+        "name = \"stopped\"\n[body]\nnu = 0.5\neta = 0.5\n[axes]\nalpha = [0.5]\nbeta = [3.0]\n\
+         kappa = { start = 0.05, stop = 2.0, num = 64 }\n\
+         energy = { start = 0.5, stop = 4.5, num = 64 }\n",
+        "stopped.toml",
+    )
+    .unwrap();
+    let request = RunRequest {
+        out: dir.path().join("stopped.h5"),
+        resume: false,
+        force: false,
+        update: false,
+        output_current: false,
+        shard: rubber_atlas::atlas::Shard::WHOLE,
+        attributes: Vec::new(),
+    };
+    // Stopped after a row and a half of 64 cells: the unit in flight is dropped part way.
+    let progress = Counting {
+        done: AtomicU64::new(0),
+        stop_after: 96,
+    };
+    let err = rubber_atlas::sweep::run(&scene, &request, &progress).unwrap_err();
+    let rubber_atlas::AtlasError::Interrupted { done, total, .. } = err else {
+        panic!("{err}");
+    };
+    assert_eq!(total, 64 * 64);
+    assert!(done < total);
+    assert_eq!(progress.done.into_inner(), done);
+}
