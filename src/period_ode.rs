@@ -136,6 +136,9 @@ struct PeriodRun {
     strayed: bool,
 }
 
+/// The spacing of the doubles at π.
+const PI_ULP: f64 = 4.440892098500626e-16;
+
 /// One run at tolerance `tol`, and the steps taken.
 fn one_period<S: Shape>(
     potential: &EffectivePotential<'_, S>,
@@ -236,6 +239,21 @@ pub fn integrate<S: Shape>(
     tol: f64,
     with_drift: bool,
 ) -> Result<PeriodIntegrals> {
+    // The runs carry θ itself, whose doubles near π are 4.4e-16 apart: a turning point a
+    // distance d from π has sin θ only to ulp(π)/d there, alike in both runs, so their
+    // difference does not show it. At κ = 1e-15 the runs went through the pole as at κ = 0
+    // (T twice the truth with an estimate of 1e-9); at d = 5e-8 and 5e-7 N was 1.15 and 1.3
+    // times its estimate off, at 5e-6 within it (α = 0.5, β = 3; an adversary pass). Within
+    // 1e10 ulps of π (4.4e-6) a component has no values by this method; the quadrature
+    // holds the turning point as its distance from π.
+    if potential.kappa != 0.0 && component.upper.from_pi < 1e10 * PI_ULP {
+        return Err(AtlasError::Integration {
+            time: 0.0,
+            reason: "a turning point within 4.4e-6 (1e10 ulps) of pi: the ODE runs, which \
+                     carry theta itself, cannot resolve it"
+                .to_string(),
+        });
+    }
     let (loose, n1) = one_period(potential, energy, component, tol)?;
     let (tight, n2) = one_period(potential, energy, component, (tol * 1e-2).max(1e-15))?;
     // Rounding accumulates over the steps of a run: a few ulps per step.

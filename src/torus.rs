@@ -1858,8 +1858,11 @@ impl<S: Shape> EffectivePotential<'_, S> {
         if tol >= SHARP_GAPS_BELOW || !self.body.shape.kinks().is_empty() {
             // (In double too the gaps vanish at the pairs' angles: where that rounding, up to
             // an ulp of the larger of sin θ and cos θ at each end, could weigh in against the
-            // tolerance relative to the length, the length is taken between the pairs.)
-            if kind == MotionKind::Libration {
+            // tolerance relative to the length, the length is taken between the pairs. Not on
+            // a shape with kinks: there it put T 5 times its estimate off beside a kink of the
+            // truncated ball and a joint of a profile, for a reason not yet found; it is left
+            // as it was, as the sharp gaps are.)
+            if kind == MotionKind::Libration && self.body.shape.kinks().is_empty() {
                 for piece in pieces.iter_mut() {
                     if 4.0 * EPS > 1e-3 * tol * piece.length {
                         piece.length +=

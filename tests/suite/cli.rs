@@ -1834,3 +1834,26 @@ fn a_trajectory_whose_period_fails_by_a_pole_fails_saying_why() {
     assert_eq!(text.trim().lines().count(), 1, "{text}");
     assert!(!out.exists());
 }
+
+/// A file-size limit (`ulimit -f`) is a failed write, reported in one line with exit 1 and
+/// nothing left behind: SIGXFSZ had killed the process (exit 153) with its temporary file
+/// in place (an adversary pass). The limit is set by a shell that leaves the signal at its
+/// default, as a login shell does.
+#[test]
+fn a_file_size_limit_is_one_line_and_no_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("t.csv");
+    let script = format!(
+        "trap - XFSZ; ulimit -f 20; exec '{}' trajectory --alpha 0.5 --beta 3 --nu 0.5 \
+         --eta 0.5 --kappa 0.8 --energy 2.5 --periods 50 --samples 100000 --out '{}'",
+        env!("CARGO_BIN_EXE_rubber-atlas"),
+        out.display()
+    );
+    let o = Command::new("sh").arg("-c").arg(&script).output().unwrap();
+    let text = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{text}");
+    assert!(text.contains("File too large"), "{text}");
+    assert_eq!(text.trim().lines().count(), 1, "{text}");
+    let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert!(left.is_empty(), "{left:?}");
+}
