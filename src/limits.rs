@@ -610,6 +610,17 @@ impl HighEnergyLimit {
     /// Slope and extrema of N∞ and Ñ to the accuracy `tol` (values; λ to 1e-7, which moves
     /// an extremum's value by N″·1e-14).
     pub fn of<S: Shape>(body: &Body<S>, tol: f64) -> Result<Self> {
+        Self::of_until(body, tol, &|| false)
+    }
+
+    /// [`Self::of`], given up when `stop` says so (asked at every value of the limit):
+    /// then [`crate::error::AtlasError::Stopped`]. (At ν = 1e-300 the limit alone took a
+    /// second, deaf to Ctrl-C; an adversary pass.)
+    pub fn of_until<S: Shape>(
+        body: &Body<S>,
+        tol: f64,
+        stop: &(dyn Fn() -> bool + Sync),
+    ) -> Result<Self> {
         if !smooth_high_energy_limit(&body.shape) {
             return Err(crate::error::AtlasError::NotPeriodic {
                 reason: "the slope and extrema of the high-energy limit are computed for bodies \
@@ -626,10 +637,23 @@ impl HighEnergyLimit {
         let lambdas: Vec<f64> = (0..=EXTREMA_SCAN)
             .map(|i| SQRT_2 * i as f64 / EXTREMA_SCAN as f64)
             .collect();
-        let values: Vec<(Estimate, Estimate)> = lambdas
-            .par_iter()
-            .map(|&l| high_energy_pair(body, l, tol))
-            .collect();
+        let stopped = std::sync::atomic::AtomicBool::new(false);
+        // A value asked for after `stop` is NaN: the searches below run out on it at once.
+        let pair = |l: f64| {
+            if stopped.load(std::sync::atomic::Ordering::Relaxed) || stop() {
+                stopped.store(true, std::sync::atomic::Ordering::Relaxed);
+                let nan = Estimate {
+                    value: f64::NAN,
+                    error: f64::NAN,
+                };
+                return (nan, nan);
+            }
+            high_energy_pair(body, l, tol)
+        };
+        let values: Vec<(Estimate, Estimate)> = lambdas.par_iter().map(|&l| pair(l)).collect();
+        if stopped.load(std::sync::atomic::Ordering::Relaxed) {
+            return Err(crate::error::AtlasError::Stopped);
+        }
         let slope = values[0].1;
         let mut extrema_error = values
             .iter()
@@ -649,18 +673,21 @@ impl HighEnergyLimit {
                 return (get(&values[i]).value, lambdas[i]);
             }
             let (l, v) = golden_max(
-                |l| sign * get(&high_energy_pair(body, l, tol)).value,
+                |l| sign * get(&pair(l)).value,
                 lambdas[i - 1],
                 lambdas[i + 1],
                 1e-7,
             );
-            extrema_error = extrema_error.max(get(&high_energy_pair(body, l, tol)).error);
+            extrema_error = extrema_error.max(get(&pair(l)).error);
             (sign * v, l)
         };
         let (mut n_max, mut lambda_at_max) = extremum(1.0, 0);
         let (mut n_min, mut lambda_at_min) = extremum(-1.0, 0);
         let (normalized_max, _) = extremum(1.0, 1);
         let (normalized_min, _) = extremum(-1.0, 1);
+        if stopped.load(std::sync::atomic::Ordering::Relaxed) {
+            return Err(crate::error::AtlasError::Stopped);
+        }
         if flat {
             (n_max, n_min, lambda_at_max, lambda_at_min) = (0.0, 0.0, 0.0, 0.0);
         }

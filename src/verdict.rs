@@ -687,7 +687,7 @@ pub fn verdict_until(
     let outside = outside_checked_range(beta, body.eta);
     let high_energy = match outside {
         Some(_) => HighEnergyLimit::not_computed(),
-        None => HighEnergyLimit::of(body, options.tol.min(1e-12))?,
+        None => HighEnergyLimit::of_until(body, options.tol.min(1e-12), stop)?,
     };
     let diagram_type = DiagramType::of(alpha, beta);
     let mut verdict = Verdict {

@@ -847,9 +847,17 @@ fn the_ode_method_gives_no_values_where_it_cannot_resolve_a_turning_point_by_pi(
             }
             for (name, x, y, e) in [
                 ("T", co.period, cq.period, co.errors.period),
-                ("N", co.rotation_number, cq.rotation_number, co.errors.rotation_number),
+                (
+                    "N",
+                    co.rotation_number,
+                    cq.rotation_number,
+                    co.errors.rotation_number,
+                ),
             ] {
-                assert!((x - y).abs() <= e, "kappa {kappa} {name}: ode {x} ± {e:e}, quadrature {y}");
+                assert!(
+                    (x - y).abs() <= e,
+                    "kappa {kappa} {name}: ode {x} ± {e:e}, quadrature {y}"
+                );
             }
         }
     }

@@ -334,3 +334,23 @@ fn the_high_energy_limit_holds_its_turning_point_to_the_last_bit() {
         "{n} ± {error:e} against {here:?}"
     );
 }
+
+/// The high-energy limit's extrema stop when asked: `stop` is asked at every value of the
+/// limit, and the search gives up at the first yes (at ν = 1e-300 the limit alone took a
+/// second of a verdict, deaf to Ctrl-C; an adversary pass). Counted, not timed.
+#[test]
+fn the_high_energy_limit_stops_when_asked() {
+    use rubber_atlas::limits::HighEnergyLimit;
+    let body = rubber_atlas::EllipsoidBody::ellipsoid(0.999999999999, 1e-3, 1e-300, 1e-3).unwrap();
+    let asked = std::sync::atomic::AtomicUsize::new(0);
+    let stop = || asked.fetch_add(1, std::sync::atomic::Ordering::Relaxed) >= 3;
+    let result = HighEnergyLimit::of_until(&body, 1e-12, &stop);
+    assert!(
+        matches!(result, Err(rubber_atlas::AtlasError::Stopped)),
+        "{result:?}"
+    );
+    // The scan's values in flight on the other threads, not the searches' hundreds.
+    assert!(asked.into_inner() <= 64);
+    let whole = HighEnergyLimit::of_until(&body, 1e-12, &|| false).unwrap();
+    assert_eq!(whole, HighEnergyLimit::of(&body, 1e-12).unwrap());
+}
