@@ -691,3 +691,30 @@ fn a_sphere_at_the_tiniest_kappa_has_one_well_at_the_equator() {
         );
     }
 }
+
+/// A census of a pancake 2e6 wide and 2e-6 thick does not follow its points in the full
+/// model, which resolves that body only by millions of steps (12 s a point, 37 s the census;
+/// an adversary pass): past a budget of steps a point is not followed, and the user's `stop`
+/// is asked a bounded number of times (counted, not timed). Its counterexamples stand on the
+/// quadrature.
+#[test]
+fn a_census_does_not_follow_a_pancake_in_the_full_model() {
+    use rubber_atlas::verdict::{census, CensusOptions};
+    let table = vec![
+        vec![0.0, -1e-6],
+        vec![1e6, -5e-7],
+        vec![1e6, 5e-7],
+        vec![0.0, 1e-6],
+    ];
+    let body = Body::new(profile_shape(&table, 0.0), 0.7, 1.3).unwrap();
+    let asked = std::sync::atomic::AtomicUsize::new(0);
+    let stop = || {
+        asked.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        false
+    };
+    let c = census(&body, &CensusOptions::default(), &stop).unwrap();
+    assert!(!c.counterexamples.is_empty());
+    assert!(c.full_model_checks.is_empty(), "{:?}", c.full_model_checks);
+    let asked = asked.into_inner();
+    assert!(asked < 1_000_000, "stop asked {asked} times");
+}
