@@ -148,6 +148,9 @@ def _numbers(name: str, value) -> np.ndarray:
     view (``np.broadcast_to``) stays one: nothing is materialised."""
     if value is None:
         raise TypeError(f"{name} is None: give a number or an array of numbers")
+    # (xarray's own error, naming no input, before: an adversary pass.)
+    if isinstance(value, xr.Dataset):
+        raise TypeError(f"{name} is an xarray.Dataset: give a DataArray (one of its variables) or numbers")
     if isinstance(value, np.ma.MaskedArray) and np.ma.is_masked(value):
         raise ValueError(f"{name} has masked values: give only the cells to compute")
     if isinstance(value, (list, tuple)):
@@ -1747,6 +1750,11 @@ def _locate_csv_damage(path: Path) -> None:
                 bad = np.flatnonzero(per_row != columns)
                 if bad.size:
                     r = row + int(bad[0])
+                    start = 0 if bad[0] == 0 else int(ends[bad[0] - 1]) + 1
+                    if block[start:int(ends[bad[0]])].strip() == b"":
+                        # (A blank line was named as a row of one field: an adversary pass.)
+                        raise _DamagedTable(f"{path}: data row {r} is a blank line: the table was edited or "
+                                            "damaged; write it again")
                     raise _DamagedTable(f"{path}: data row {r} has {per_row[bad[0]]} fields where the header "
                                         f"names {columns}: the table was edited or damaged; write it again")
                 line_starts = np.concatenate(([0], ends[:-1] + 1))

@@ -528,6 +528,10 @@ def test_read_table_refuses_edited_rows(tmp_path):
     refused(ValueError, lambda: ra.read_table(dropped), "data row 3", "9 fields", "10")
     added = edited("added.csv", ",".join(fields + ["1"]) + "\n")
     refused(ValueError, lambda: ra.read_table(added), "data row 3", "11 fields")
+    # A blank line was named as a row of one field (an adversary pass).
+    blank = tmp_path / "blank.csv"
+    blank.write_text("".join(lines) + "\n")
+    refused(ValueError, lambda: ra.read_table(blank), "data row 6", "blank line")
     word = edited("word.csv", ",".join(fields[:4] + ["x"] + fields[5:]) + "\n")
     refused(ValueError, lambda: ra.read_table(word), "column 'psi'", "data row 3", "'x'", "not a number")
     # NaN and inf are numbers a table may hold.

@@ -169,6 +169,8 @@ def test_inputs_that_would_be_misread_are_refused():
         ra.cells(0.5, 3.0, 0.5, 0.5, 0.8, energies, threads=1)
     with pytest.raises(TypeError, match="kappa is None"):
         ra.cells(0.5, 3.0, 0.5, 0.5, None, 2.5)
+    with pytest.raises(TypeError, match="kappa is an xarray.Dataset"):
+        ra.cells(0.5, 3.0, 0.5, 0.5, xr.Dataset({"k": ("kappa", [0.5, 0.8])}), 2.5)
     with pytest.raises(TypeError, match="complex"):
         ra.cells(0.5, 3.0, 0.5, 0.5, np.array([0.5 + 1j]), 2.5)
     with pytest.raises(ValueError, match="masked"):
