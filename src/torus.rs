@@ -102,6 +102,16 @@ impl Site {
         }
     }
 
+    /// The site `d` further on in θ, in the same chart (θ + d, or π − (φ − d)).
+    #[inline]
+    pub fn moved(&self, d: f64) -> Self {
+        if self.theta_exact {
+            Self::at(self.theta + d)
+        } else {
+            Self::from_pi(self.from_pi - d)
+        }
+    }
+
     /// The size the site's rounding is relative to: |θ| where θ is held exactly, else
     /// |π − θ| (negative beyond π on the κ = 0 circle).
     #[inline]
@@ -1399,6 +1409,18 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         (saddle_t, saddle_psi)
     }
 
+    /// The size of V′'s terms at `a`, which its rounding is a few ulps of: U′'s
+    /// ([`Shape::potential_prime_scale_at`]) and the wall's κ² |cos θ| / sin³θ.
+    pub(crate) fn slope_scale_at(&self, a: Angle) -> f64 {
+        let wall = if self.kappa == 0.0 {
+            0.0
+        } else {
+            let w = self.kappa / a.sin;
+            (w * w * a.cos / a.sin).abs()
+        };
+        self.body.shape.potential_prime_scale_at(a) + wall
+    }
+
     /// |ε − V_s| for the critical point `p` and a bound on its error: V at the point in
     /// double-double where the shape gives it (about 1e-30 of V's terms), plus how far the
     /// extremum may lie beyond V at the rounded site, V′²/(2|V″|) with V′ there bounded by
@@ -1413,14 +1435,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             return plain;
         };
         let distance = DoubleDouble::from_f64(energy).sub(value).to_f64();
-        let wall = if self.kappa == 0.0 {
-            0.0
-        } else {
-            let w = self.kappa / a.sin;
-            (w * w * a.cos / a.sin).abs()
-        };
-        let slope_scale = self.body.shape.potential_prime_scale_at(a) + wall;
-        let slope = self.slope(a).abs() + 4.0 * EPS * slope_scale;
+        let slope = self.slope(a).abs() + 4.0 * EPS * self.slope_scale_at(a);
         let beyond = slope * slope / (2.0 * p.curvature.abs());
         let error = error + EPS * distance.abs() + beyond;
         if error.is_finite() {

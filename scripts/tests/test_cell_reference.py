@@ -213,9 +213,25 @@ def test_a_level_across_a_saddle_in_its_rounding_keeps_an_honest_period():
 # reference now cuts its integrals geometrically about it (`Cell.turns`), and agrees with the
 # solver and with a quadrature cut at π/2 ± 1e-2 … 1e6 β at 40 digits.
 NEEDLE = [(-0.90289184, 1.3420438e-08, 2.0, 1.4423, 6788.4, 18257164534.50095, 1e-13)]
+# Fixed points (an adversary pass; the reference is the libration at the same double energy):
+# of needles, whose minimum lies within β of π/2, where the double θ_m nearest it knows
+# cos θ ≈ β only to an ulp of π/2 and V″ and ψ̇ move with it (T was 1.3e4 times its estimate
+# off, 8e-9 relative, N 7e4 times); and of the flat, near-quartic wells of near-spheres a few
+# ulps above V_min, where T ∝ (ε − V)^(−1/4) is far from linear in the window (T 62 and 2.3
+# times its estimate off).
+FIXED_POINTS = [
+    (4.374397312551575e-14, 0.999999999999, 1.0056668846991432, 0.0028611200493300127, 1e-07,
+     0.999999999999005, 1e-12),
+    (0.0, 0.9999999999773372, 1.895120106499201, 510.06694494706835, 3.279833382339295e-08,
+     0.9999999999773381, 1e-12),
+    (0.6644956033020413, 1.785928611142336e-08, 1.638868476822438, 22.29920536035619,
+     -1.0022276211969165e-07, 1.3346109765048465e-08, 1e-14),
+    (-0.09269493478586477, 1e-08, 1.4130391457726639, 0.029146006963931496, -0.00017816605893870746,
+     2.5828517839965226e-08, 1e-14),
+]
 
 
-@pytest.mark.parametrize("alpha, beta, nu, eta, kappa, energy, tol", SHAPE_ROUNDING + UNPLACED + NEEDLE)
+@pytest.mark.parametrize("alpha, beta, nu, eta, kappa, energy, tol", SHAPE_ROUNDING + UNPLACED + NEEDLE + FIXED_POINTS)
 def test_hard_cells_are_within_their_estimates(alpha, beta, nu, eta, kappa, energy, tol):
     for comp, truth in components_against_reference(alpha, beta, nu, eta, kappa, energy, tol):
         where = f"beta {beta} energy {energy} tol {tol} {comp['family']}"
