@@ -1295,8 +1295,8 @@ fn fixed_point<S: Shape>(
 /// few ulps of θ off it (the rounding of the root of V′, at least half an ulp): where V″ or
 /// ψ̇ vary on a scale near that (a needle's minimum within β of π/2, where cos θ ≈ β is only
 /// known to an ulp of π/2), the values move with it. Bounded by 1.25 times the largest change
-/// of T and ψ̇ over θ_m ± δ, δ the larger of an ulp of θ_m and the root's rounding
-/// 4 ε |V′|-scale / V″. (Needles at β = 1e-8 … 1e-4 had T up to 1.3e4 times its estimate off,
+/// of T and ψ̇ over θ_m ± δ (measured over a K times longer step and divided by K), δ the
+/// larger of an ulp of θ_m and the root's rounding 4 ε |V′|-scale / V″. (Needles at β = 1e-8 … 1e-4 had T up to 1.3e4 times its estimate off,
 /// 8e-9 relative, and N 7e4 times; an adversary pass.)
 fn add_site_error<S: Shape>(
     potential: &EffectivePotential<'_, S>,
@@ -1321,13 +1321,20 @@ fn add_site_error<S: Shape>(
         let curvature = potential.curvature_at(angle);
         (curvature > 0.0).then(|| (TAU / (curvature / b).sqrt(), potential.psi_rate(angle)))
     };
+    // Measured over a step K δ, K up to 1e4 while K δ stays below a hundredth of the body's
+    // finest angular scale, and divided by K: the change is linear over it, and V″'s own
+    // rounding at the neighbours (relative 3e-10 by a nearly symmetric body's equator, where
+    // T is flat to 1e-16) is divided by K too.
+    let reach = (1e-2 * potential.body.shape.angular_feature_scale() / delta).clamp(1.0, 1e4);
     let moved = |d: f64| values(site.moved(d).angle());
-    let (Some(here), Some(up), Some(down)) = (values(a), moved(delta), moved(-delta)) else {
+    let (Some(here), Some(up), Some(down)) =
+        (values(a), moved(reach * delta), moved(-reach * delta))
+    else {
         return;
     };
-    // (Over so small a step the change is linear in it: a quarter more for its rounding.)
+    // (A quarter more for the rounding of the change.)
     let change = |f: fn(&(f64, f64)) -> f64| {
-        1.25 * (f(&up) - f(&here)).abs().max((f(&down) - f(&here)).abs())
+        1.25 * (f(&up) - f(&here)).abs().max((f(&down) - f(&here)).abs()) / reach
     };
     let (period_change, rate_change) = (change(|v| v.0), change(|v| v.1));
     let e = &mut result.errors;
@@ -1439,21 +1446,23 @@ fn add_window_error<S: Shape>(
     if near_rise > 4.0 * window {
         let near = libration_around(potential, bottom.value + near_rise, bottom)
             .and_then(|c| solve_component(potential, bottom.value + near_rise, &c, options).ok());
-        // (Beyond the values' errors: the near libration's own rounding is not a bend.)
-        let bent = |x0: f64, (x_near, e_near): (f64, f64), (x_far, e_far): (f64, f64)| {
-            x0.is_finite()
-                && x_near.is_finite()
-                && x_far.is_finite()
-                && (x_near - x0).abs() - e_near > ((x_far - x0).abs() + e_far) / 16.0
-        };
+        // (Beyond the values' errors, the fixed point's own included: rounding is not a
+        // bend; a nearly symmetric body's N = −1e-16 ± 1e-15 by its equator was taken for one.)
+        let bent =
+            |(x0, e0): (f64, f64), (x_near, e_near): (f64, f64), (x_far, e_far): (f64, f64)| {
+                x0.is_finite()
+                    && x_near.is_finite()
+                    && x_far.is_finite()
+                    && (x_near - x0).abs() - e_near - e0 > ((x_far - x0).abs() + e_far + e0) / 16.0
+            };
         match near {
             Some(near)
                 if bent(
-                    result.period,
+                    (result.period, result.errors.period),
                     (near.period, near.errors.period),
                     (far.period, far.errors.period),
                 ) || bent(
-                    result.rotation_number,
+                    (result.rotation_number, result.errors.rotation_number),
                     (near.rotation_number, near.errors.rotation_number),
                     (far.rotation_number, far.errors.rotation_number),
                 ) =>
