@@ -1296,8 +1296,9 @@ fn fixed_point<S: Shape>(
 /// ψ̇ vary on a scale near that (a needle's minimum within β of π/2, where cos θ ≈ β is only
 /// known to an ulp of π/2), the values move with it. Bounded by 1.25 times the largest change
 /// of T and ψ̇ over θ_m ± δ (measured over a K times longer step and divided by K), δ the
-/// larger of an ulp of θ_m and the root's rounding 4 ε |V′|-scale / V″. (Needles at β = 1e-8 … 1e-4 had T up to 1.3e4 times its estimate off,
-/// 8e-9 relative, and N 7e4 times; an adversary pass.)
+/// larger of an ulp of θ_m and the root's rounding 4 ε |V′|-scale / V″. (Needles at
+/// β = 1e-8 … 1e-4 had T up to 1.3e4 times its estimate off, 8e-9 relative, and N 7e4 times;
+/// an adversary pass.)
 fn add_site_error<S: Shape>(
     potential: &EffectivePotential<'_, S>,
     m: &crate::torus::CriticalPoint,

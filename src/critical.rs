@@ -576,28 +576,10 @@ fn peaks_of_rotation_number<S: Shape>(
             continue;
         }
         // Golden-section search on (θ_{i−1}, θ_{i+1}) for the largest sign·N.
-        let ratio = 0.5 * (5f64.sqrt() - 1.0);
-        let (mut a, mut b) = (pts[i - 1].theta0, pts[i + 1].theta0);
-        let at = |t: f64| {
-            let p = (curve.point)(t);
-            (height(&p), p)
-        };
-        let mut x1 = b - ratio * (b - a);
-        let mut x2 = a + ratio * (b - a);
-        let (mut f1, mut p1) = at(x1);
-        let (mut f2, mut p2) = at(x2);
-        while b - a > 1e-10 * b.abs().max(f64::MIN_POSITIVE) {
-            if f1 >= f2 {
-                (b, x2, f2, p2) = (x2, x1, f1, p1);
-                x1 = b - ratio * (b - a);
-                (f1, p1) = at(x1);
-            } else {
-                (a, x1, f1, p1) = (x1, x2, f2, p2);
-                x2 = a + ratio * (b - a);
-                (f2, p2) = at(x2);
-            }
-        }
-        let top = if f1 >= f2 { p1 } else { p2 };
+        let (a, b) = (pts[i - 1].theta0, pts[i + 1].theta0);
+        let xtol = 1e-10 * b.abs().max(f64::MIN_POSITIVE);
+        let (t, _) = crate::limits::golden_max(|t| height(&(curve.point)(t)), a, b, xtol);
+        let top = (curve.point)(t);
         if top.stable && top.kappa <= kappa_max && height(&top) > height(&pts[i]) {
             found.push(top);
         }

@@ -1880,8 +1880,7 @@ impl<S: Shape> EffectivePotential<'_, S> {
             if kind == MotionKind::Libration && self.body.shape.kinks().is_empty() {
                 for piece in pieces.iter_mut() {
                     if 4.0 * EPS > 1e-3 * tol * piece.length {
-                        piece.length +=
-                            pair_offset(&piece.right.site) - pair_offset(&piece.left.site);
+                        piece.length += pair_span(piece);
                     }
                 }
             }
@@ -1949,15 +1948,14 @@ impl<S: Shape> EffectivePotential<'_, S> {
                 // tilt. (The pairs' angles are off the sites' by up to an ulp of the sine or
                 // cosine: a 2e-14 error of T in a libration 1.7e-3 wide at θ = 2.57, once its
                 // level offset no longer hid it; whole-domain seed 12.)
-                let shift =
-                    |end: &PieceEnd| end.placed.map_or(0.0, |p| p.shift) + pair_offset(&end.site);
-                piece.length += shift(&piece.right) - shift(&piece.left);
+                let shift = |end: &PieceEnd| end.placed.map_or(0.0, |p| p.shift);
+                piece.length += pair_span(piece) + shift(&piece.right) - shift(&piece.left);
                 piece.tilt_rate = 0.0;
             } else if kind == MotionKind::Libration {
                 // (The gaps vanish at the ends' pairs, whatever their levels: a libration
                 // 6.9e-10 wide at θ = 6e-6, its turning points too far off ε to be placed,
                 // had T 1.8 times its estimate off with the length between the doubles.)
-                piece.length += pair_offset(&piece.right.site) - pair_offset(&piece.left.site);
+                piece.length += pair_span(piece);
             }
         }
     }
@@ -2035,6 +2033,12 @@ fn pair_offset(site: &Site) -> f64 {
         let (sin, cos) = DoubleDouble::sin_cos(site.from_pi);
         -cos.mul_f64(a.sin).add(sin.mul_f64(a.cos)).to_f64()
     }
+}
+
+/// The length of `piece` between the angles of its ends' (sine, cosine) pairs, which its gaps
+/// vanish at, less that between its ends' sites.
+fn pair_span(piece: &Piece) -> f64 {
+    pair_offset(&piece.right.site) - pair_offset(&piece.left.site)
 }
 
 /// [`PeriodIntegrals::level_residual`] of a libration cut into `pieces`: the largest residual
