@@ -3,6 +3,16 @@
 //! computation that failed, 75 an output another process is writing, 130 / 143 / 129 a
 //! command stopped by SIGINT / SIGTERM / SIGHUP (a run's journal kept for --resume).
 
+/// `eprintln!` that cannot fail: a line that cannot reach standard error (`2> /dev/full`) is
+/// lost, and the exit status stays the outcome's (bad input exited 1, not 2, and a written
+/// file's "wrote" line failed the command: adversary pass of 2026-11-27).
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
 mod cli;
 mod progress;
 mod stop;
@@ -37,8 +47,7 @@ fn main() -> ExitCode {
             .or_else(|| payload.downcast_ref::<&str>().copied())
             .unwrap_or("");
         if message.starts_with("failed printing to std") {
-            use std::io::Write;
-            let _ = writeln!(std::io::stderr(), "rubber-atlas: {message}");
+            say!("rubber-atlas: {message}");
             std::process::exit(1);
         }
         default_hook(info);
@@ -49,7 +58,7 @@ fn main() -> ExitCode {
             // --help and --version, which a full disk must not lose in silence either.
             use std::io::Write;
             if let Err(error) = e.print().and_then(|()| std::io::stdout().flush()) {
-                eprintln!("rubber-atlas: failed printing to stdout: {error}");
+                say!("rubber-atlas: failed printing to stdout: {error}");
                 return ExitCode::from(1);
             }
             return ExitCode::SUCCESS;
@@ -68,7 +77,7 @@ fn main() -> ExitCode {
                 .map(str::trim)
                 .filter(|l| !l.is_empty() && !l.starts_with("tip:"))
                 .collect();
-            eprintln!("{}", line.join(" "));
+            say!("{}", line.join(" "));
             return ExitCode::from(2);
         }
     };
@@ -83,13 +92,11 @@ fn main() -> ExitCode {
             }) =>
         {
             let (signal, status) = stop::received();
-            eprintln!(
-                "rubber-atlas: stopped by {signal} before the work was done; nothing was written"
-            );
+            say!("rubber-atlas: stopped by {signal} before the work was done; nothing was written");
             ExitCode::from(status)
         }
         Err(e) => {
-            eprintln!("error: {}", one_line(&format!("{e:#}")));
+            say!("error: {}", one_line(&format!("{e:#}")));
             if e.chain().any(|c| {
                 matches!(
                     c.downcast_ref::<rubber_atlas::AtlasError>(),

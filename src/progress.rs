@@ -87,7 +87,7 @@ impl Reporter {
         );
         let elapsed = self.started.lock().unwrap().elapsed();
         let (rate, eta) = rate_and_eta(done, self.resumed.load(Ordering::Relaxed), total, elapsed);
-        eprintln!(
+        say!(
             "run {}: {done}/{total} cells ({:.1}%), {rate:.0} cells/s, ETA {}",
             self.name,
             100.0 * done as f64 / total.max(1) as f64,
@@ -145,7 +145,7 @@ impl Progress for Reporter {
             }
             Mode::Lines { .. } => {
                 if done > 0 {
-                    eprintln!(
+                    say!(
                         "run {}: resuming, {done} of {total} cells already done",
                         self.name
                     );
@@ -182,7 +182,7 @@ impl Progress for Reporter {
                     "a damaged unit of the journal ({cells} cells) is computed again"
                 ));
             }
-            Mode::Lines { .. } => eprintln!(
+            Mode::Lines { .. } => say!(
                 "run {}: a damaged unit of the journal ({cells} cells) is computed again",
                 self.name
             ),
@@ -208,7 +208,7 @@ impl Progress for Reporter {
                 bar.set_message("laying out the component axis (the grid's critical points)");
                 bar.enable_steady_tick(Duration::from_millis(200));
             }
-            Mode::Lines { .. } => eprintln!(
+            Mode::Lines { .. } => say!(
                 "run {}: laying out the component axis (the grid's critical points)",
                 self.name
             ),
@@ -219,7 +219,7 @@ impl Progress for Reporter {
     fn writing(&self) {
         match &self.mode {
             Mode::Bar(bar) => bar.set_message("writing the file"),
-            Mode::Lines { .. } => eprintln!("run {}: writing the file", self.name),
+            Mode::Lines { .. } => say!("run {}: writing the file", self.name),
             Mode::Quiet => {}
         }
     }

@@ -8,6 +8,7 @@ import json
 import math
 import numbers
 import re
+import os
 import sys
 import time
 import functools
@@ -1327,17 +1328,27 @@ def _file(path) -> Path:
     # (Path("") is ".": an empty name was refused as the folder ".".)
     if isinstance(path, str) and not path:
         raise ValueError("path is empty: give a file's name")
+    given = path
     try:
         path = Path(path)
     except TypeError:
         raise TypeError(f"path must be a file's name (str or pathlib.Path), not {path!r}") from None
+    # The name as given, quoted where it holds a character a terminal would not show (a NUL
+    # was shown as a space), and not normalised by Path ("http://" was shown as "http:/").
+    text = os.fspath(given) if isinstance(given, (str, os.PathLike)) else str(path)
+    text = os.fsdecode(text)
+    shown = text if text.isprintable() else repr(text)
+    if "\0" in text:
+        raise ValueError(f"{shown}: a file's name cannot hold a NUL character")
+    if "://" in text:
+        raise ValueError(f"{shown}: a URL; give the name of a local file")
     if path.is_dir():
-        raise ValueError(f"{path}: a folder, not a file")
+        raise ValueError(f"{shown}: a folder, not a file")
     if not path.exists():
-        raise ValueError(f"{path}: no such file")
+        raise ValueError(f"{shown}: no such file")
     if not path.is_file():
         # A FIFO would block the reader until someone writes to it.
-        raise ValueError(f"{path}: not a regular file (a device, FIFO or socket)")
+        raise ValueError(f"{shown}: not a regular file (a device, FIFO or socket)")
     return path
 
 
@@ -1657,38 +1668,39 @@ def _read_csv(path: Path) -> xr.Dataset:
         f.seek(max(size - 1, 0))
         if size == 0 or f.read(1) != b"\n":
             raise _DamagedTable(f"{path}: the table is cut short (its last line is not complete); write it again")
-    rows = attrs.pop("rows", None)
-    if rows is not None and not (isinstance(rows, float) and rows >= 0 and rows == int(rows)):
+    # (Every table rubber-atlas writes has both lines: one without either was edited. A table
+    # whose '# columns' line was deleted had been read as untyped: an adversary pass.)
+    for key in ("columns", "rows"):
+        if key not in attrs:
+            raise _DamagedTable(f"{path}: the table's header has no '# {key}' line: the table was edited or "
+                                "damaged; write it again")
+    rows = attrs.pop("rows")
+    if not (isinstance(rows, float) and rows >= 0 and rows == int(rows)):
         raise _DamagedTable(f"{path}: the table's '# rows' line is not a count ({rows!r}): the table was edited "
                             "or damaged; write it again")
-    types = _csv_types(path, attrs.pop("columns", None))
+    types = _csv_types(path, attrs.pop("columns"))
     _check_csv_fields(path)
     frame = pd.read_csv(path, comment="#", low_memory=False)
-    if rows is not None and len(frame) != rows:
+    if len(frame) != rows:
         raise _DamagedTable(f"{path}: the table is cut short or damaged: {len(frame)} rows where its header "
                             f"says {rows:.0f}; write it again")
-    if types is not None and list(frame.columns) != list(types):
+    if list(frame.columns) != list(types):
         raise _DamagedTable(f"{path}: the column names {','.join(map(str, frame.columns))} differ from the table's "
                             f"'# columns' line ({','.join(types)}): the table was edited or damaged; write it again")
     if len(frame) == 0:
         frame = frame.astype(np.float64)
     _check_csv_numbers(path, frame)
-    if types is not None:
-        frame = _typed_columns(path, frame, types)
+    frame = _typed_columns(path, frame, types)
     dim = frame.columns[0]
     ds = xr.Dataset.from_dataframe(frame.set_index(dim))
-    if types is not None:
-        # (A pandas index is int64 whatever its column was.)
-        ds = ds.assign_coords({dim: ds[dim].to_numpy().astype(types[dim])})
+    # (A pandas index is int64 whatever its column was.)
+    ds = ds.assign_coords({dim: ds[dim].to_numpy().astype(types[dim])})
     ds.attrs.update(attrs)
     return ds
 
 
-def _csv_types(path: Path, line) -> dict | None:
-    """The column names and types of a CSV table's ``# columns: name:type …`` line (written
-    since it was added; None for an older table)."""
-    if line is None:
-        return None
+def _csv_types(path: Path, line) -> dict:
+    """The column names and types of a CSV table's ``# columns: name:type …`` line."""
     types = {}
     for item in str(line).split():
         name, _, kind = item.partition(":")

@@ -580,6 +580,12 @@ def test_read_table_refuses_edited_headers_and_typed_columns_and_reads_an_empty_
     rows_line = next(i for i, line in enumerate(lines) if line.startswith("# rows:"))
     many = edited("many.csv", rows_line, "# rows: many\n")
     refused(ValueError, lambda: ra.read_table(many), "'# rows' line is not a count", "'many'")
+    # (Adversary pass 17: a table whose '# columns' line was deleted was read untyped.)
+    columns_line = next(i for i, line in enumerate(lines) if line.startswith("# columns:"))
+    for at, key in [(columns_line, "columns"), (rows_line, "rows")]:
+        deleted = tmp_path / f"no-{key}.csv"
+        deleted.write_text("".join(lines[:at] + lines[at + 1:]))
+        refused(ValueError, lambda: ra.read_table(deleted), f"no '# {key}' line", "edited")
 
 
 def test_a_length_one_vector_with_a_longer_one_makes_a_grid():
@@ -702,3 +708,13 @@ def test_a_huge_lazy_input_is_sized_before_it_is_read():
     data = dask.array.from_delayed(dask.delayed(unreadable)(), shape=(10**5, 3 * 10**4), dtype=np.float64)
     kappa = xr.DataArray(data, dims=("a", "b"))
     refused(ValueError, lambda: ra.cells(*BODY, kappa=kappa, energy=2.5), "GB")
+
+
+def test_a_files_name_is_shown_as_given():
+    """Adversary pass 17: a NUL in a name was shown as a space (a terminal prints nothing
+    for it) and "http://" as "http:/" (pathlib's normal form), in a 'no such file' line; a
+    line break split the one line."""
+    for read in (ra.open_atlas, ra.read_table):
+        refused(ValueError, lambda: read("a\0b.h5"), "'a\\x00b.h5'", "NUL")
+        refused(ValueError, lambda: read("http://example.com/x.h5"), "http://example.com/x.h5", "URL")
+        refused(ValueError, lambda: read("a\nb.h5"), "'a\\nb.h5'", "no such file")

@@ -80,7 +80,7 @@ pub(super) fn diagram(args: DiagramArgs) -> Result<()> {
     }
     if let Some(out) = &args.out {
         write_diagram(out, &set)?;
-        eprintln!(
+        say!(
             "wrote {} points on {} branches to {}",
             set.branches.iter().map(|b| b.points.len()).sum::<usize>(),
             set.branches.len(),

@@ -142,7 +142,7 @@ fn output_current(args: &RunArgs, out: &std::path::Path) -> Result<bool> {
             .into());
         }
         Ok(status) if status.code().is_none() && !args.quiet => {
-            eprintln!(
+            say!(
                 "rubber-atlas: reading {} crashed HDF5 (a damaged file); it is computed afresh",
                 out.display()
             );
@@ -289,12 +289,12 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
             let (signal, status) = crate::stop::received();
             let journal = rubber_atlas::store::journal::Journal::dir_for(&out);
             if journal.is_dir() {
-                eprintln!(
+                say!(
                     "rubber-atlas: stopped by {signal} with {done} of {total} cells computed and kept in {}; continue with: {resume}",
                     journal.display(),
                 );
             } else {
-                eprintln!(
+                say!(
                     "rubber-atlas: stopped by {signal} before any cell was computed (nothing kept, nothing to resume)",
                 );
             }

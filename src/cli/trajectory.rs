@@ -113,7 +113,7 @@ pub(super) fn trajectory(args: TrajectoryArgs) -> Result<()> {
     ]);
     table.attributes.extend(table_attributes(&attributes));
     write_table_until(&args.out, &table, &crate::stop::requested)?;
-    eprintln!(
+    say!(
         "wrote {} samples over t in [0, {}] ({} model, energy kept to {:.1e}) to {}",
         traj.t.len(),
         show(t_end),

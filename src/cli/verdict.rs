@@ -126,7 +126,7 @@ pub(super) fn verdict(args: VerdictArgs) -> Result<()> {
                     let mut last = last_line.lock().unwrap_or_else(|e| e.into_inner());
                     if last.elapsed() >= std::time::Duration::from_secs(10) {
                         *last = std::time::Instant::now();
-                        eprintln!(
+                        say!(
                             "verdict --boundaries: {message} {done}/{of} ({:.0} s)",
                             started.elapsed().as_secs_f64()
                         );

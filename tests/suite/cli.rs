@@ -1024,6 +1024,65 @@ fn output_that_cannot_be_written_is_one_line_and_exit_1() {
     }
 }
 
+/// A standard error that cannot be written (`2> /dev/full`) loses its lines but not the
+/// outcome's exit status: bad input 2, a written file 0 (adversary pass of 2026-11-27: both
+/// exited 1, the panic of `eprintln!`).
+#[test]
+fn a_full_standard_error_keeps_the_exit_status() {
+    let dir = tempfile::tempdir().unwrap();
+    let table = dir.path().join("t.csv");
+    let table_arg = table.to_str().unwrap();
+    let cases: [(&[&str], i32); 3] = [
+        (
+            &[
+                "cell", "--alpha", "5", "--beta", "3", "--nu", "0.5", "--eta", "0.5", "--kappa",
+                "0.8", "--energy", "2.5",
+            ],
+            2,
+        ),
+        (&["cell", "--no-such-flag"], 2),
+        (
+            &[
+                "trajectory",
+                "--alpha",
+                "0.5",
+                "--beta",
+                "3",
+                "--nu",
+                "0.5",
+                "--eta",
+                "0.5",
+                "--kappa",
+                "0.8",
+                "--energy",
+                "2.5",
+                "--periods",
+                "1",
+                "--samples",
+                "3",
+                "--out",
+                table_arg,
+            ],
+            0,
+        ),
+    ];
+    for (args, code) in cases {
+        let full = std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap();
+        let o = Command::new(env!("CARGO_BIN_EXE_rubber-atlas"))
+            .args(args)
+            .stderr(full)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(code), "{args:?}");
+    }
+    assert!(std::fs::read_to_string(&table)
+        .unwrap()
+        .contains("# rows: 4"));
+}
+
 /// `diagram --shape`: the JSON of an edged body names its shape and cut, has no β and no
 /// diagram type, and lists the kinks.
 #[test]
