@@ -606,6 +606,56 @@ def reference(alpha, beta, nu, eta, kappa, energy, digits: int = DIGITS) -> list
     return Cell(alpha, beta, nu, eta, kappa, digits).components(energy)
 
 
+def libration_drift(alpha, beta, nu, eta, kappa, energy, theta_min, theta_max, degree: int = 6,
+                    digits: int = DIGITS):
+    """(|Δζ|, Δψ) of the libration of the ellipsoid cell (α, β, ν, η, κ ≠ 0, ε) between the
+    turning points near `theta_min` and `theta_max` (refined here to `digits`), for a libration
+    with no critical point of V inside.
+
+    Δζ = ∫ ζ̇ dt over one θ-period from θ_min, with ζ̇ = −U e^{iψ} (κ/(J sinθ) + i θ̇) (docs/model.md),
+    in the variable φ ∈ [0, 2π] of θ = θ_min + L (1 − cos φ)/2 (the way out, then back):
+    dt/dφ = √(B/(2(ε − V))) L |sin φ|/2 and θ̇ dt/dφ = L sin φ/2, both analytic and periodic in φ.
+    Gauss–Legendre on [0, 2π] with 3·2^(degree−1) nodes, and ψ(φ) at each node by a rule of its
+    own over [0, φ]: no symmetry of the orbit and nothing of the solver's (a trapezoid rule and a
+    spectral antiderivative over the way out alone). Compare two degrees for its error."""
+    cell = Cell(alpha, beta, nu, eta, kappa, digits)
+    with mpmath.workdps(digits):
+        e = mpmath.mpf(energy)
+
+        def end(theta):
+            return mpmath.findroot(lambda x: cell.potential(at(x)) - e, mpmath.mpf(theta), tol=mpmath.mpf(10) ** (-digits + 5))
+
+        lo, hi = end(theta_min), end(theta_max)
+        length = hi - lo
+        rule = mpmath.calculus.quadrature.GaussLegendre(mpmath.mp)
+        unit = rule.calc_nodes(degree, mpmath.mp.prec)
+
+        def rates(phi):
+            # dt/dφ, ψ̇ dt/dφ, dθ/dφ and U, κ/(J sinθ) at φ.
+            theta = lo + length * (1 - mpmath.cos(phi)) / 2
+            s, c = mpmath.sin(theta), mpmath.cos(theta)
+            slope = length * mpmath.sin(phi) / 2
+            gap = e - cell.potential(at(theta))
+            dt = mpmath.sqrt(cell.inertia(s, c) / (2 * gap)) * abs(slope) if gap > 0 else mpmath.mpf(0)
+            j = cell.integral_factor(s, c)
+            u = cell._z(s, c) + cell.alpha * c
+            return dt, -cell.kappa * c / (j * s * s) * dt, slope, u, cell.kappa / (j * s)
+
+        def integral(f, a, b):
+            half = (b - a) / 2
+            return half * mpmath.fsum(w * f(a + half * (x + 1)) for x, w in unit)
+
+        def psi_at(phi):
+            return integral(lambda t: rates(t)[1], mpmath.mpf(0), phi)
+
+        def velocity(phi):
+            dt, _, slope, u, along = rates(phi)
+            return -u * mpmath.expj(psi_at(phi)) * mpmath.mpc(along * dt, slope)
+
+        drift = integral(velocity, mpmath.mpf(0), 2 * mpmath.pi)
+        return abs(drift), psi_at(2 * mpmath.pi)
+
+
 def critical_levels(alpha, beta, nu, eta, kappa, digits: int = DIGITS) -> list[tuple[float, float]]:
     """(θ, V) of every critical point of V, as floats."""
     cell = Cell(alpha, beta, nu, eta, kappa, digits)

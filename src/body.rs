@@ -289,6 +289,18 @@ pub trait Shape: Send + Sync {
     ) -> Option<(DoubleDouble, f64)> {
         None
     }
+
+    /// [`Shape::potential_double_double`] and |r|² = U² + U′² together, in double-double, for
+    /// shapes that provide it (|r|² to about 1e-30 of itself: a sum of squares): the cell
+    /// solver's integrands where their rounding in double is what keeps the drift from the
+    /// tolerance ([`Body::reduction_double_double`]).
+    fn potential_and_contact_distance_sq_double_double(
+        &self,
+        _sin: DoubleDouble,
+        _cos: DoubleDouble,
+    ) -> Option<(DoubleDouble, f64, DoubleDouble)> {
+        None
+    }
 }
 
 /// An ellipsoid of revolution with semi-axes b1 = β (equatorial) and b3 = 1 (axial), its
@@ -589,6 +601,28 @@ impl Shape for Ellipsoid {
         Some((z.add(offset), error))
     }
 
+    /// U as [`Shape::potential_double_double`], and |r|² = U² + U′² with
+    /// U′ = sinθ ((β² − 1) cosθ / Z − α) (β² − 1 exact in double-double: β·β is a double's
+    /// exact product). None where a term overflows (β beyond about 1e77).
+    #[inline(always)]
+    fn potential_and_contact_distance_sq_double_double(
+        &self,
+        sin: DoubleDouble,
+        cos: DoubleDouble,
+    ) -> Option<(DoubleDouble, f64, DoubleDouble)> {
+        let bs = sin.mul_f64(self.beta);
+        let z = bs.mul(bs).add(cos.mul(cos)).sqrt();
+        let offset = cos.mul_f64(self.alpha);
+        let error = crate::dd::RELATIVE_ERROR * (z.hi + offset.hi.abs());
+        let u = z.add(offset);
+        let b = DoubleDouble::from_f64(self.beta)
+            .mul_f64(self.beta)
+            .add_f64(-1.0);
+        let slope = sin.mul(b.mul(cos).div(z).add_f64(-self.alpha));
+        let r2 = u.mul(u).add(slope.mul(slope));
+        (r2.hi.is_finite() && r2.lo.is_finite()).then_some((u, error, r2))
+    }
+
     #[inline]
     fn potential_and_contact_distance_sq_at(&self, a: Angle) -> (f64, f64) {
         let z = self.centre_height_at(a);
@@ -624,6 +658,19 @@ pub struct Reduction {
     pub reduced_inertia: f64,
     /// J = √((cos²θ + ν sin²θ)/η + U²).
     pub integral_factor: f64,
+}
+
+/// [`Reduction`] in double-double ([`Body::reduction_double_double`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReductionDoubleDouble {
+    /// U.
+    pub potential: DoubleDouble,
+    /// A bound on the absolute error of U (its terms may cancel).
+    pub potential_error: f64,
+    /// η B = 1 + η |r|².
+    pub scaled_inertia: DoubleDouble,
+    /// η J² = cos²θ + ν sin²θ + η U².
+    pub scaled_integral_factor_sq: DoubleDouble,
 }
 
 /// The paper's body: an ellipsoid of revolution.
@@ -694,6 +741,35 @@ impl<S: Shape> Body<S> {
             reduced_inertia: 1.0 / self.eta + r2,
             integral_factor: j2.sqrt(),
         }
+    }
+
+    /// U (with the bound on its error of [`Shape::potential_double_double`]), η B and η J² in
+    /// double-double at the angle whose sine and cosine are `sin` and `cos`, for shapes that
+    /// provide |r|² so (the ellipsoid): η B = 1 + η |r|² and η J² = cos²θ + ν sin²θ + η U² to
+    /// about 1e-29 of themselves (sums of positive terms), scaled by η so that no quotient is
+    /// needed. None for other shapes, or where a term overflows.
+    #[inline(always)]
+    pub fn reduction_double_double(
+        &self,
+        sin: DoubleDouble,
+        cos: DoubleDouble,
+    ) -> Option<ReductionDoubleDouble> {
+        let (potential, potential_error, r2) = self
+            .shape
+            .potential_and_contact_distance_sq_double_double(sin, cos)?;
+        let scaled_inertia = r2.mul_f64(self.eta).add_f64(1.0);
+        let axial = sin.mul(sin).mul_f64(self.nu).add(cos.mul(cos));
+        let scaled_integral_factor_sq = axial.add(potential.mul(potential).mul_f64(self.eta));
+        let finite = |x: DoubleDouble| x.hi.is_finite() && x.lo.is_finite();
+        (finite(scaled_inertia)
+            && finite(scaled_integral_factor_sq)
+            && scaled_integral_factor_sq.hi > 0.0)
+            .then_some(ReductionDoubleDouble {
+                potential,
+                potential_error,
+                scaled_inertia,
+                scaled_integral_factor_sq,
+            })
     }
 
     /// J(θ) = √((cos²θ + ν sin²θ)/η + U²): the integral F2 = J ω3 (paper §2.3 `sec_inv`,

@@ -18,7 +18,7 @@ pub struct DoubleDouble {
 pub const RELATIVE_ERROR: f64 = 1e-30;
 
 /// a + b = s + e exactly (Knuth's TwoSum).
-#[inline]
+#[inline(always)]
 fn two_sum(a: f64, b: f64) -> (f64, f64) {
     let s = a + b;
     let bb = s - a;
@@ -26,14 +26,14 @@ fn two_sum(a: f64, b: f64) -> (f64, f64) {
 }
 
 /// a + b = s + e exactly when |a| ≥ |b| (Dekker's FastTwoSum).
-#[inline]
+#[inline(always)]
 fn fast_two_sum(a: f64, b: f64) -> (f64, f64) {
     let s = a + b;
     (s, b - (s - a))
 }
 
 /// a b = p + e exactly (with a fused multiply-add).
-#[inline]
+#[inline(always)]
 fn two_prod(a: f64, b: f64) -> (f64, f64) {
     let p = a * b;
     (p, a.mul_add(b, -p))
@@ -76,17 +76,20 @@ impl std::iter::Sum<f64> for CompensatedSum {
 
 impl DoubleDouble {
     /// A double, exactly.
+    #[inline(always)]
     pub const fn from_f64(x: f64) -> Self {
         Self { hi: x, lo: 0.0 }
     }
 
     /// The double nearest the value.
+    #[inline(always)]
     pub fn to_f64(self) -> f64 {
         self.hi + self.lo
     }
 
     /// Sum (Joldes–Muller–Popescu's accurate DWPlusDW).
     #[allow(clippy::should_implement_trait)]
+    #[inline(always)]
     pub fn add(self, other: Self) -> Self {
         let (s, e) = two_sum(self.hi, other.hi);
         let (t, f) = two_sum(self.lo, other.lo);
@@ -96,6 +99,7 @@ impl DoubleDouble {
     }
 
     /// The value plus a double.
+    #[inline(always)]
     pub fn add_f64(self, b: f64) -> Self {
         let (s, e) = two_sum(self.hi, b);
         let (hi, lo) = fast_two_sum(s, e + self.lo);
@@ -104,6 +108,7 @@ impl DoubleDouble {
 
     /// Negation, exactly.
     #[allow(clippy::should_implement_trait)]
+    #[inline(always)]
     pub fn neg(self) -> Self {
         Self {
             hi: -self.hi,
@@ -113,6 +118,7 @@ impl DoubleDouble {
 
     /// Difference.
     #[allow(clippy::should_implement_trait)]
+    #[inline(always)]
     pub fn sub(self, other: Self) -> Self {
         self.add(other.neg())
     }
@@ -120,6 +126,7 @@ impl DoubleDouble {
     /// The pair (`sin`, `cos`) scaled onto the unit circle: for a pair within a few ulps of
     /// it, δ = sin² + cos² − 1 and 1/√(1 + δ) = 1 − δ/2 + O(δ²) (δ² below 1e-30 for
     /// |δ| ≤ 1e-15); otherwise by the root and two quotients.
+    #[inline(always)]
     pub fn onto_circle(sin: Self, cos: Self) -> (Self, Self) {
         let radius_sq = sin.mul(sin).add(cos.mul(cos));
         let delta = radius_sq.add_f64(-1.0).to_f64();
@@ -134,6 +141,7 @@ impl DoubleDouble {
 
     /// Product (DWTimesDW).
     #[allow(clippy::should_implement_trait)]
+    #[inline(always)]
     pub fn mul(self, other: Self) -> Self {
         let (p, e) = two_prod(self.hi, other.hi);
         let t = self.hi.mul_add(other.lo, self.lo * other.hi);
@@ -142,6 +150,7 @@ impl DoubleDouble {
     }
 
     /// The value times a double.
+    #[inline(always)]
     pub fn mul_f64(self, b: f64) -> Self {
         let (p, e) = two_prod(self.hi, b);
         let (hi, lo) = fast_two_sum(p, self.lo.mul_add(b, e));
@@ -151,6 +160,7 @@ impl DoubleDouble {
     /// Quotient: a first quotient and two corrections from its remainder (itself computed to
     /// about u²).
     #[allow(clippy::should_implement_trait)]
+    #[inline(always)]
     pub fn div(self, other: Self) -> Self {
         let q1 = self.hi / other.hi;
         let r = self.sub(other.mul_f64(q1));
@@ -197,6 +207,7 @@ impl DoubleDouble {
     }
 
     /// Square root of a value ≥ 0: one Newton step from the double root.
+    #[inline(always)]
     pub fn sqrt(self) -> Self {
         if self.hi <= 0.0 {
             return Self::from_f64(0.0);

@@ -245,6 +245,8 @@ pub struct EffectivePotential<'a, S: Shape> {
     /// The angles in (0, π) where the integrals are split ([`Self::splits_inside`]), found
     /// once.
     split_angles: Vec<f64>,
+    /// 1/η in double-double, for [`precise_sample`].
+    inverse_eta: DoubleDouble,
 }
 
 /// Number of scan cells for critical points; between scan nodes the pole-free function
@@ -261,6 +263,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             critical: Vec::new(),
             dips: Vec::new(),
             split_angles: Vec::new(),
+            inverse_eta: DoubleDouble::from_f64(1.0).div(DoubleDouble::from_f64(body.eta)),
         };
         v.critical = v.find_critical_points();
         v.dips = body
@@ -2332,6 +2335,33 @@ impl Piece {
         plain.right.sharp = None;
         plain
     }
+
+    /// The end nearer `node`, and the node's signed offset from it (≥ 0 from the left end).
+    #[inline]
+    fn nearer_end(&self, node: IntervalNode) -> (&PieceEnd, f64) {
+        if node.from_left <= node.from_right {
+            (&self.left, node.from_left)
+        } else {
+            (&self.right, -node.from_right)
+        }
+    }
+}
+
+impl SharpEnd {
+    /// The (sine, cosine) pair of the angle `offset` beyond the end, whose sine and cosine are
+    /// `sin_offset` and `cos_offset`, in double-double, scaled onto the unit circle.
+    #[inline(always)]
+    fn rotated(&self, sin_offset: f64, cos_offset: f64) -> (DoubleDouble, DoubleDouble) {
+        let sin = self
+            .sin
+            .mul_f64(cos_offset)
+            .add(self.cos.mul_f64(sin_offset));
+        let cos = self
+            .cos
+            .mul_f64(cos_offset)
+            .sub(self.sin.mul_f64(sin_offset));
+        DoubleDouble::onto_circle(sin, cos)
+    }
 }
 
 /// What one node contributes, already multiplied by dθ/dτ (not by the τ-step).
@@ -2838,11 +2868,7 @@ fn sample<S: Shape>(
 ) -> Result<NodeSample> {
     // Measure from the nearer end: offset x ≥ 0 and the end's angle (a placed end lies
     // `shift` beyond its double, and its gap is measured from V there, `offset` below ε).
-    let (end, signed) = if node.from_left <= node.from_right {
-        (&piece.left, node.from_left)
-    } else {
-        (&piece.right, -node.from_right)
-    };
+    let (end, signed) = piece.nearer_end(node);
     // (Nodes nearer a placed end than its shift, in the tanh-sinh rule's tails, are measured
     // from the double: there ε − V(e) and the shift times D would cancel to their rounding,
     // and D at e is D at e + shift to within `Placed::near`.)
@@ -2927,13 +2953,127 @@ fn sharp_gap<S: Shape>(
     sx: f64,
     cx: f64,
 ) -> Option<(f64, f64)> {
-    let sin = sharp.sin.mul_f64(cx).add(sharp.cos.mul_f64(sx));
-    let cos = sharp.cos.mul_f64(cx).sub(sharp.sin.mul_f64(sx));
-    let (sin, cos) = DoubleDouble::onto_circle(sin, cos);
+    let (sin, cos) = sharp.rotated(sx, cx);
     let (value, error) = v.value_double_double_on_circle(sin, cos)?;
     let gap = sharp.level.add_f64(tilt).sub(value).to_f64();
     let bound = excess_error + sharp.error + error + EPS * (tilt.abs() + 2.0 * gap.abs());
     Some((gap, bound))
+}
+
+/// Bound on the relative rounding of an integrand of [`precise_sample`] beyond that of its gap,
+/// counted twice as [`INTEGRAND_ROUNDING`] is: the node's own position (its offset from the end
+/// rounded, and that offset's sine and cosine from libm: about 3u of the offset, which moves an
+/// integrand ∝ 1/√gap by up to about 1.5 times as much), dθ/dτ's rounding (u), and the values'
+/// rounding to doubles (u/2): 6u in all.
+pub(super) const PRECISE_NODE_ROUNDING: f64 = 6.0 * EPS;
+
+/// The integrands at a node of the cosine rule's plain map with U, B, J, the gap and the
+/// integrands themselves in double-double ([`crate::body::Body::reduction_double_double`]),
+/// from the nearer end's sharp pair; their rounding bound is the gap's error and
+/// [`PRECISE_NODE_ROUNDING`] (issue 23: in double each integrand carries up to
+/// [`INTEGRAND_ROUNDING`], which summed over ∫ |ψ̇| dt in the drift's phases kept the drift
+/// from tolerances below about 3e-14 on the standard slice). The node in double ([`sample`]
+/// of `piece`) is taken where this one is not to be had (a shape with no double-double form,
+/// an end with no sharp pair, a node within a placed end's shift, an overflow), or where the
+/// two differ by more than the double one's bound (of `plain`, the piece with its gaps in
+/// double: that would be a fault here).
+fn precise_sample<S: Shape>(
+    v: &EffectivePotential<'_, S>,
+    piece: &Piece,
+    plain: &Piece,
+    energy: f64,
+    node: IntervalNode,
+) -> Result<NodeSample> {
+    if let Some(precise) = precise_node(v, piece, node) {
+        // (Checked against the node in double with its gap in double: the cheaper one.)
+        let double = sample(v, plain, energy, node)?;
+        let within = |a: f64, b: f64| (a - b).abs() <= 0.5 * double.rounding * b.abs();
+        if within(precise.dt, double.dt) && within(precise.dpsi, double.dpsi) {
+            return Ok(precise);
+        }
+    }
+    sample(v, piece, energy, node)
+}
+
+/// [`precise_sample`]'s node, where it is to be had: with the fused multiply-add in the
+/// double-double products where the processor has it (without the target feature each
+/// `mul_add` was a call to a library function, which took most of a node's time).
+fn precise_node<S: Shape>(
+    v: &EffectivePotential<'_, S>,
+    piece: &Piece,
+    node: IntervalNode,
+) -> Option<NodeSample> {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("fma") {
+        // SAFETY: the processor has the fused multiply-add (just checked).
+        return unsafe { precise_node_with_fma(v, piece, node) };
+    }
+    precise_node_in(v, piece, node)
+}
+
+/// [`precise_node_in`] compiled with the fused multiply-add.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "fma")]
+fn precise_node_with_fma<S: Shape>(
+    v: &EffectivePotential<'_, S>,
+    piece: &Piece,
+    node: IntervalNode,
+) -> Option<NodeSample> {
+    precise_node_in(v, piece, node)
+}
+
+/// [`precise_node`]'s work (inlined into each caller, so that the double-double operations
+/// take the caller's target features).
+#[inline(always)]
+fn precise_node_in<S: Shape>(
+    v: &EffectivePotential<'_, S>,
+    piece: &Piece,
+    node: IntervalNode,
+) -> Option<NodeSample> {
+    let (end, signed) = piece.nearer_end(node);
+    let sharp = end.sharp.as_ref()?;
+    let (signed, residual) = match end.placed {
+        Some(placed) if signed.abs() > placed.shift.abs() => {
+            (signed + placed.shift, placed.residual)
+        }
+        Some(_) => return None,
+        None => (signed, 0.0),
+    };
+    let (sx, cx) = libm::sincos(signed);
+    let (sin, cos) = sharp.rotated(sx, cx);
+    let red = v.body.reduction_double_double(sin, cos)?;
+    // V = κ²/(2 sin²θ) + U, with w = κ / sinθ.
+    let inv_sin = DoubleDouble::from_f64(1.0).div(sin);
+    let w = inv_sin.mul_f64(v.kappa);
+    let wall = w.mul(w).mul_f64(0.5);
+    let value = wall.add(red.potential);
+    let value_error = red.potential_error + crate::dd::RELATIVE_ERROR * wall.hi;
+    let tilt = piece.tilt_rate * signed;
+    let gap = sharp.level.add_f64(tilt).sub(value);
+    let gap_error = end.excess_error + residual + sharp.error + value_error + EPS * tilt.abs();
+    if !(gap.hi > 0.0 && gap.hi.is_finite()) {
+        return None;
+    }
+    // dt/dτ / J = √(B / (2 gap J²)) dθ/dτ (η B over η J²: one quotient), J = √(η J² / η);
+    // ψ̇ dt/dτ = −(κ / sinθ)(cosθ / sinθ) dt/dτ / J.
+    let dt_over_j = red
+        .scaled_inertia
+        .div(gap.mul(red.scaled_integral_factor_sq).mul_f64(2.0))
+        .sqrt()
+        .mul_f64(node.jacobian);
+    let integral_factor = red.scaled_integral_factor_sq.mul(v.inverse_eta).sqrt();
+    let dt = dt_over_j.mul(integral_factor);
+    let w3_dt = w.mul(dt_over_j);
+    let dpsi = w3_dt.mul(cos).mul(inv_sin).neg();
+    let potential = red.potential.to_f64();
+    let sample = NodeSample {
+        dt: dt.to_f64(),
+        dpsi: dpsi.to_f64(),
+        along: potential * w3_dt.to_f64(),
+        across: potential * node.jacobian,
+        rounding: gap_error / gap.hi + PRECISE_NODE_ROUNDING,
+    };
+    (sample.dt.is_finite() && sample.dpsi.is_finite() && sample.along.is_finite()).then_some(sample)
 }
 
 /// The (sine, cosine) pair of `a` in double-double, scaled onto the unit circle.

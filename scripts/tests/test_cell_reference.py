@@ -196,6 +196,47 @@ UNPLACED = [
 ]
 
 
+# A libration of the standard slice's body (α 0.5, β 3, ν η 0.5), and of two random ones, whose
+# drift missed tol 1e-14 by its phases' rounding (16 ulps of ψ̇ per node, over ∫ |ψ̇| dt ≈ 5):
+# their nodes are now taken in double-double once the sums have converged. (α, β, ν, η, κ, ε)
+DRIFT_AT_1E_14 = [
+    (0.5, 3.0, 0.5, 0.5, 0.8, 2.5),
+    (-0.6581443605976778, 3.0648359394669815, 1.5511717760555668, 0.3236965357034844,
+     0.31095399395282264, 1.2471862244450695),
+    (0.7677119228145589, 0.7632238170762878, 1.840912687460059, 6.988389860770817,
+     0.07244366836094189, 0.27894277387659694),
+]
+
+
+@pytest.mark.parametrize("alpha, beta, nu, eta, kappa, energy", DRIFT_AT_1E_14)
+def test_the_drift_reaches_1e_14_against_50_digits(alpha, beta, nu, eta, kappa, energy):
+    """|Δζ| at tol 1e-14 is `ok` and within its estimate of a 50-digit quadrature of ζ̇ over the
+    whole period (`reference.libration_drift`: Gauss–Legendre in φ with ψ(φ) integrated at each
+    node, two degrees that agree to 1e-30), as are T and N; on the build before the change the
+    status was `tolerance_not_reached`, the drift's estimate 2.9e-13 at |Δζ| ≈ 1 (its error
+    9e-16)."""
+    import reference
+
+    out = subprocess.run(
+        [BIN, "cell", "--alpha", repr(alpha), "--beta", repr(beta), "--nu", repr(nu), "--eta", repr(eta),
+         "--kappa", repr(kappa), "--energy", repr(energy), "--tol", "1e-14", "--json"],
+        check=True, capture_output=True, text=True,
+    ).stdout
+    components = json.loads(out)["components"]
+    truths = reference.reference(alpha, beta, nu, eta, kappa, energy)
+    assert len(components) == len(truths) >= 1
+    for comp, truth in zip(components, truths):
+        where = f"kappa {kappa} energy {energy} theta_min {comp['theta_min']}"
+        drifts = [reference.libration_drift(alpha, beta, nu, eta, kappa, energy, comp["theta_min"],
+                                            comp["theta_max"], degree=d)[0] for d in (6, 7)]
+        assert abs(drifts[0] - drifts[1]) < 1e-30, where
+        assert comp["status"] == "ok", where
+        assert abs(comp["drift"] - float(drifts[1])) <= comp["errors"]["drift"], where
+        assert abs(comp["period"] - truth.period) <= comp["errors"]["period"] <= 1e-14 * comp["period"], where
+        error = abs(comp["rotation_number"] - truth.rotation_number)
+        assert error <= comp["errors"]["rotation_number"] <= 1e-14, where
+
+
 def test_a_level_across_a_saddle_in_its_rounding_keeps_an_honest_period():
     import reference
 

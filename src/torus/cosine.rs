@@ -6,9 +6,9 @@
 //! at small κ) it stops early and the tanh-sinh path of the parent module takes over.
 
 use super::{
-    at_level_floor, interleave, level_error, root_of_ratio, sample, weighted, Component,
-    Convergence, DriftEstimate, EffectivePotential, NodeSample, PeriodIntegrals, Piece, EPS,
-    HIDDEN_PEAK, INTEGRAND_ROUNDING, LEVEL_FLOOR,
+    at_level_floor, interleave, level_error, precise_sample, root_of_ratio, sample, weighted,
+    Component, Convergence, DriftEstimate, EffectivePotential, NodeSample, PeriodIntegrals, Piece,
+    EPS, HIDDEN_PEAK, INTEGRAND_ROUNDING, LEVEL_FLOOR, PRECISE_NODE_ROUNDING,
 };
 use crate::body::{Angle, Shape};
 use crate::dd::CompensatedSum;
@@ -125,7 +125,16 @@ fn integrate_on<S: Shape>(
         Map::Mercator { .. } => v.passage_rounding(component),
     };
     let residual = super::level_residual(component, std::slice::from_ref(piece));
-    let Some(mut samples) = Samples::new(v, &plain, map, energy, first_intervals(tol)) else {
+    // Where the resampled nodes may have their integrands in double-double too (the plain
+    // map, whose nodes' offsets and dθ/dφ are a table value times L: [`precise_sample`]).
+    let precise = matches!(map, Map::Plain { .. })
+        && piece
+            .left
+            .sharp
+            .as_ref()
+            .is_some_and(|s| v.body.reduction_double_double(s.sin, s.cos).is_some());
+    let Some(mut samples) = Samples::new(v, &plain, map, energy, first_intervals(tol), false)
+    else {
         // (A node of the first level outside the allowed set: at most that level spent.)
         return Ok(Err(first_intervals(tol) + 1));
     };
@@ -195,7 +204,11 @@ fn integrate_on<S: Shape>(
             || psi_error + extra_psi > tol * TAU
             || drift.is_some_and(|d| d.error > tol * d.scale);
         if (!done || over) && !resampled && piece.left.sharp.is_some() {
-            let per_node = INTEGRAND_ROUNDING + 4.0 * EPS;
+            let per_node = if precise {
+                PRECISE_NODE_ROUNDING + EPS
+            } else {
+                INTEGRAND_ROUNDING + 4.0 * EPS
+            };
             let floor_t = per_node * t_sums[0] + saddle_t;
             let floor_nodes_psi = per_node * sums.psi_variation + saddle_psi;
             let floor_psi = floor_nodes_psi + passage_error;
@@ -228,7 +241,7 @@ fn integrate_on<S: Shape>(
             if converged && (within || (improves && drift_freed)) {
                 resampled = true;
                 let intervals = samples.intervals;
-                match Samples::new(v, piece, map, energy, intervals) {
+                match Samples::new(v, piece, map, energy, intervals, precise) {
                     Some(resampled) => samples = resampled,
                     None => return Ok(Err(samples.nodes.len() + intervals + 1)),
                 }
@@ -278,7 +291,13 @@ fn integrate_on<S: Shape>(
             return Ok(Err(samples.nodes.len()));
         }
         let current = if resampled { piece } else { &plain };
-        let at = |node| sample(v, current, energy, node);
+        let at = |node| {
+            if resampled && precise {
+                precise_sample(v, piece, &plain, energy, node)
+            } else {
+                sample(v, current, energy, node)
+            }
+        };
         if samples.refine(map, at).is_err() {
             return Ok(Err(samples.nodes.len()));
         }
@@ -317,12 +336,21 @@ impl Samples {
         map: &Map,
         energy: f64,
         intervals: usize,
+        precise: bool,
     ) -> Option<Self> {
         let n = intervals;
         let mut nodes = Vec::with_capacity(2 * LAST_INTERVALS + 1);
         nodes.push(end_sample(v, piece, map, true)?);
         for j in 1..n {
-            nodes.push(sample(v, piece, energy, map.node(n, j)).ok()?);
+            let node = map.node(n, j);
+            nodes.push(
+                if precise {
+                    precise_sample(v, piece, &piece.in_double(), energy, node)
+                } else {
+                    sample(v, piece, energy, node)
+                }
+                .ok()?,
+            );
         }
         nodes.push(end_sample(v, piece, map, false)?);
         Some(Self {
