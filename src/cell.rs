@@ -10,7 +10,8 @@ use crate::family::Family;
 use crate::limits::Estimate;
 use crate::period_ode;
 use crate::torus::{
-    Component, CriticalKind, CriticalPoint, EffectivePotential, MotionKind, PeriodIntegrals, Site,
+    Component, CriticalKind, CriticalPoint, EffectivePotential, MotionKind, PeriodIntegrals,
+    SaddleTerms, Site,
 };
 use serde::Serialize;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
@@ -517,22 +518,29 @@ fn sharpen_saddle_terms<S: Shape>(
     raw: &mut PeriodIntegrals,
     delta: f64,
 ) {
-    let [t, psi] = raw.saddle;
-    if t == 0.0 && psi == 0.0 {
+    let before = raw.saddle;
+    if before.period == 0.0 && before.psi_advance == 0.0 {
         return;
     }
     // Twice the leading term 1/(λ |ε − V_s|) per passage: with the offset computed exactly
     // the leading term alone left no margin (the true error 0.986 of the whole estimate of T
     // at α = 0, β = 2.38, η = 265, κ = 0, 2e-6 below a separatrix; whole-domain seed 12).
-    let (sharp_t, sharp_psi) =
+    let sharp =
         potential.saddle_conditioning_within(energy, component, raw.period, 2.0, 2.0 * delta);
-    let (less_t, less_psi) = ((t - sharp_t).max(0.0), (psi - sharp_psi).max(0.0));
+    let less = |was: f64, now: f64| (was - now).max(0.0);
+    let less_t = less(before.period, sharp.period);
+    let less_psi = less(before.psi_advance, sharp.psi_advance);
+    let less_drift = less(before.drift, sharp.drift);
     raw.period_error -= less_t;
     raw.psi_advance_error -= less_psi;
     if let Some(d) = raw.drift.as_mut() {
-        d.error -= less_psi * d.scale;
+        d.error -= less_psi * d.scale + less_drift;
     }
-    raw.saddle = [t - less_t, psi - less_psi];
+    raw.saddle = SaddleTerms {
+        period: before.period - less_t,
+        psi_advance: before.psi_advance - less_psi,
+        drift: before.drift - less_drift,
+    };
 }
 
 /// Errors of T, Δψ and |Δζ| caused by an offset of the energy the integrals are taken at.
@@ -748,8 +756,9 @@ fn level_offset_error<S: Shape>(
     // The integrator's saddle terms are at the a-priori energy error: the sharp offset is
     // computed where they weigh in too (the ψ term against tol itself: times the path
     // scale it is the drift's).
-    let saddle_small =
-        values.saddle[0] <= 0.05 * tol * values.period && values.saddle[1] <= 0.05 * tol;
+    let saddle_small = values.saddle.period <= 0.05 * tol * values.period
+        && values.saddle.psi_advance <= 0.05 * tol
+        && values.saddle.drift <= 0.05 * tol * drift_scale;
     // A kink whose level lies within the level's uncertainty of ε, at or next to the
     // libration: which side of it the turning point lies on is decided by rounding, and X may
     // jump there (a neutral sphere beside an edge, V′ = 2e-11 on both sides: T = 2866 on the

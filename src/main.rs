@@ -109,10 +109,19 @@ fn main() -> ExitCode {
             // A full disk (a quota, a file-size limit) is no bad input, whatever the error's
             // kind (a run into a full disk exited 2: adversary pass of 2026-11-27).
             let text = format!("{e:#}");
-            // (By the system's error codes as io::Error shows them: ENOSPC, EFBIG, EDQUOT.)
-            let out_of_space = ["(os error 28)", "(os error 27)", "(os error 122)"]
-                .iter()
-                .any(|m| text.contains(m));
+            // (By the system's error codes as io::Error and HDF5 show them: ENOSPC, EFBIG,
+            // EDQUOT. An HDF5 table into a full disk or past `ulimit -f` exited 2: adversary
+            // pass of 2026-11-28.)
+            let out_of_space = [
+                "(os error 28)",
+                "(os error 27)",
+                "(os error 122)",
+                "errno = 28,",
+                "errno = 27,",
+                "errno = 122,",
+            ]
+            .iter()
+            .any(|m| text.contains(m));
             let bad_input = !out_of_space
                 && e.chain().any(|c| {
                     matches!(

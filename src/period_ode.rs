@@ -8,7 +8,9 @@ use crate::body::Shape;
 use crate::error::{AtlasError, Result};
 use crate::ode::run_dop853;
 use crate::reduced::ReducedSystem;
-use crate::torus::{Component, DriftEstimate, EffectivePotential, MotionKind, PeriodIntegrals};
+use crate::torus::{
+    Component, DriftEstimate, EffectivePotential, MotionKind, PeriodIntegrals, SaddleTerms,
+};
 use nalgebra::SVector;
 use ode_solvers::System;
 use std::cell::RefCell;
@@ -273,8 +275,9 @@ pub fn integrate<S: Shape>(
         2.0
     };
     let energy_error = tight.energy_error.max(loose.energy_error);
-    let (saddle_t, saddle_psi) =
+    let saddle =
         potential.saddle_conditioning(energy, component, tight.period, double, energy_error);
+    let (saddle_t, saddle_psi) = (saddle.period, saddle.psi_advance);
     let mut period_error =
         (tight.period - loose.period).abs() + eps * tight.period + timing + saddle_t;
     let mut psi_advance_error = (tight.psi_advance - loose.psi_advance).abs()
@@ -291,6 +294,7 @@ pub fn integrate<S: Shape>(
         let error = (tight.drift[0] - loose.drift[0]).hypot(tight.drift[1] - loose.drift[1])
             + eps * tight.scale
             + tight.scale / tight.period * (timing + saddle_t)
+            + saddle.drift
             + tight.scale * saddle_psi;
         DriftEstimate {
             value: tight.drift,
@@ -310,7 +314,7 @@ pub fn integrate<S: Shape>(
         drift,
         psi_variation: None,
         // (The runs' own energy drift, not a level offset: kept.)
-        saddle: [0.0, 0.0],
+        saddle: SaddleTerms::default(),
         level_residual: None,
         work: n1 + n2,
         converged: true,

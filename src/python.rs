@@ -741,7 +741,7 @@ fn census(
 /// The verdict of the boundedness hypothesis (docs/hypothesis.md) for each body, as JSON (the
 /// `verdict --json` object), computed in parallel with the GIL released.
 #[pyfunction]
-#[pyo3(signature = (alpha, beta, nu, eta, tol, resolution, threads=None))]
+#[pyo3(signature = (alpha, beta, nu, eta, tol, resolution, threads=None, allow_large=false))]
 #[allow(clippy::too_many_arguments)]
 fn verdicts(
     py: Python<'_>,
@@ -752,6 +752,7 @@ fn verdicts(
     tol: f64,
     resolution: i64,
     threads: Option<i64>,
+    allow_large: bool,
 ) -> PyResult<Vec<String>> {
     use rayon::prelude::*;
     let resolution = resolution_between(resolution, 8, "")?;
@@ -777,6 +778,18 @@ fn verdicts(
         counterexamples: true,
         coarse_first: true,
     };
+    // As many bodies are sampled at once as the pool has threads: each one's samples (the
+    // verdict checks one body's alone).
+    let at_once = pool
+        .as_ref()
+        .map_or_else(rayon::current_num_threads, |p| p.current_num_threads())
+        .min(n);
+    check_memory(
+        at_once as f64 * verdict::sampling_memory(resolution),
+        allow_large,
+        "ask for a smaller resolution (its samples grow as its square) or fewer threads, or \
+         allow_large=True",
+    )?;
     // Ctrl-C (KeyboardInterrupt) is heard within a component's time.
     let found = interruptible(py, &pool, |stop| {
         bodies

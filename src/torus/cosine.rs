@@ -154,8 +154,8 @@ fn integrate_on<S: Shape>(
         // The quadrature gets what the tolerance leaves of the whole error estimate after the
         // rounding of the gap and the conditioning near a saddle, which refining cannot
         // reduce (when those alone exceed it, a tenth of them: the status then says so).
-        let (saddle_t, saddle_psi) =
-            v.placed_saddle_conditioning(energy, component, period, 2.0, residual);
+        let saddle = v.placed_saddle_conditioning(energy, component, period, 2.0, residual);
+        let (saddle_t, saddle_psi) = (saddle.period, saddle.psi_advance);
         let extra_t = 2.0 * sums.t_rounding + saddle_t;
         let nodes_psi = 2.0 * sums.psi_rounding + saddle_psi;
         let extra_psi = nodes_psi + passage_error;
@@ -181,16 +181,18 @@ fn integrate_on<S: Shape>(
             && (psi_error <= budget(tol * TAU, extra_psi) || at_level_floor(psi_sums, rate));
         let period_error = t_error + extra_t;
         let psi_advance_error = psi_error + extra_psi;
-        // Rounding in T and Δψ enters the drift through the phases and the weights.
+        // Rounding in T and Δψ enters the drift through the phases and the weights, and the
+        // time spent by a saddle at the speed there (`saddle.drift`).
         // (Not the passages' term: the drift's phases left it out before it moved here.)
         let phase = (extra_t - saddle_t) / period + nodes_psi;
+        let drift_extra = |d: &DriftEstimate| phase * d.scale + saddle.drift;
         // The drift (the costly part) only once T and Δψ have converged.
         let drift = (done && with_drift).then(|| samples.drift(rate));
         done &= drift.is_none_or(|d| {
-            d.error <= budget(tol * d.scale, phase * d.scale) || d.error <= LEVEL_FLOOR * d.scale
+            d.error <= budget(tol * d.scale, drift_extra(&d)) || d.error <= LEVEL_FLOOR * d.scale
         });
         let drift = drift.map(|mut d| {
-            d.error += phase * d.scale;
+            d.error += drift_extra(&d);
             d
         });
         // Where the gaps' rounding is what keeps the converged sums from the tolerance, and
@@ -226,8 +228,15 @@ fn integrate_on<S: Shape>(
             };
             let drift_freed = match drift {
                 Some(d) => {
-                    let quadrature = d.error / d.scale.max(f64::MIN_POSITIVE) - phase;
-                    frees(quadrature, phase, floor_phase, tol)
+                    let scale = d.scale.max(f64::MIN_POSITIVE);
+                    let quadrature = (d.error - drift_extra(&d)) / scale;
+                    let saddle_part = saddle.drift / scale;
+                    frees(
+                        quadrature,
+                        phase + saddle_part,
+                        floor_phase + saddle_part,
+                        tol,
+                    )
                 }
                 None => !with_drift || phase <= 0.5 * tol || floor_phase <= 0.5 * tol,
             };
@@ -268,7 +277,7 @@ fn integrate_on<S: Shape>(
             let drift = match drift {
                 None if with_drift => {
                     let mut d = samples.drift(rate);
-                    d.error += phase * d.scale;
+                    d.error += drift_extra(&d);
                     Some(d)
                 }
                 d => d,
@@ -281,7 +290,7 @@ fn integrate_on<S: Shape>(
                 psi_advance_error,
                 drift,
                 psi_variation: Some(2.0 * sums.psi_variation),
-                saddle: [saddle_t, saddle_psi],
+                saddle,
                 level_residual: residual,
                 work: samples.nodes.len(),
                 converged: true,
