@@ -782,7 +782,16 @@ fn check_window(options: &ResonanceOptions) -> Result<()> {
         );
     }
     if !(k1.is_finite() && k1 > k0) {
-        return bad("kappa_max", k1, "must be finite and above kappa_min");
+        // Name both: kappa_max may be its default, not a value the user gave (a kappa_min of
+        // 2.5 was blamed on "kappa_max = 2": adversary pass of 2026-11-28).
+        return Err(AtlasError::Atlas {
+            path: format!("invalid kappa_max = {}", crate::error::show(k1)),
+            reason: format!(
+                "must be finite and above kappa_min = {} (when not given, kappa_max is the \
+                 default of the window)",
+                crate::error::show(k0)
+            ),
+        });
     }
     // κ's and ε's ranges of every surface: the window's corners are cells.
     if k0 < f64::MIN_POSITIVE {

@@ -105,8 +105,12 @@ def test_cells_refuse_a_kappa_that_is_not_real_numbers(kappa, error):
 
 
 def test_a_value_too_large_for_a_float_is_named_where_it_is():
-    message = refused(ValueError, lambda: ra.cells(*BODY, [0.5, 2**1100], 2.5), "kappa[1]", "1.36e+331")
+    message = refused(ValueError, lambda: ra.cells(*BODY, [0.5, 2**1100], 2.5), "kappa[1]",
+                      "1.3582985290493858e+331")
     assert len(message) < 300, message
+    # (Adversary pass 19: 2**1024 at 3 digits read as the limit it is beyond.)
+    refused(ValueError, lambda: ra.cells(*BODY, [0.5, 2**1024], 2.5), "1.7976931348623159e+308",
+            "beyond the largest float64 (1.7976931348623157e+308)")
 
 
 @pytest.mark.parametrize("value", ["no", "False", 0, 1, None, [True]])
@@ -718,3 +722,19 @@ def test_a_files_name_is_shown_as_given():
         refused(ValueError, lambda: read("a\0b.h5"), "'a\\x00b.h5'", "NUL")
         refused(ValueError, lambda: read("http://example.com/x.h5"), "http://example.com/x.h5", "URL")
         refused(ValueError, lambda: read("a\nb.h5"), "'a\\nb.h5'", "no such file")
+
+
+def test_a_verdict_whose_samples_would_not_fit_is_a_value_error():
+    """Adversary pass 19: at resolution 4096 under a 1.5 GB address-space limit the allocator
+    aborted the interpreter (exit 134, no exception to catch); the samples' memory (about
+    200 r² bytes a body) is checked first."""
+    code = ("import resource; resource.setrlimit(resource.RLIMIT_AS, (1_500_000_000, 1_500_000_000))\n"
+            "import rubber_atlas as ra\n"
+            "try:\n"
+            "    ra.verdict(0.5, 3.0, 0.5, 0.5, resolution=4096)\n"
+            "except ValueError as e:\n"
+            "    print('refused:', e)\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.startswith("refused:") and "resolution" in done.stdout and "memory" in done.stdout, done.stdout
+    assert "\n" not in done.stdout.strip(), done.stdout

@@ -88,7 +88,8 @@ pub(super) fn parse_rotation_number(text: &str) -> Result<f64> {
     if !value.is_finite() {
         return Err(bad().into());
     }
-    Ok(value)
+    // (−0 is 0: the text printed "N = -0"; adversary pass of 2026-11-28.)
+    Ok(value + 0.0)
 }
 
 pub(super) fn resonance(args: ResonanceArgs) -> Result<()> {
