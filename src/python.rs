@@ -687,7 +687,15 @@ fn resonance<'py>(
     shape: &str,
     profile: Option<Vec<Vec<f64>>>,
 ) -> PyResult<(Bound<'py, PyDict>, f64)> {
-    let grid = count("grid", grid, 1)?;
+    // (The whole range where a count below it is refused: "must be >= 1" for -1 named
+    // only half of it; adversary pass of 2026-11-28.)
+    if grid < 4 {
+        return Err(bad(format!(
+            "invalid grid = {grid}: {}",
+            crate::resonance::GRID_RANGE
+        )));
+    }
+    let grid = count("grid", grid, 4)?;
     let body = any_body(shape, profile.as_deref(), alpha, beta, nu, eta)?;
     let options = crate::with_body!(&body, b => ResonanceOptions::window(
         b,

@@ -764,6 +764,9 @@ fn tangent((gk, ge): (f64, f64), sign: f64) -> (f64, f64) {
     (-ge / norm * sign, gk / norm * sign)
 }
 
+/// The seed scan's `grid`, as its refusal states it.
+pub const GRID_RANGE: &str = "must be between 4 and 4096 (the seed scan solves about grid² cells)";
+
 fn check_window(options: &ResonanceOptions) -> Result<()> {
     let bad = |name: &'static str, value: f64, reason: &'static str| {
         Err(AtlasError::InvalidParameter {
@@ -841,11 +844,7 @@ fn check_window(options: &ResonanceOptions) -> Result<()> {
         "must be at most 1e-4 for resonance curves (their points have N = P/Q to the tolerance)",
     )?;
     if !(4..=MAX_GRID).contains(&options.grid) {
-        return bad(
-            "grid",
-            options.grid as f64,
-            "must be between 4 and 4096 (the seed scan solves about grid² cells)",
-        );
+        return bad("grid", options.grid as f64, GRID_RANGE);
     }
     options.cell.validate()
 }

@@ -53,6 +53,12 @@ def resonances(lo: float, hi: float, max_q: int = 7) -> list[float]:
 def _family_codes(ds: xr.Dataset) -> dict[str, int]:
     """{name: code} of the torus families the `family` flags of `ds` know."""
     if "family" not in ds:
+        # (A dataset of no rubber-atlas at all was told it came from an old version of it:
+        # adversary pass of 2026-11-28.)
+        if ds.attrs.get("program") != "rubber-atlas" and "cell_status" not in ds:
+            raise ValueError("this dataset is not an atlas of rubber-atlas (no `family` variable, no "
+                             "`cell_status`, no attribute program = 'rubber-atlas'): open one with "
+                             "rubber_atlas.open_atlas, or compute one with rubber_atlas.cells")
         raise ValueError("this dataset has no `family` variable: it was written by a version of rubber-atlas "
                          "from before the families of tori (its components are numbered by increasing "
                          "theta_min); compute it again (`rubber-atlas run`, or rubber_atlas.cells)")

@@ -738,3 +738,13 @@ def test_a_verdict_whose_samples_would_not_fit_is_a_value_error():
     assert done.returncode == 0, done.stderr[-2000:]
     assert done.stdout.startswith("refused:") and "resolution" in done.stdout and "memory" in done.stdout, done.stdout
     assert "\n" not in done.stdout.strip(), done.stdout
+
+
+def test_a_foreign_dataset_and_a_grid_below_its_range_are_named_as_such():
+    """Adversary pass 19: `.rubber.family()` on a dataset of no rubber-atlas said it was an
+    atlas from an old version; `grid=-1` was refused as "must be >= 1", half of its range."""
+    foreign = xr.Dataset({"x": ("a", np.arange(3.0))})
+    refused(ValueError, lambda: foreign.rubber.family("well_0"), "not an atlas of rubber-atlas")
+    for grid in (-1, 0, 3):
+        refused(ValueError, lambda: ra.resonance(*BODY, "1/2", grid=grid), f"invalid grid = {grid}",
+                "between 4 and 4096")
