@@ -2114,7 +2114,8 @@ fn drift_estimate(
     let (fine, mid, coarse) = (level(0), level(1), level(2));
     let rate = if samples.iter().all(PieceSamples::geometric) {
         let coarsest = level(3);
-        let gap = |a: ([f64; 2], f64), b: ([f64; 2], f64)| (a.0[0] - b.0[0]).hypot(a.0[1] - b.0[1]);
+        let gap =
+            |a: LevelDrift, b: LevelDrift| (a.value[0] - b.value[0]).hypot(a.value[1] - b.value[1]);
         let (d1, d2, d3) = (gap(fine, mid), gap(mid, coarse), gap(coarse, coarsest));
         if d2 == 0.0 || d3 == 0.0 || d1 / d2 >= (d2 / d3).powi(2) / 16.0 {
             Convergence::Geometric
@@ -2127,8 +2128,25 @@ fn drift_estimate(
     DriftEstimate::from_levels(fine, mid, coarse, rate)
 }
 
-/// Drift sums already made (Δζ and its path scale), by the pieces' levels.
-type KnownDrifts = Vec<(Option<u64>, ([f64; 2], f64))>;
+/// Drift sums already made, by the pieces' levels.
+type KnownDrifts = Vec<(Option<u64>, LevelDrift)>;
+
+/// Δζ on one level of a rule: its value, the L1 size of its integrand (the path scale), and
+/// the largest change of the phase its nodes take e^{iψ} at between neighbours (of ψ̃, ψ less
+/// its mean rate, in the cosine rule, which integrates e^{iνφ} exactly).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct LevelDrift {
+    pub(crate) value: [f64; 2],
+    pub(crate) scale: f64,
+    pub(crate) phase_step: f64,
+}
+
+/// The largest phase step between neighbouring nodes at which a level is taken to resolve
+/// e^{iψ} (four nodes a quarter-turn): where the phase turns faster the sums alias, and three
+/// levels can agree on a wrong Δζ. (A libration passing a pole within 1e-4 at κ = −2.5e-4,
+/// N = 811, Δψ = −5096 over a period: its drift was `ok` at tol 1e-6 with 65 … 129 cosine
+/// nodes, 112 times too small against an estimate of 2.9e-8; adversary pass of 2026-11-28.)
+const RESOLVED_PHASE_STEP: f64 = FRAC_PI_2;
 const _: () = assert!(MAX_LEVEL < 16 && crate::quadrature::FINEST_CHEBYSHEV_LEVEL < 16);
 
 /// Δζ and the L1 size of its integrand from every `stride`-th node of each piece's samples.
@@ -2137,19 +2155,18 @@ const _: () = assert!(MAX_LEVEL < 16 && crate::quadrature::FINEST_CHEBYSHEV_LEVE
 /// period's way back, e^{−iΔψ} times this one's, and the rule's weights of ∫ over [0, 1] at
 /// the mirrored nodes (v_{N−j}) carry that factor; elsewhere the two ways join smoothly (at
 /// θ_max, or within the piece) and the sum of both is integrated at once.
-fn drift_sum(
-    samples: &[PieceSamples],
-    psi_advance: f64,
-    double: f64,
-    stride: usize,
-) -> ([f64; 2], f64) {
+fn drift_sum(samples: &[PieceSamples], psi_advance: f64, double: f64, stride: usize) -> LevelDrift {
     let stride_exp = stride.trailing_zeros();
     let (sa, ca) = psi_advance.sin_cos();
     let (mut re, mut im, mut scale) = (0.0, 0.0, 0.0);
     let mut psi_offset = 0.0;
+    let mut phase_step: f64 = 0.0;
     let mut psi = Vec::new();
     for s in samples {
         s.psi_along(stride_exp, &mut psi);
+        phase_step = psi
+            .windows(2)
+            .fold(phase_step, |worst, w| worst.max((w[1] - w[0]).abs()));
         let weights = s.weights(stride_exp);
         let mirror = (s.rule == Rule::Chebyshev(ChebyshevPiece::TurningLeft))
             .then(|| &ChebyshevLevel::get(s.level - stride_exp).turning_left_mirror);
@@ -2182,7 +2199,11 @@ fn drift_sum(
         }
         psi_offset += psi.last().copied().unwrap_or(0.0);
     }
-    ([re, im], scale)
+    LevelDrift {
+        value: [re, im],
+        scale,
+        phase_step,
+    }
 }
 
 /// Δζ with its error estimate and the scale the tolerance is relative to.
@@ -2197,22 +2218,35 @@ pub struct DriftEstimate {
 }
 
 impl DriftEstimate {
-    /// The finest of three successive (Δζ, path scale) values, with its error from their
-    /// differences by [`cautious_error`].
+    /// The finest of three successive levels' Δζ, with its error from their differences by
+    /// [`cautious_error`]: at `rate` where the coarsest level resolves e^{iψ}
+    /// ([`RESOLVED_PHASE_STEP`]), at [`Convergence::Unknown`] where only the two finer ones
+    /// do, and the whole path scale (Δζ unknown, the levels to be refined) where the middle
+    /// one does not either.
     fn from_levels(
-        fine: ([f64; 2], f64),
-        mid: ([f64; 2], f64),
-        coarse: ([f64; 2], f64),
+        fine: LevelDrift,
+        mid: LevelDrift,
+        coarse: LevelDrift,
         rate: Convergence,
     ) -> Self {
-        let (d1, d2) = (
-            (fine.0[0] - mid.0[0]).hypot(fine.0[1] - mid.0[1]),
-            (mid.0[0] - coarse.0[0]).hypot(mid.0[1] - coarse.0[1]),
-        );
+        let distance =
+            |a: LevelDrift, b: LevelDrift| (a.value[0] - b.value[0]).hypot(a.value[1] - b.value[1]);
+        let (d1, d2) = (distance(fine, mid), distance(mid, coarse));
+        // (A NaN phase step is no resolved one.)
+        let resolved = |l: LevelDrift| l.phase_step <= RESOLVED_PHASE_STEP;
+        let rate = if resolved(coarse) {
+            rate
+        } else {
+            Convergence::Unknown
+        };
+        let mut error = cautious_error(d1, d2, rate).max(LEVEL_FLOOR * fine.scale);
+        if !resolved(mid) {
+            error = error.max(fine.scale);
+        }
         Self {
-            value: fine.0,
-            error: cautious_error(d1, d2, rate).max(LEVEL_FLOOR * fine.1),
-            scale: fine.1,
+            value: fine.value,
+            error,
+            scale: fine.scale,
         }
     }
 }

@@ -7,8 +7,9 @@
 
 use super::{
     at_level_floor, interleave, level_error, precise_sample, root_of_ratio, sample, weighted,
-    Component, Convergence, DriftEstimate, EffectivePotential, NodeSample, PeriodIntegrals, Piece,
-    EPS, HIDDEN_PEAK, INTEGRAND_ROUNDING, LEVEL_FLOOR, PRECISE_NODE_ROUNDING,
+    Component, Convergence, DriftEstimate, EffectivePotential, LevelDrift, NodeSample,
+    PeriodIntegrals, Piece, EPS, HIDDEN_PEAK, INTEGRAND_ROUNDING, LEVEL_FLOOR,
+    PRECISE_NODE_ROUNDING,
 };
 use crate::body::{Angle, Shape};
 use crate::dd::CompensatedSum;
@@ -335,7 +336,7 @@ struct Samples {
     nodes: Vec<NodeSample>,
     /// Δζ and its path scale already computed on a level, by its number of steps (a level's
     /// nodes never change, so a refinement reuses them as its two coarser levels).
-    drifts: Vec<(usize, ([f64; 2], f64))>,
+    drifts: Vec<(usize, LevelDrift)>,
 }
 
 impl Samples {
@@ -424,7 +425,7 @@ impl Samples {
 
 impl Samples {
     /// [`fourier_drift`] on every `stride`-th node, computed once per level.
-    fn level_drift(&mut self, stride: usize) -> ([f64; 2], f64) {
+    fn level_drift(&mut self, stride: usize) -> LevelDrift {
         let intervals = self.intervals / stride;
         if let Some((_, known)) = self.drifts.iter().find(|(n, _)| *n == intervals) {
             return *known;
@@ -752,7 +753,7 @@ thread_local! {
 /// so Δζ = Σ_k P̂_k ∫₀^{2π} e^{i(ν+k)φ} dφ = 2 e^{iπν} sin(πν) Σ_k P̂_k / (ν + k): exact
 /// but for the aliasing of P̂, which decays like the trapezoid error. ψ̃ is odd, so
 /// P(−φ) = conj P(φ) and every P̂_k is real: R = |Σ_k P̂_k / (ν + k)|.
-fn fourier_drift(nodes: &[NodeSample], stride: usize) -> ([f64; 2], f64) {
+fn fourier_drift(nodes: &[NodeSample], stride: usize) -> LevelDrift {
     DRIFT_BUFFERS.with(|buffers| {
         let buffers = &mut *buffers.borrow_mut();
         let n = (nodes.len() - 1) / stride;
@@ -776,12 +777,16 @@ fn fourier_drift_in(
     psi: &mut [f64],
     values: &mut [f64],
     spectrum: &mut [Complex<f64>],
-) -> ([f64; 2], f64) {
+) -> LevelDrift {
     let n = (nodes.len() - 1) / stride;
     let m = 2 * n;
     let node = |j: usize| &nodes[j * stride];
     // ν: the mean of ψ̇ dt/dφ over the circle, on this level.
     let nu = antiderivative(nodes, stride, psi, spectrum);
+    // (ψ̃ is odd about both ends: its steps on the way out are all of them.)
+    let phase_step = psi[..=n]
+        .windows(2)
+        .fold(0.0, |worst: f64, w| worst.max((w[1] - w[0]).abs()));
     // y_j = Re P_j + Im P_j: its real transform Y_k gives m P̂_{±k} = Re Y_k ∓ Im Y_k (the
     // even part Re P transforms to a real, the odd part Im P to an imaginary sequence).
     let mut scale = 0.0;
@@ -830,5 +835,9 @@ fn fourier_drift_in(
         };
     }
     let drift = 2.0 * sum / m as f64;
-    ([cd * drift, sd * drift], scale * PI / n as f64)
+    LevelDrift {
+        value: [cd * drift, sd * drift],
+        scale: scale * PI / n as f64,
+        phase_step,
+    }
 }

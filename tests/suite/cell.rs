@@ -782,6 +782,73 @@ fn the_drift_counts_the_time_by_a_saddle() {
     }
 }
 
+/// Adversary pass of 2026-11-28: librations passing a pole within 1e-4 precess fast (N = 811,
+/// Δψ = −5096 over a period). With 65 … 129 cosine nodes ψ̃ turned by tens of radians between
+/// neighbours, the three levels aliased alike, and the drift was `ok` at tol 1e-6, 112 times
+/// too small against an estimate of 2.9e-8; at tol 1e-12 a tanh-sinh level gave 0.0221 ±
+/// 0.0135 against 0.00118. A level is now trusted only where its phase turns by at most a
+/// quarter-turn between neighbouring nodes (`torus::RESOLVED_PHASE_STEP`). Each tolerance's
+/// drift lies within its estimate of the one-period displacement of a 1e-12 trajectory,
+/// 0.00117950539, and so does a libration 1.4e-14 below the equator's saddle of an oblate
+/// body (N = −136), whose drift at tol 1e-12 was 3 times the two estimates off those at 1e-11
+/// and 1e-13.
+#[test]
+fn the_drift_of_a_fast_precessing_libration_is_not_aliased() {
+    let fast = EllipsoidBody::ellipsoid(
+        0.999999,
+        901.3631399874322,
+        0.05136374208890875,
+        151.66647868937162,
+    )
+    .unwrap();
+    for tol in [1e-3, 1e-6, 1e-12] {
+        let c = solve(
+            &fast,
+            -0.0002531039785673815,
+            2.8885768758932904,
+            Method::Quadrature,
+            tol,
+        );
+        let d = &c.components[1];
+        assert!(
+            (d.drift - 0.00117950539).abs() <= d.errors.drift + 1e-11,
+            "tol {tol:e}: {} ± {:e}",
+            d.drift,
+            d.errors.drift
+        );
+    }
+    let by_saddle = EllipsoidBody::ellipsoid(
+        -0.37108051627681937,
+        786.1433757647487,
+        0.00945407303992059,
+        3.796853663818693,
+    )
+    .unwrap();
+    let at = |tol| {
+        solve(
+            &by_saddle,
+            -0.08706479528566927,
+            786.147253484929,
+            Method::Quadrature,
+            tol,
+        )
+        .components[0]
+            .clone()
+    };
+    let tight = at(1e-13);
+    for tol in [1e-11, 1e-12] {
+        let d = at(tol);
+        assert!(
+            (d.drift - tight.drift).abs() <= d.errors.drift + tight.errors.drift,
+            "tol {tol:e}: {} ± {:e} against {} ± {:e}",
+            d.drift,
+            d.errors.drift,
+            tight.drift,
+            tight.errors.drift
+        );
+    }
+}
+
 /// Issue 23: at tol 1e-14 the drift's phases, 16 ulps of ψ̇ per node over ∫ |ψ̇| dt ≈ 5, kept
 /// all but 1 % of the standard slice's components from `ok` (none of the 26 librations below).
 /// Once the sums have converged the cosine rule takes its nodes again with the integrands in
