@@ -249,6 +249,13 @@ pub trait Shape: Send + Sync {
         1.0
     }
 
+    /// The angles in (0, π) about which U, B and J turn on [`Shape::angular_feature_scale`]
+    /// where that is below 0.1 (a needle's π/2): the integrals are cut there, where a rule's
+    /// nodes crowd ([`crate::torus`]'s pieces). None by default.
+    fn feature_angles(&self) -> Vec<f64> {
+        Vec::new()
+    }
+
     /// A bound on the error of U as the body is held in doubles, beyond the rounding of its
     /// evaluation: 0 where the shape's parameters are its inputs; a profile's arcs, fitted
     /// through its points, carry the fit's rounding
@@ -512,6 +519,16 @@ impl Shape for Ellipsoid {
     /// poles of an oblate one.
     fn angular_feature_scale(&self) -> f64 {
         self.beta.min(1.0 / self.beta)
+    }
+
+    /// A needle's Z = √(β² sin²θ + cos²θ) turns within β of π/2 (its singularities lie at
+    /// π/2 ± i artanh β … about ±iβ off the real axis).
+    fn feature_angles(&self) -> Vec<f64> {
+        if self.beta < 0.1 {
+            vec![std::f64::consts::FRAC_PI_2]
+        } else {
+            Vec::new()
+        }
     }
 
     /// U′ = sinθ ((β² − 1) cosθ / Z − α) = 0 off the poles where (β² − 1) cosθ = α Z:

@@ -1855,6 +1855,29 @@ impl<S: Shape> EffectivePotential<'_, S> {
                         }
                     }),
             );
+            // And at a needle's π/2, where Z turns within β (a tenth of that scale clear of
+            // the ends and of every critical point, which are cut already): a libration
+            // across it that neither turns nor has its minimum there (α → −1, β = 0.0038)
+            // had the turn in the middle of a piece, and T was 9.3 times its estimate off at
+            // tol 1e-4 (adversary pass of 2026-11-28).
+            let shape = &self.body.shape;
+            let clear = 0.1 * shape.angular_feature_scale();
+            let taken: Vec<f64> = ends.iter().map(|e| e.site.theta).collect();
+            ends.extend(
+                lifted_inside(
+                    &shape.feature_angles(),
+                    component.lower.theta + clear,
+                    component.upper.theta - clear,
+                )
+                .into_iter()
+                .filter(|site| {
+                    taken
+                        .iter()
+                        .chain(self.critical.iter().map(|p| &p.site.theta))
+                        .all(|&t| (t - site.theta).abs() > clear)
+                })
+                .map(|site| end(site, false)),
+            );
             ends[1..].sort_by(|a, b| a.site.theta.total_cmp(&b.site.theta));
             ends.dedup_by(|a, b| a.site.theta == b.site.theta);
         }

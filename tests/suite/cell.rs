@@ -849,6 +849,38 @@ fn the_drift_of_a_fast_precessing_libration_is_not_aliased() {
     }
 }
 
+/// Adversary pass of 2026-11-28: a needle (β = 0.0038) whose libration spans θ from 4e-7 to
+/// π − 6e-7 with its minimum by a pole (α → −1) had Z's turn at π/2, β wide, in the middle
+/// of a piece: T was `ok` at tol 1e-4 and 1e-5, 9.3 times its estimate off. The pieces are
+/// now cut at a needle's π/2 too. T against 50 digits (scripts/reference.py):
+/// 62.366410751433705.
+#[test]
+fn a_needles_turn_inside_a_libration_is_not_stepped_over() {
+    let b = EllipsoidBody::ellipsoid(
+        -0.9999997515690455,
+        0.0038023297438580105,
+        0.21225301214422782,
+        0.002002486867789268,
+    )
+    .unwrap();
+    for tol in [1e-4, 1e-6, 1e-10] {
+        let c = solve(
+            &b,
+            1.0426269748724147e-06,
+            3.3838558603477025,
+            Method::Quadrature,
+            tol,
+        );
+        let t = &c.components[0];
+        assert!(
+            (t.period - 62.366410751433705).abs() <= t.errors.period,
+            "tol {tol:e}: {} ± {:e}",
+            t.period,
+            t.errors.period
+        );
+    }
+}
+
 /// Issue 23: at tol 1e-14 the drift's phases, 16 ulps of ψ̇ per node over ∫ |ψ̇| dt ≈ 5, kept
 /// all but 1 % of the standard slice's components from `ok` (none of the 26 librations below).
 /// Once the sums have converged the cosine rule takes its nodes again with the integrands in
