@@ -793,7 +793,7 @@ fn verdicts(
         .map_or_else(rayon::current_num_threads, |p| p.current_num_threads())
         .min(n);
     check_memory(
-        at_once as f64 * verdict::sampling_memory(resolution),
+        at_once as f64 * verdict::samples_memory(resolution) + verdict::sampling_memory(0),
         allow_large,
         "ask for a smaller resolution (its samples grow as its square) or fewer threads, or \
          allow_large=True",

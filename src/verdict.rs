@@ -664,14 +664,22 @@ fn check_sampling(tol: f64, resolution: usize) -> Result<()> {
     Ok(())
 }
 
-/// The memory a verdict's or a census's sampling holds at its peak, in bytes: 2 (r + 1)
-/// κ-lines of r base energies, about 1.2 components each with their [`Sample`] and a
-/// reference to it (measured at resolution 256, 512 and 1024 on the paper's body: 28, 67 and
-/// 202 MB resident, 190 bytes per line and energy at 1024), and 10 MB besides.
+/// The memory a verdict's or a census's sampling takes at its peak, in bytes, as the
+/// address-space limit counts it: 2 (r + 1) κ-lines of r base energies, about 1.2 components
+/// each with their [`Sample`] and a reference to it, their vectors' growth, and 100 MB for
+/// the program and its threads' allocator arenas. (Measured at resolution 256, 512 and 1024
+/// on the paper's body: 28, 67 and 202 MB resident; under `ulimit -v` 350–450 MB the run at
+/// 1024 still aborted, where the check counted 241 MB: adversary pass of 2026-11-28.)
 pub fn sampling_memory(resolution: usize) -> f64 {
+    samples_memory(resolution) + 100e6
+}
+
+/// [`sampling_memory`] less what the program takes whatever it samples: one body's samples
+/// (the package samples one body a thread at once).
+pub fn samples_memory(resolution: usize) -> f64 {
     let r = resolution as f64;
-    let per_point = 1.25 * (std::mem::size_of::<Sample>() + std::mem::size_of::<&Sample>()) as f64;
-    2.0 * (r + 1.0) * r * per_point + 10e6
+    let per_point = 1.6 * (std::mem::size_of::<Sample>() + std::mem::size_of::<&Sample>()) as f64;
+    2.0 * (r + 1.0) * r * per_point
 }
 
 /// The verdict for one body with α ≥ 0.

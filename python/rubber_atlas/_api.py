@@ -2185,8 +2185,9 @@ def verdict(alpha, beta, nu, eta, *, tol: float = 1e-10, resolution: int = 64,
         Solver tolerance (1e-13 … 1e-4).
     resolution : int, default 64
         Sampling of the (κ, ε) plane: κ-lines and energies per line, 8 … 4096; higher finds
-        narrower resonance regions, and costs about its square in time and memory (about
-        200 r² bytes a body while it is sampled: 210 MB at 1024, 3.4 GB at 4096).
+        narrower resonance regions, and costs about its square in time and memory (counted as
+        about 280 r² bytes a body while it is sampled, and 100 MB besides: 400 MB at 1024,
+        4.8 GB at 4096).
     threads : int, optional
         Number of threads (≥ 1); by default rayon's pool.
     allow_large : bool, default False

@@ -1029,19 +1029,23 @@ fn output_that_cannot_be_written_is_one_line_and_exit_1() {
 /// and took a Python interpreter down with it: adversary pass of 2026-11-28).
 #[test]
 fn a_verdict_too_large_for_the_memory_is_refused_in_one_line() {
-    let script = format!(
-        "ulimit -v 1000000; exec '{}' verdict --alpha 0.5 --beta 3 --nu 0.5 --eta 0.5 \
-         --resolution 4096",
-        env!("CARGO_BIN_EXE_rubber-atlas"),
-    );
-    let o = Command::new("sh").arg("-c").arg(&script).output().unwrap();
-    let text = stderr(&o);
-    assert_eq!(o.status.code(), Some(2), "{text}");
-    assert!(
-        text.contains("resolution 4096") && text.contains("of memory"),
-        "{text}"
-    );
-    assert_eq!(text.trim().lines().count(), 1, "{text}");
+    // (And at 1024 under 400 MB, where the check had counted the samples alone, 241 MB, and
+    // the run aborted: a second adversary pass.)
+    for (limit, resolution) in [(1_000_000, 4096), (400_000, 1024)] {
+        let script = format!(
+            "ulimit -v {limit}; exec '{}' verdict --alpha 0.5 --beta 3 --nu 0.5 --eta 0.5 \
+             --resolution {resolution}",
+            env!("CARGO_BIN_EXE_rubber-atlas"),
+        );
+        let o = Command::new("sh").arg("-c").arg(&script).output().unwrap();
+        let text = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{text}");
+        assert!(
+            text.contains(&format!("resolution {resolution}")) && text.contains("of memory"),
+            "{text}"
+        );
+        assert_eq!(text.trim().lines().count(), 1, "{text}");
+    }
 }
 
 /// A standard error that cannot be written (`2> /dev/full`) loses its lines but not the
