@@ -391,6 +391,21 @@ impl Ellipsoid {
         (self.beta * self.beta * a.sin * a.sin + a.cos * a.cos).sqrt()
     }
 
+    /// Z and U = Z + α cosθ in double-double at the angle whose sine and cosine are `sin` and
+    /// `cos`, with the bound on U's error ([`Shape::potential_double_double`]).
+    #[inline(always)]
+    fn height_double_double(
+        &self,
+        sin: DoubleDouble,
+        cos: DoubleDouble,
+    ) -> (DoubleDouble, DoubleDouble, f64) {
+        let bs = sin.mul_f64(self.beta);
+        let z = bs.mul(bs).add(cos.mul(cos)).sqrt();
+        let offset = cos.mul_f64(self.alpha);
+        let error = crate::dd::RELATIVE_ERROR * (z.hi + offset.hi.abs());
+        (z, z.add(offset), error)
+    }
+
     /// β² − 1 as (β − 1)(β + 1): within two ulps of itself (β − 1 is exact by Sterbenz's lemma
     /// for β in [½, 2]), where β·β − 1 loses the digits of β² below an ulp of 1 (near a sphere,
     /// β = 0.9989: 5e-14 of itself, a systematic error of U′ and of T at tight tolerances; a
@@ -611,11 +626,8 @@ impl Shape for Ellipsoid {
         sin: DoubleDouble,
         cos: DoubleDouble,
     ) -> Option<(DoubleDouble, f64)> {
-        let bs = sin.mul_f64(self.beta);
-        let z = bs.mul(bs).add(cos.mul(cos)).sqrt();
-        let offset = cos.mul_f64(self.alpha);
-        let error = crate::dd::RELATIVE_ERROR * (z.hi + offset.hi.abs());
-        Some((z.add(offset), error))
+        let (_, u, error) = self.height_double_double(sin, cos);
+        Some((u, error))
     }
 
     /// U as [`Shape::potential_double_double`], and |r|² = U² + U′² with
@@ -627,11 +639,7 @@ impl Shape for Ellipsoid {
         sin: DoubleDouble,
         cos: DoubleDouble,
     ) -> Option<(DoubleDouble, f64, DoubleDouble)> {
-        let bs = sin.mul_f64(self.beta);
-        let z = bs.mul(bs).add(cos.mul(cos)).sqrt();
-        let offset = cos.mul_f64(self.alpha);
-        let error = crate::dd::RELATIVE_ERROR * (z.hi + offset.hi.abs());
-        let u = z.add(offset);
+        let (z, u, error) = self.height_double_double(sin, cos);
         let b = DoubleDouble::from_f64(self.beta)
             .mul_f64(self.beta)
             .add_f64(-1.0);

@@ -386,9 +386,11 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         if self.kappa == 0.0 {
             return Some((u, error));
         }
-        let w = DoubleDouble::from_f64(self.kappa).div(sin);
-        let wall = w.mul(w).mul_f64(0.5);
-        Some((wall.add(u), error + crate::dd::RELATIVE_ERROR * wall.hi))
+        Some(with_wall(
+            u,
+            error,
+            DoubleDouble::from_f64(self.kappa).div(sin),
+        ))
     }
 
     /// V(b) − V(a) between two angles `length` = θ_b − θ_a apart (from
@@ -584,7 +586,14 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         if self.kappa == 0.0 {
             return 0.0;
         }
-        let j = self.body.reduction_at(a).integral_factor;
+        self.psi_rate_with(a, self.body.reduction_at(a).integral_factor)
+    }
+
+    /// [`Self::psi_rate`] with J at the angle known (0 for κ = 0, also at a pole).
+    fn psi_rate_with(&self, a: Angle, j: f64) -> f64 {
+        if self.kappa == 0.0 {
+            return 0.0;
+        }
         -self.kappa * a.cos / (j * a.sin * a.sin)
     }
 
@@ -1391,7 +1400,8 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             .map(|(p, passes, gap)| (p, passes, gap, false));
         for (p, passes, gap, sharp) in saddles.chain(shoulders) {
             let a = p.site.angle();
-            let b = self.body.reduction_at(a).reduced_inertia;
+            let red = self.body.reduction_at(a);
+            let b = red.reduced_inertia;
             // The distance left once the offset is spent: (ε − V_s) ± δ must keep its sign.
             let gap = if sharp {
                 let (distance, error) = self.saddle_distance(energy, &p);
@@ -1413,8 +1423,8 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             let sensitivity = (1.0 / lambda).min(period) / gap;
             let dt = passes * delta(&p) * sensitivity;
             terms.period += dt;
-            terms.psi_advance += dt * self.psi_rate(a).abs();
-            terms.drift += dt * self.saddle_speed(a);
+            terms.psi_advance += dt * self.psi_rate_with(a, red.integral_factor).abs();
+            terms.drift += dt * self.saddle_speed(a, &red);
         }
         terms
     }
@@ -1424,11 +1434,10 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
     /// term ([`Self::saddle_conditioning`]) times this adds to the drift. (Left out, the drift
     /// of librations within 1e-6 of a separatrix was up to 5.7 times its estimate off, at
     /// status `ok` at tol 1e-10: adversary pass of 2026-11-28.)
-    fn saddle_speed(&self, a: Angle) -> f64 {
+    fn saddle_speed(&self, a: Angle, red: &Reduction) -> f64 {
         if self.kappa == 0.0 {
             return 0.0;
         }
-        let red = self.body.reduction_at(a);
         (red.potential * self.kappa / (red.integral_factor * a.sin)).abs()
     }
 
@@ -2137,9 +2146,11 @@ fn drift_estimate(
     let (fine, mid, coarse) = (level(0), level(1), level(2));
     let rate = if samples.iter().all(PieceSamples::geometric) {
         let coarsest = level(3);
-        let gap =
-            |a: LevelDrift, b: LevelDrift| (a.value[0] - b.value[0]).hypot(a.value[1] - b.value[1]);
-        let (d1, d2, d3) = (gap(fine, mid), gap(mid, coarse), gap(coarse, coarsest));
+        let (d1, d2, d3) = (
+            fine.distance(&mid),
+            mid.distance(&coarse),
+            coarse.distance(&coarsest),
+        );
         if d2 == 0.0 || d3 == 0.0 || d1 / d2 >= (d2 / d3).powi(2) / 16.0 {
             Convergence::Geometric
         } else {
@@ -2162,6 +2173,20 @@ pub(crate) struct LevelDrift {
     pub(crate) value: [f64; 2],
     pub(crate) scale: f64,
     pub(crate) phase_step: f64,
+}
+
+impl LevelDrift {
+    /// |Δζ − Δζ′| between two levels.
+    fn distance(&self, other: &Self) -> f64 {
+        (self.value[0] - other.value[0]).hypot(self.value[1] - other.value[1])
+    }
+}
+
+/// The largest change between neighbours of `phases` (0 for fewer than two).
+pub(crate) fn largest_step(phases: &[f64]) -> f64 {
+    phases
+        .windows(2)
+        .fold(0.0, |worst: f64, w| worst.max((w[1] - w[0]).abs()))
 }
 
 /// The largest phase step between neighbouring nodes at which a level is taken to resolve
@@ -2187,9 +2212,7 @@ fn drift_sum(samples: &[PieceSamples], psi_advance: f64, double: f64, stride: us
     let mut psi = Vec::new();
     for s in samples {
         s.psi_along(stride_exp, &mut psi);
-        phase_step = psi
-            .windows(2)
-            .fold(phase_step, |worst, w| worst.max((w[1] - w[0]).abs()));
+        phase_step = phase_step.max(largest_step(&psi));
         let weights = s.weights(stride_exp);
         let mirror = (s.rule == Rule::Chebyshev(ChebyshevPiece::TurningLeft))
             .then(|| &ChebyshevLevel::get(s.level - stride_exp).turning_left_mirror);
@@ -2252,9 +2275,7 @@ impl DriftEstimate {
         coarse: LevelDrift,
         rate: Convergence,
     ) -> Self {
-        let distance =
-            |a: LevelDrift, b: LevelDrift| (a.value[0] - b.value[0]).hypot(a.value[1] - b.value[1]);
-        let (d1, d2) = (distance(fine, mid), distance(mid, coarse));
+        let (d1, d2) = (fine.distance(&mid), mid.distance(&coarse));
         // (A NaN phase step is no resolved one.)
         let resolved = |l: LevelDrift| l.phase_step <= RESOLVED_PHASE_STEP;
         let rate = if resolved(coarse) {
@@ -3136,9 +3157,7 @@ fn precise_node_in<S: Shape>(
     // V = κ²/(2 sin²θ) + U, with w = κ / sinθ.
     let inv_sin = DoubleDouble::from_f64(1.0).div(sin);
     let w = inv_sin.mul_f64(v.kappa);
-    let wall = w.mul(w).mul_f64(0.5);
-    let value = wall.add(red.potential);
-    let value_error = red.potential_error + crate::dd::RELATIVE_ERROR * wall.hi;
+    let (value, value_error) = with_wall(red.potential, red.potential_error, w);
     let tilt = piece.tilt_rate * signed;
     let gap = sharp.level.add_f64(tilt).sub(value);
     let gap_error = end.excess_error + residual + sharp.error + value_error + EPS * tilt.abs();
@@ -3165,6 +3184,14 @@ fn precise_node_in<S: Shape>(
         rounding: gap_error / gap.hi + PRECISE_NODE_ROUNDING,
     };
     (sample.dt.is_finite() && sample.dpsi.is_finite() && sample.along.is_finite()).then_some(sample)
+}
+
+/// V = κ²/(2 sin²θ) + U in double-double from U (with the bound `error` on it) and
+/// w = κ / sin θ, with the bound on V's error.
+#[inline(always)]
+fn with_wall(u: DoubleDouble, error: f64, w: DoubleDouble) -> (DoubleDouble, f64) {
+    let wall = w.mul(w).mul_f64(0.5);
+    (wall.add(u), error + crate::dd::RELATIVE_ERROR * wall.hi)
 }
 
 /// The (sine, cosine) pair of `a` in double-double, scaled onto the unit circle.

@@ -6,8 +6,8 @@
 //! at small κ) it stops early and the tanh-sinh path of the parent module takes over.
 
 use super::{
-    at_level_floor, interleave, level_error, precise_sample, root_of_ratio, sample, weighted,
-    Component, Convergence, DriftEstimate, EffectivePotential, LevelDrift, NodeSample,
+    at_level_floor, interleave, largest_step, level_error, precise_sample, root_of_ratio, sample,
+    weighted, Component, Convergence, DriftEstimate, EffectivePotential, LevelDrift, NodeSample,
     PeriodIntegrals, Piece, EPS, HIDDEN_PEAK, INTEGRAND_ROUNDING, LEVEL_FLOOR,
     PRECISE_NODE_ROUNDING,
 };
@@ -126,14 +126,9 @@ fn integrate_on<S: Shape>(
         Map::Mercator { .. } => v.passage_rounding(component),
     };
     let residual = super::level_residual(component, std::slice::from_ref(piece));
-    // Where the resampled nodes may have their integrands in double-double too (the plain
-    // map, whose nodes' offsets and dθ/dφ are a table value times L: [`precise_sample`]).
-    let precise = matches!(map, Map::Plain { .. })
-        && piece
-            .left
-            .sharp
-            .as_ref()
-            .is_some_and(|s| v.body.reduction_double_double(s.sin, s.cos).is_some());
+    // Whether the resampled nodes have their integrands in double-double too: decided where
+    // the nodes are taken again.
+    let mut precise = false;
     let Some(mut samples) = Samples::new(v, &plain, map, energy, first_intervals(tol), false)
     else {
         // (A node of the first level outside the allowed set: at most that level spent.)
@@ -207,7 +202,15 @@ fn integrate_on<S: Shape>(
             || psi_error + extra_psi > tol * TAU
             || drift.is_some_and(|d| d.error > tol * d.scale);
         if (!done || over) && !resampled && piece.left.sharp.is_some() {
-            let per_node = if precise {
+            // (The plain map's nodes, whose offsets and dθ/dφ are a table value times L, on
+            // a shape that gives the reduction in double-double: [`precise_sample`].)
+            let can_be_precise = matches!(map, Map::Plain { .. })
+                && piece
+                    .left
+                    .sharp
+                    .as_ref()
+                    .is_some_and(|s| v.body.reduction_double_double(s.sin, s.cos).is_some());
+            let per_node = if can_be_precise {
                 PRECISE_NODE_ROUNDING + EPS
             } else {
                 INTEGRAND_ROUNDING + 4.0 * EPS
@@ -250,6 +253,7 @@ fn integrate_on<S: Shape>(
             // estimate alone took the work to 1.53 times that at 1e-13.)
             if converged && (within || (improves && drift_freed)) {
                 resampled = true;
+                precise = can_be_precise;
                 let intervals = samples.intervals;
                 match Samples::new(v, piece, map, energy, intervals, precise) {
                     Some(resampled) => samples = resampled,
@@ -351,11 +355,12 @@ impl Samples {
         let n = intervals;
         let mut nodes = Vec::with_capacity(2 * LAST_INTERVALS + 1);
         nodes.push(end_sample(v, piece, map, true)?);
+        let in_double = piece.in_double();
         for j in 1..n {
             let node = map.node(n, j);
             nodes.push(
                 if precise {
-                    precise_sample(v, piece, &piece.in_double(), energy, node)
+                    precise_sample(v, piece, &in_double, energy, node)
                 } else {
                     sample(v, piece, energy, node)
                 }
@@ -784,9 +789,7 @@ fn fourier_drift_in(
     // ν: the mean of ψ̇ dt/dφ over the circle, on this level.
     let nu = antiderivative(nodes, stride, psi, spectrum);
     // (ψ̃ is odd about both ends: its steps on the way out are all of them.)
-    let phase_step = psi[..=n]
-        .windows(2)
-        .fold(0.0, |worst: f64, w| worst.max((w[1] - w[0]).abs()));
+    let phase_step = largest_step(&psi[..=n]);
     // y_j = Re P_j + Im P_j: its real transform Y_k gives m P̂_{±k} = Re Y_k ∓ Im Y_k (the
     // even part Re P transforms to a real, the odd part Im P to an imaginary sequence).
     let mut scale = 0.0;
