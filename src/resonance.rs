@@ -1030,30 +1030,24 @@ pub fn fold_until<S: Shape>(
             well: top.well,
         })
     };
-    // Golden section for the largest κ(ε) between the top's neighbours on the curve (or one
-    // step either side of an end).
-    let neighbours: Vec<f64> = [index.checked_sub(1), Some(index + 1)]
-        .into_iter()
-        .flatten()
-        .filter_map(|i| curve.points.get(i).map(|p| p.energy))
-        .chain(at_end.then(|| {
-            let n = curve.points[if index == 0 {
-                1.min(curve.points.len() - 1)
-            } else {
-                index - 1
-            }];
-            2.0 * top.energy - n.energy
-        }))
-        .collect();
-    let (mut a, mut b) = neighbours
-        .iter()
-        .fold((top.energy, top.energy), |(lo, hi), &e| {
-            (lo.min(e), hi.max(e))
-        });
-    if a == b {
-        return Ok(None);
-    }
-    let bracket = (a, b);
+    // Golden section for the largest κ(ε) between the top's neighbours on the curve (or, at
+    // an end, one step beyond it: where the search runs to that side's edge with κ still
+    // above the end's, the step beyond is doubled, up to 16 steps. One step was short of a
+    // fold 0.4 steps beyond an end that the continuation reached a little earlier once the
+    // cells by a separatrix were sharper: 1.4291487 called a corner for 1.4291530).
+    let neighbour_energy = |i: Option<usize>| i.and_then(|i| curve.points.get(i)).map(|p| p.energy);
+    let inside = [
+        neighbour_energy(index.checked_sub(1)),
+        neighbour_energy(Some(index + 1)),
+    ];
+    let step_beyond = at_end.then(|| {
+        let n = curve.points[if index == 0 {
+            1.min(curve.points.len() - 1)
+        } else {
+            index - 1
+        }];
+        top.energy - n.energy
+    });
     let ratio = 0.5 * (5f64.sqrt() - 1.0);
     let mut start = top.kappa;
     let value = |e: f64, start: &mut f64| -> f64 {
@@ -1065,27 +1059,52 @@ pub fn fold_until<S: Shape>(
             None => f64::NEG_INFINITY,
         }
     };
-    let (mut c, mut d) = (b - ratio * (b - a), a + ratio * (b - a));
-    let (mut fc, mut fd) = (value(c, &mut start), value(d, &mut start));
-    while (b - a).abs() > 1e-9 * (1.0 + top.energy.abs()) {
-        if stop() {
-            return Err(AtlasError::Stopped);
+    let mut reach = 1.0;
+    let (bracket, energy, fc, fd) = loop {
+        let (a, b) = inside
+            .iter()
+            .flatten()
+            .copied()
+            .chain(step_beyond.map(|step| top.energy + reach * step))
+            .fold((top.energy, top.energy), |(lo, hi), e| {
+                (lo.min(e), hi.max(e))
+            });
+        if a == b {
+            return Ok(None);
         }
-        if fc > fd {
-            b = d;
-            d = c;
-            fd = fc;
-            c = b - ratio * (b - a);
-            fc = value(c, &mut start);
-        } else {
-            a = c;
-            c = d;
-            fc = fd;
-            d = a + ratio * (b - a);
-            fd = value(d, &mut start);
+        let (mut a, mut b) = (a, b);
+        let bracket = (a, b);
+        let (mut c, mut d) = (b - ratio * (b - a), a + ratio * (b - a));
+        let (mut fc, mut fd) = (value(c, &mut start), value(d, &mut start));
+        while (b - a).abs() > 1e-9 * (1.0 + top.energy.abs()) {
+            if stop() {
+                return Err(AtlasError::Stopped);
+            }
+            if fc > fd {
+                b = d;
+                d = c;
+                fd = fc;
+                c = b - ratio * (b - a);
+                fc = value(c, &mut start);
+            } else {
+                a = c;
+                c = d;
+                fc = fd;
+                d = a + ratio * (b - a);
+                fd = value(d, &mut start);
+            }
         }
-    }
-    let energy = 0.5 * (a + b);
+        let energy = 0.5 * (a + b);
+        let beyond_edge = step_beyond.is_some_and(|step| {
+            let edge = top.energy + reach * step;
+            (energy - edge).abs() <= 1e-3 * (bracket.1 - bracket.0)
+        });
+        if beyond_edge && reach < 16.0 && fc.max(fd) >= top.kappa {
+            reach *= 2.0;
+            continue;
+        }
+        break (bracket, energy, fc, fd);
+    };
     let Some((kappa, point)) = kappa_at(energy, start) else {
         return Ok(if at_end { end_corner() } else { None });
     };

@@ -239,8 +239,9 @@ pub struct EffectivePotential<'a, S: Shape> {
     /// κ.
     pub kappa: f64,
     critical: Vec<CriticalPoint>,
-    /// The dips of B = 1/η + U² + U′² ([`EffectivePotential::dip_width`]): (θ, width) at
-    /// each zero of U′ in (0, π) where B has a minimum.
+    /// The narrow dips of the integrands' factors, (θ, width): of B = 1/η + U² + U′² at each
+    /// zero of U′ in (0, π) where B has a minimum ([`EffectivePotential::dip_width`]), and of
+    /// J² near θ = π/2 where ν + η U² is small ([`EffectivePotential::equator_dip`]).
     dips: Vec<(f64, f64)>,
     /// The angles in (0, π) where the integrals are split ([`Self::splits_inside`]), found
     /// once.
@@ -271,6 +272,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             .slope_zeros()
             .into_iter()
             .map(|zero| (zero, v.dip_width(zero)))
+            .chain(v.equator_dip())
             .filter(|(_, width)| width.is_finite())
             .collect();
         v.split_angles = v.find_split_angles();
@@ -292,6 +294,32 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         } else {
             f64::INFINITY
         }
+    }
+
+    /// The dip of η J² = cos²θ + ν sin²θ + η U² about θ = π/2 (for ν < 1 its first two terms
+    /// fall to ν there), as (θ_J, width): with x = θ − π/2, η J² ≈ a + b x + c x², whose
+    /// complex zeros, where 1/J is singular, lie `width` = √(m/c) off the real axis at
+    /// θ_J = π/2 − b/(2c), m = a − b²/(4c) the least value. None where the quadratic has no
+    /// minimum or it lies outside (0, π). At ν = 0.018, η = 0.0034 (width 0.15) the Mercator
+    /// map's middle steps (0.66 in θ on 64 steps of a libration from pole to pole at
+    /// κ = −6e-5, ε = 221) stepped over it, and N was 1.28 times its estimate off at tol
+    /// 1e-10 (an adversary pass).
+    fn equator_dip(&self) -> Option<(f64, f64)> {
+        let body = self.body;
+        let a = Angle::new(FRAC_PI_2);
+        let u = body.shape.potential_at(a);
+        let u1 = body.shape.potential_prime_at(a);
+        let u2 = body.shape.potential_second_at(a);
+        let eta = body.eta;
+        let constant = body.nu + eta * u * u;
+        let linear = 2.0 * eta * u * u1;
+        let quadratic = 1.0 - body.nu + eta * (u1 * u1 + u * u2);
+        if quadratic <= 0.0 {
+            return None;
+        }
+        let least = constant - linear * linear / (4.0 * quadratic);
+        let at = FRAC_PI_2 - linear / (2.0 * quadratic);
+        (least > 0.0 && at > 0.0 && at < PI).then(|| (at, (least / quadratic).sqrt()))
     }
 
     /// The dips of B as the θ-interval [`lower`, `upper`] sees them: for each (on the κ = 0
@@ -398,11 +426,19 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
     /// sin(θ_b − θ_a) times the divided difference of V (its plain difference beyond 1.98
     /// apart, where the divided difference would lose to cos(θ_b − θ_a) → −1).
     pub(crate) fn rise(&self, a: Angle, b: Angle, length: f64) -> f64 {
+        self.rise_with_error(a, b, length).0
+    }
+
+    /// [`Self::rise`] and a bound on its rounding: four ulps of the terms.
+    fn rise_with_error(&self, a: Angle, b: Angle, length: f64) -> (f64, f64) {
         let (sl, cl) = length.sin_cos();
         if cl > -0.4 {
-            sl * divided_difference(self, b, a, sl, cl).0
+            let (d, scale) = divided_difference(self, b, a, sl, cl);
+            let rise = sl * d;
+            (rise, 4.0 * EPS * (rise.abs() + sl.abs() * scale))
         } else {
-            self.value(b) - self.value(a)
+            let scales = self.value_scale(a) + self.value_scale(b);
+            (self.value(b) - self.value(a), 4.0 * EPS * scales)
         }
     }
 
@@ -1616,50 +1652,62 @@ fn lifted_inside(angles: &[f64], lower: f64, upper: f64) -> Vec<Site> {
 }
 
 impl<S: Shape> EffectivePotential<'_, S> {
-    /// A kink `plain` inside a libration as a piece end, its gap measured from the nearer
-    /// turning point: ε − V(k) taken as V(b) − V(k) = −sin(k − b) D(k, b) (D the divided
-    /// difference of V, free of cancellation on the part both lie on) rather than ε − V(k),
-    /// whose rounding, a few ulps of V, is not small against ε − V(k) when the kink lies
-    /// near the turning point: the two pieces' gaps there would carry a relative error
-    /// ulps(V)/(ε − V(k)), and T an error growing like its inverse square root (measured:
-    /// 3e-9 in N at 1e-13 from the kink on a truncated ball, and a wrong N within an ulp).
-    /// The turning point's level is the one its pieces are measured against already. None
-    /// where the kink is too close to the turning point to tell on which side it lies (the
-    /// computed gap not above twice its rounding): it is not cut there, and the piece's
-    /// integrand differs from an analytic one only that close to its end.
-    fn kink_end_from_turning_point(
+    /// An interior end `plain` of a libration (a critical point below ε, a kink, a needle's
+    /// π/2) on the level its turning points are measured against. A turning point's gaps
+    /// vanish at the double e itself, so its level is V(e), ε only to the rounding of the
+    /// root; the libration's level runs linearly from V(e_min) to V(e_max), and an interior
+    /// end k gets the excess level(k) − V(k) = V(b) − V(k) + w (V(b′) − V(b)), b the nearer
+    /// turning point, b′ the other, w = |k − b| / L, with V(b) − V(k) = −sin(k − b) D(k, b)
+    /// (D the divided difference of V, free of cancellation on the part both lie on) and
+    /// `rise` = V(e_max) − V(e_min). Against ε − V(k) in double this is sharper (its rounding,
+    /// a few ulps of V, is not small against ε − V(k) when k lies near a turning point: 3e-9
+    /// in N at 1e-13 from a kink on a truncated ball) and it keeps the level one straight
+    /// line: at ε at an interior end and V(e) at the turning points, the level bent by each
+    /// turning point's offset s = ε − V(e) over half the libration, which moves T by about
+    /// s/(ε − V_min) of itself whatever s's spread (a needle's small libration cut at its
+    /// minimum, β = 0.0013, 4.5e-6 deep: T 1.15e-12 off, 1.9 times its estimate, at tol
+    /// 1e-11; an adversary pass), where [`crate::cell`] bounds a straight level's offsets.
+    /// `None` where the computed excess is not above twice its rounding (a kink too close to
+    /// a turning point to tell on which side it lies, or a maximum just below ε): a kink is
+    /// then not cut (the piece's integrand differs from an analytic one only that close to
+    /// its end), and a critical point is kept at the level ε.
+    fn on_turning_level(
         &self,
         plain: PieceEnd,
         lower: &PieceEnd,
         upper: &PieceEnd,
+        length: f64,
+        rise: (f64, f64),
     ) -> Option<PieceEnd> {
+        let (rise, rise_error) = rise;
         let from_lower = self.separation(&lower.site, &plain.site);
         let from_upper = self.separation(&plain.site, &upper.site);
-        // The signed step k − b from the nearer turning point b.
-        let (turning, step) = if from_lower <= from_upper {
-            (lower, from_lower)
+        // The signed step k − b from the nearer turning point b, and V(b′) − V(b).
+        let (turning, step, other) = if from_lower <= from_upper {
+            (lower, from_lower, rise)
         } else {
-            (upper, -from_upper)
+            (upper, -from_upper, -rise)
         };
+        let share = step.abs() / length;
         let (sin_step, cos_step) = libm::sincos(step);
-        if cos_step <= -0.4 {
-            return Some(plain);
-        }
-        let (d, scale) = divided_difference(self, plain.angle, turning.angle, sin_step, cos_step);
-        let excess = -sin_step * d;
-        let error = 4.0 * EPS * (excess.abs() + sin_step.abs() * scale);
-        if excess <= 2.0 * error {
-            return None;
-        }
-        Some(if error < plain.excess_error {
-            PieceEnd {
-                excess,
-                level: turning.level,
-                excess_error: error,
-                ..plain
-            }
+        let (drop, drop_error) = if cos_step > -0.4 {
+            let (d, scale) =
+                divided_difference(self, plain.angle, turning.angle, sin_step, cos_step);
+            let drop = -sin_step * d;
+            (drop, 4.0 * EPS * (drop.abs() + sin_step.abs() * scale))
         } else {
-            plain
+            let drop = self.value(turning.angle) - self.value(plain.angle);
+            let scales = self.value_scale(turning.angle) + self.value_scale(plain.angle);
+            (drop, 4.0 * EPS * scales)
+        };
+        let tilt = share * other;
+        let excess = drop + tilt;
+        let error = drop_error + 4.0 * EPS * (excess.abs() + tilt.abs()) + share * rise_error;
+        (excess > 2.0 * error).then_some(PieceEnd {
+            excess,
+            level: turning.level + tilt,
+            excess_error: error,
+            ..plain
         })
     }
 
@@ -1812,8 +1860,8 @@ impl<S: Shape> EffectivePotential<'_, S> {
     }
 
     /// The pieces of a component: cut at the ends and, if `cut`, at every interior maximum or
-    /// tangency and at every kink of U (kinks within a libration measured from its turning
-    /// points, [`EffectivePotential::kink_end_from_turning_point`]).
+    /// tangency and at every kink of U (a libration's interior ends on the straight level of
+    /// its turning points, [`EffectivePotential::on_turning_level`]).
     fn pieces(&self, energy: f64, component: &Component, cut: bool) -> Vec<Piece> {
         let end = |site: Site, turning: bool| {
             let angle = site.angle();
@@ -1834,7 +1882,16 @@ impl<S: Shape> EffectivePotential<'_, S> {
             }
         };
         let turning = component.kind == MotionKind::Libration;
-        let mut ends = vec![end(component.lower, turning)];
+        let lower = end(component.lower, turning);
+        let upper = end(component.upper, turning);
+        // A libration's interior ends on the straight level of its turning points.
+        let span = self.separation(&lower.site, &upper.site);
+        let rise = turning.then(|| self.rise_with_error(lower.angle, upper.angle, span));
+        let on_level = |site: Site| match rise {
+            Some(rise) => self.on_turning_level(end(site, false), &lower, &upper, span, rise),
+            None => Some(end(site, false)),
+        };
+        let mut ends = vec![lower];
         // Maxima and tangencies are near-singular points. Minima are harmless inside a piece
         // unless U is sharply curved (an angular feature scale below 0.1, e.g. a prolate
         // ellipsoid with β < 0.1 round θ = π/2), where the feature sits at the minimum and
@@ -1845,24 +1902,15 @@ impl<S: Shape> EffectivePotential<'_, S> {
                 .interior
                 .iter()
                 .filter(|p| cut && (p.kind != CriticalKind::Minimum || sharp))
-                .map(|p| end(p.site, false)),
+                .map(|p| on_level(p.site).unwrap_or_else(|| end(p.site, false))),
         );
-        let upper = end(component.upper, turning);
         if cut {
             // U″ jumps at a kink: each piece must be analytic for the rule's fast convergence;
             // and a narrow peak of 1/J is put at a piece's end, where the rule's nodes crowd.
-            let lower = ends[0];
             ends.extend(
                 self.splits_inside(component.lower.theta, component.upper.theta)
                     .into_iter()
-                    .filter_map(|site| {
-                        let plain = end(site, false);
-                        if turning {
-                            self.kink_end_from_turning_point(plain, &lower, &upper)
-                        } else {
-                            Some(plain)
-                        }
-                    }),
+                    .filter_map(on_level),
             );
             // And at a needle's π/2, where Z turns within β (a tenth of that scale clear of
             // the ends and of every critical point, which are cut already): a libration
@@ -1885,7 +1933,7 @@ impl<S: Shape> EffectivePotential<'_, S> {
                         .chain(self.critical.iter().map(|p| &p.site.theta))
                         .all(|&t| (t - site.theta).abs() > clear)
                 })
-                .map(|site| end(site, false)),
+                .map(|site| on_level(site).unwrap_or_else(|| end(site, false))),
             );
             ends[1..].sort_by(|a, b| a.site.theta.total_cmp(&b.site.theta));
             ends.dedup_by(|a, b| a.site.theta == b.site.theta);

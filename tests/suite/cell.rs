@@ -881,6 +881,74 @@ fn a_needles_turn_inside_a_libration_is_not_stepped_over() {
     }
 }
 
+/// Issue 22, adversary pass of 2026-11-28: a needle's small libration (β = 0.0013, 4.5e-6
+/// above the bottom of its well, just beyond π/2) is cut at its minimum; that end's level was
+/// ε while the turning points' were V(e), the level bent by the roots' rounding, and T was
+/// 1.15e-12 off, 1.9 times its estimate, at tol 1e-11 (and at every tolerance down to it).
+/// The interior ends now lie on the turning points' straight level. T against 50 digits
+/// (scripts/reference.py).
+#[test]
+fn a_libration_cut_at_its_minimum_keeps_one_straight_level() {
+    let b = EllipsoidBody::ellipsoid(
+        0.23808983591969213,
+        0.001260548598979636,
+        0.0030168224119851866,
+        0.0026233276668222614,
+    )
+    .unwrap();
+    for tol in [1e-8, 1e-10, 1e-11, 1e-12] {
+        let c = solve(
+            &b,
+            4.2213101910791835e-08,
+            0.0012287842277211624,
+            Method::Quadrature,
+            tol,
+        );
+        let t = &c.components[0];
+        assert_eq!(t.status, Status::Ok, "tol {tol:e}");
+        assert!(
+            (t.period - 4.556586053943789).abs() <= t.errors.period,
+            "tol {tol:e}: {} ± {:e}",
+            t.period,
+            t.errors.period
+        );
+    }
+}
+
+/// Issue 22, adversary pass of 2026-11-28: at ν = 0.018, η = 0.0034 the factor
+/// η J² = cos²θ + ν sin²θ + η U² dips to 0.021 at π/2, 1/J singular 0.15 off the real
+/// axis; a libration from pole to pole (κ = −6e-5, ε = 221) in the Mercator map had steps
+/// of 0.66 in θ there on 64 intervals, and its sums stepped over the dip: N 1.28 times its
+/// estimate off at tol 1e-8 and 1e-10. The dip now counts among the narrow features the
+/// rules must resolve. N against 50 digits (scripts/reference.py).
+#[test]
+fn the_dip_of_j_at_the_equator_is_not_stepped_over() {
+    let b = EllipsoidBody::ellipsoid(
+        0.6081726040839008,
+        1.0009372668303411,
+        0.017925348041110536,
+        0.0033594709643241733,
+    )
+    .unwrap();
+    for tol in [1e-8, 1e-10, 1e-12] {
+        let c = solve(
+            &b,
+            -6.084476120418878e-05,
+            220.8151808401805,
+            Method::Quadrature,
+            tol,
+        );
+        let t = &c.components[0];
+        assert_eq!(t.status, Status::Ok, "tol {tol:e}");
+        let n = t.rotation_number;
+        assert!(
+            (n - 1.1269925448549571e-08).abs() <= t.errors.rotation_number,
+            "tol {tol:e}: N = {n:e} ± {:e}",
+            t.errors.rotation_number
+        );
+    }
+}
+
 /// Issue 23: at tol 1e-14 the drift's phases, 16 ulps of ψ̇ per node over ∫ |ψ̇| dt ≈ 5, kept
 /// all but 1 % of the standard slice's components from `ok` (none of the 26 librations below).
 /// Once the sums have converged the cosine rule takes its nodes again with the integrands in
