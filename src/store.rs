@@ -213,11 +213,46 @@ impl OutputLock {
     }
 }
 
+impl OutputLock {
+    /// Whether the lock file's path still names the file this claim locked. A lock file
+    /// removed while its run was writing (by hand, or by a clean-up script after a
+    /// preemption) lets a second process claim the output afresh, remove the partial file and
+    /// journal, and write its own: the first run, renaming `<out>.partial.h5` by name, would
+    /// publish the other's half-written file as its own, with a success summary (adversary
+    /// pass of 2026-11-28). Checked before a finished file is put in place.
+    pub fn is_held(&self) -> bool {
+        use std::os::unix::fs::MetadataExt;
+        match (self.file.metadata(), std::fs::symlink_metadata(&self.path)) {
+            (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+            _ => false,
+        }
+    }
+
+    /// [`Self::is_held`], or the error that says the output was not put in place.
+    pub fn check_held(&self, out: &Path) -> Result<()> {
+        if self.is_held() {
+            return Ok(());
+        }
+        Err(AtlasError::Busy {
+            path: out.display().to_string(),
+            reason: format!(
+                "its lock file {} was removed while this process wrote it, so another process \
+                 may have claimed the output and written its partial file since; the output is \
+                 not replaced: run again when no other process writes it",
+                self.path.display()
+            ),
+        })
+    }
+}
+
 impl Drop for OutputLock {
     fn drop(&mut self) {
         // Unlinked while still held: a process that opened the old file finds it unlinked
-        // (above) and tries again with a fresh one.
-        let _ = std::fs::remove_file(&self.path);
+        // (above) and tries again with a fresh one. (Not another's: where this claim's file
+        // was removed, the path may name a second process's lock by now.)
+        if self.is_held() {
+            let _ = std::fs::remove_file(&self.path);
+        }
         let _ = self.file.unlock();
     }
 }

@@ -290,7 +290,7 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
         .shard
         .check_against(scene.shape(), scene.second_name())?;
     // Held until the file is in place and the journal gone.
-    let _claim = crate::store::OutputLock::acquire(out)?;
+    let claim = crate::store::OutputLock::acquire(out)?;
     // A current output (made from this scene by this build for this shard): --update
     // keeps it without a census.
     if out.exists() && request.update && request.output_current {
@@ -538,7 +538,9 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
         file.close()
     })();
     if let Err(e) = written {
-        let _ = std::fs::remove_file(&tmp);
+        if claim.is_held() {
+            let _ = std::fs::remove_file(&tmp);
+        }
         if let AtlasError::Interrupted { path, total, .. } = e {
             // What a resumed run will find: the units the journal holds now.
             let done = kept_cells(&journal.listed_units().unwrap_or_default());
@@ -546,6 +548,8 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
         }
         return Err(e);
     }
+    // (Not where the claim was lost: the partial file and the journal may be another's now.)
+    claim.check_held(out)?;
     std::fs::rename(&tmp, out).map_err(|e| AtlasError::atlas(out, e))?;
     journal.remove()?;
     summary.seconds = started.elapsed().as_secs_f64();
@@ -561,8 +565,20 @@ pub fn merge(
     force: bool,
     extra_attributes: &[(String, AttrValue)],
 ) -> Result<Summary> {
+    merge_until(shards, out, force, extra_attributes, &|| false)
+}
+
+/// [`merge`], given up when `stop` says so (asked before each unit is copied): then
+/// [`AtlasError::Stopped`], with the partial file removed and the output as it was.
+pub fn merge_until(
+    shards: &[PathBuf],
+    out: &Path,
+    force: bool,
+    extra_attributes: &[(String, AttrValue)],
+    stop: &dyn Fn() -> bool,
+) -> Result<Summary> {
     let started = Instant::now();
-    let _claim = crate::store::OutputLock::acquire(out)?;
+    let claim = crate::store::OutputLock::acquire(out)?;
     if out.exists() && !force {
         return Err(AtlasError::atlas(
             out,
@@ -622,13 +638,35 @@ pub fn merge(
             ));
         }
         let file = AtlasFile::open(path, &scene, &shard.region(shape), &variables, &axis)?;
+        // The checks `--update` and `open_atlas(check=True)` make of the text and the
+        // constants: a shard whose scene text or program version was edited merged into a
+        // file with a fresh checksum, its damage laundered (adversary pass of 2026-11-28).
+        if !file.texts_intact() {
+            return Err(AtlasError::atlas(
+                path,
+                "is damaged: its text attributes (scene, program version, …) do not have the \
+                 CRC-32 it was written with; run that shard again",
+            ));
+        }
         if file.text_attribute("scene_fingerprint").as_deref() != Some(fingerprint.as_str()) {
             return Err(AtlasError::atlas(
                 path,
-                format!(
-                    "is not a shard of the same scene as {} (or was made by another version)",
-                    first.display()
-                ),
+                if path == first {
+                    "was made by another build of rubber-atlas (its scene fingerprint is not \
+                     this build's): merge with the build that made the shards, or run them again"
+                        .to_string()
+                } else {
+                    format!(
+                        "is not a shard of the same scene as {} (or was made by another build)",
+                        first.display()
+                    )
+                },
+            ));
+        }
+        if !file.constants_match(&scene) {
+            return Err(AtlasError::atlas(
+                path,
+                "its nu or eta is not its scene's (the file was edited?); run that shard again",
             ));
         }
         if !file.coordinates_match(&scene) {
@@ -722,6 +760,9 @@ pub fn merge(
                 count: n,
             };
             for u in shard.units(shape) {
+                if stop() {
+                    return Err(AtlasError::Stopped);
+                }
                 let block = source.read_unit(&u)?;
                 summary.count(&variables, &block);
                 let encoded = encode_unit(&variables, &block, chunk_cells);
@@ -734,6 +775,7 @@ pub fn merge(
         let _ = std::fs::remove_file(&tmp);
         return Err(e);
     }
+    claim.check_held(out)?;
     std::fs::rename(&tmp, out).map_err(|e| AtlasError::atlas(out, e))?;
     summary.seconds = started.elapsed().as_secs_f64();
     Ok(summary)

@@ -26,11 +26,12 @@ pub struct MergeArgs {
 pub(super) fn merge(args: MergeArgs) -> Result<()> {
     let inputs: Vec<&std::path::Path> = args.shards.iter().map(|p| p.as_path()).collect();
     check_output(&args.out, args.force, &inputs, &ATLAS_EXTENSIONS)?;
-    let summary = sweep::merge(
+    let summary = sweep::merge_until(
         &args.shards,
         &args.out,
         args.force,
         &invocation_attributes(),
+        &crate::stop::requested,
     )?;
     if !args.quiet {
         println!(

@@ -376,10 +376,15 @@ fn body_text(body: &AnyBody) -> String {
 /// Runs one parsed command line.
 pub fn run(cli: Cli) -> Result<()> {
     // The long commands stop at their next check on SIGINT, SIGTERM or SIGHUP, writing
-    // nothing (`run` installs its own handlers, which keep its journal).
+    // nothing (`run` installs its own handlers, which keep its journal). (`merge` too: it
+    // was killed by them, leaving its partial file and lock; adversary pass of 2026-11-28.)
     if matches!(
         cli.command,
-        Command::Diagram(_) | Command::Trajectory(_) | Command::Resonance(_) | Command::Verdict(_)
+        Command::Diagram(_)
+            | Command::Trajectory(_)
+            | Command::Resonance(_)
+            | Command::Verdict(_)
+            | Command::Merge(_)
     ) {
         crate::stop::install("nothing was written")
             .context("cannot install the SIGINT and SIGTERM handlers")?;

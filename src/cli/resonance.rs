@@ -132,6 +132,17 @@ pub(super) fn resonance(args: ResonanceArgs) -> Result<()> {
     ] {
         header[key] = value;
     }
+    // On a body that is its own mirror image in its equatorial plane, N = 0 on every torus
+    // that spans both halves: a region of the plane, not a curve (its tori run away). Said
+    // so, rather than "no component reaches N = 0" (adversary pass of 2026-11-28).
+    let zero_region = target == 0.0
+        && rubber_atlas::with_body!(&body, b => rubber_atlas::Shape::symmetric_about_equator(&b.shape));
+    const ZERO_REGION: &str = "this body is symmetric about its equator: N = 0 on every torus \
+        that spans both halves (a region of the plane, not a curve), and those paths run away; \
+        the curves below are where N = 0 on the other tori";
+    if zero_region {
+        header["note"] = serde_json::json!(ZERO_REGION);
+    }
     if args.fold {
         let fold = rubber_atlas::with_body!(&body, b => resonance::fold_until(
             b,
@@ -201,7 +212,10 @@ pub(super) fn resonance(args: ResonanceArgs) -> Result<()> {
         digits(options.energy.0, 6),
         show(options.energy.1)
     );
-    if curves.is_empty() {
+    if zero_region {
+        println!("  ({ZERO_REGION})");
+    }
+    if curves.is_empty() && !zero_region {
         println!(
             "  (no component reaches N = {shown} on the seed grid of this window: the curve may \
              lie beyond the window (widen it with --kappa-max and --energy-max), or between the \

@@ -152,6 +152,18 @@ fn output_current(args: &RunArgs, out: &std::path::Path) -> Result<bool> {
     })
 }
 
+/// The bytes of the regular files directly in the journal `dir` (0 where there is none).
+fn journal_bytes(dir: &std::path::Path) -> f64 {
+    std::fs::read_dir(dir).map_or(0.0, |entries| {
+        entries
+            .flatten()
+            .filter_map(|e| e.metadata().ok())
+            .filter(|m| m.is_file())
+            .map(|m| m.len() as f64)
+            .sum()
+    })
+}
+
 pub(super) fn run_scene(args: RunArgs) -> Result<()> {
     let scene = Scene::from_file(&args.scene)?;
     let shard = match &args.shard {
@@ -237,21 +249,34 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
         Some(n) => n.min(std::thread::available_parallelism().map_or(1, |c| c.get())),
         None => std::thread::available_parallelism().map_or(1, |n| n.get()),
     };
+    // A current output (--update) is kept without a census: nothing to allocate or write, so
+    // no size check (a finished shard resubmitted on a nearly full disk was refused:
+    // adversary pass of 2026-11-28).
+    let current = args.update && out.exists() && output_current(&args, &out)?;
     // Before anything is allocated: a grid the machine cannot hold is refused in one line.
     let need = sweep::footprint(&scene, shard, threads);
-    args.limits.check(
-        need.memory_bytes,
-        Some(need.disk_bytes),
-        Some(&out),
-        // (The shard count is searched only for a refusal.)
-        &|| {
-            format!(
-                "the run has {:.3e} cells: {}use fewer kappa or energy points",
-                need.cells,
-                shards_to_fit(&scene, &out, threads)
-            )
-        },
-    )?;
+    // What a resumed run's journal holds is on the disk already: after a full disk, the room
+    // freed need only hold the rest (`--resume` was refused with enough freed for it).
+    let journaled = if args.resume {
+        journal_bytes(&rubber_atlas::store::journal::Journal::dir_for(&out))
+    } else {
+        0.0
+    };
+    if !current {
+        args.limits.check(
+            need.memory_bytes,
+            Some((need.disk_bytes - journaled).max(0.0)),
+            Some(&out),
+            // (The shard count is searched only for a refusal.)
+            &|| {
+                format!(
+                    "the run has {:.3e} cells: {}use fewer kappa or energy points",
+                    need.cells,
+                    shards_to_fit(&scene, &out, threads)
+                )
+            },
+        )?;
+    }
     // The global pool, so that the run's serial parts (file creation, writing) stay on the
     // main thread: on a pool thread glibc grows that thread's heap a page at a time, and
     // creating the HDF5 file took 7 ms of mprotect calls instead of 1.
@@ -264,7 +289,7 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
         resume: args.resume,
         force: args.force,
         update: args.update,
-        output_current: args.update && out.exists() && output_current(&args, &out)?,
+        output_current: current,
         shard,
         attributes: invocation_attributes(),
     };

@@ -397,24 +397,34 @@ impl AtlasFile {
     /// written with (`text_attributes_crc32`). Reading a damaged file can crash HDF5: ask
     /// this in a child process ([`crate::sweep::output_is_current`]).
     pub fn is_intact(&self, scene: &Scene) -> bool {
+        self.is_whole()
+            && self.coordinates_match(scene)
+            && self.constants_match(scene)
+            && self.scales_attached(scene)
+            && self.texts_intact()
+            && super::h5::objects(&self.file).is_ok_and(|objects| {
+                objects
+                    .iter()
+                    .all(|(_, location)| super::h5::attributes_read(location))
+            })
+    }
+
+    /// Whether the scalar variables ν and η are the scene's, bit for bit.
+    pub fn constants_match(&self, scene: &Scene) -> bool {
         let scalar = |name: &str, want: f64| {
             self.file
                 .dataset(name)
                 .and_then(|d| d.read_scalar::<f64>())
                 .is_ok_and(|got| got.to_bits() == want.to_bits())
         };
-        self.is_whole()
-            && self.coordinates_match(scene)
-            && scalar("nu", scene.nu)
-            && scalar("eta", scene.eta)
-            && self.scales_attached(scene)
-            && super::h5::text_attributes_crc32(&self.file)
-                .is_ok_and(|crc| self.integer_attribute(TEXT_CRC) == Some(i64::from(crc)))
-            && super::h5::objects(&self.file).is_ok_and(|objects| {
-                objects
-                    .iter()
-                    .all(|(_, location)| super::h5::attributes_read(location))
-            })
+        scalar("nu", scene.nu) && scalar("eta", scene.eta)
+    }
+
+    /// Whether the text attributes' letters (kept in HDF5's global heap without a checksum)
+    /// have the CRC-32 the file was written with (`text_attributes_crc32`).
+    pub fn texts_intact(&self) -> bool {
+        super::h5::text_attributes_crc32(&self.file)
+            .is_ok_and(|crc| self.integer_attribute(TEXT_CRC) == Some(i64::from(crc)))
     }
 
     /// The grid's coordinates of this file's region of `scene`, by name, in the order of the

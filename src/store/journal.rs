@@ -67,8 +67,9 @@ impl Journal {
         if found != fingerprint {
             return Err(AtlasError::Atlas {
                 path: dir.display().to_string(),
-                reason: "the interrupted run was of another scene (or program version); \
-                         use --force to start over"
+                reason: "the interrupted run was of another scene, program version, shard \
+                         (--shard) or component layout; resume it with the same scene, build \
+                         and --shard, or use --force to start over"
                     .into(),
             });
         }

@@ -1949,3 +1949,42 @@ fn a_file_size_limit_is_one_line_and_no_file() {
         assert!(left.is_empty(), "{name}: {left:?}");
     }
 }
+
+/// Adversary pass of 2026-11-28: `resonance` for N = 0 on a body symmetric about its equator
+/// said "no component reaches N = 0" (and advised a finer grid), where N = 0 on every torus
+/// that spans both halves. It says that N = 0 is a region there, in text and JSON.
+#[test]
+fn resonance_of_zero_on_a_symmetric_body_names_the_region() {
+    let args = [
+        "resonance",
+        "--shape",
+        "disk",
+        "--alpha",
+        "0",
+        "--nu",
+        "2",
+        "--eta",
+        "4",
+        "--rotation-number",
+        "0/1",
+        "--kappa-max",
+        "1.5",
+        "--energy-max",
+        "3",
+        "--grid",
+        "16",
+    ];
+    let text = run(&args);
+    assert!(text.status.success());
+    let stdout = String::from_utf8_lossy(&text.stdout);
+    assert!(
+        stdout.contains("symmetric about its equator") && !stdout.contains("no component reaches"),
+        "{stdout}"
+    );
+    let mut with_json = args.to_vec();
+    with_json.push("--json");
+    let json: serde_json::Value = serde_json::from_slice(&run(&with_json).stdout).unwrap();
+    assert!(json["note"]
+        .as_str()
+        .is_some_and(|n| n.contains("N = 0 on every torus")));
+}

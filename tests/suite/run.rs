@@ -512,6 +512,36 @@ fn four_shards_merged_equal_a_single_run() {
         text.contains("is named twice among the shards") && text.lines().count() == 1,
         "{text}"
     );
+    // A shard whose scene text was edited (adversary pass of 2026-11-28: merged, with a
+    // fresh checksum, when given second; "not a shard of the same scene as itself" when
+    // first): refused as damaged, in either place.
+    let edited = dir.path().join("edited.h5");
+    std::fs::copy(&shards[1], &edited).unwrap();
+    {
+        let file = hdf5::File::open_rw(&edited).unwrap();
+        let text: hdf5::types::VarLenUnicode = file.attr("scene").unwrap().read_scalar().unwrap();
+        let changed: hdf5::types::VarLenUnicode = format!("{text}\n# edited").parse().unwrap();
+        file.attr("scene").unwrap().write_scalar(&changed).unwrap();
+    }
+    for order in [[0, 1], [1, 0]] {
+        let paths = [shards[0].as_path(), edited.as_path()];
+        let damaged = run(&[
+            "merge",
+            paths[order[0]].to_str().unwrap(),
+            paths[order[1]].to_str().unwrap(),
+            shards[2].to_str().unwrap(),
+            shards[3].to_str().unwrap(),
+            "--out",
+            r,
+        ]);
+        assert_eq!(damaged.status.code(), Some(2));
+        let text = String::from_utf8_lossy(&damaged.stderr);
+        assert!(
+            text.contains("edited.h5: is damaged") && text.lines().count() == 1,
+            "{text}"
+        );
+        assert!(!refused.exists());
+    }
     // A directory that is not a journal, and a symbolic link, where the run keeps its
     // resume journal: refused and kept, with --force too.
     let user_dir = dir.path().join("kept.h5.partial.d");
@@ -1580,4 +1610,40 @@ fn a_stopped_run_counts_only_the_cells_it_keeps() {
     assert_eq!(total, 64 * 64);
     assert!(done < total);
     assert_eq!(progress.done.into_inner(), done);
+}
+
+/// Adversary pass of 2026-11-28: a run's lock file removed while it wrote (by hand, or by a
+/// clean-up script after a preemption) let a second `run --force` claim the output, remove
+/// the first's partial file and write its own; the first then renamed the second's
+/// half-written file into place and exited 0. A claim now knows when its lock file is no
+/// longer the one at the path: the finished file is not put in place (exit 75), and its
+/// drop leaves the second's lock file alone.
+#[test]
+fn a_claim_whose_lock_file_was_removed_publishes_nothing() {
+    use rubber_atlas::store::OutputLock;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o.h5");
+    let lock = dir.path().join("o.h5.lock");
+    let first = OutputLock::acquire(&out).unwrap();
+    assert!(first.is_held());
+    assert!(
+        OutputLock::acquire(&out).is_err(),
+        "a second claim while held"
+    );
+    std::fs::remove_file(&lock).unwrap();
+    assert!(!first.is_held());
+    let second = OutputLock::acquire(&out).unwrap();
+    let refused = first.check_held(&out).unwrap_err();
+    assert!(
+        matches!(refused, rubber_atlas::AtlasError::Busy { .. }),
+        "{refused}"
+    );
+    assert!(refused.to_string().contains("not replaced"), "{refused}");
+    drop(first);
+    assert!(
+        lock.exists() && second.is_held(),
+        "the second's lock file kept"
+    );
+    drop(second);
+    assert!(!lock.exists());
 }
