@@ -956,8 +956,15 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             };
         }
         // (On the circle U(−θ) = U(θ): the well near −π/2 mirrors the one near π/2.)
-        let slope = self.body.shape.potential_prime_at(Angle::EQUATOR);
-        if symmetric || slope == 0.0 {
+        // A slope within U's rounding and the body's representation error is none: a
+        // profile's table symmetric about z = α has U′(π/2) = −6e-16 from its fitted arcs,
+        // and its equator well was filed as well_pi beside the well of its lower face, two
+        // tori of one family (adversary pass of 2026-11-28).
+        let shape = &self.body.shape;
+        let slope = shape.potential_prime_at(Angle::EQUATOR);
+        let flat =
+            4.0 * EPS * shape.potential_at(Angle::EQUATOR).abs() + shape.representation_error();
+        if symmetric || slope.abs() <= flat {
             Side::Equator
         } else if slope < 0.0 {
             Side::Lower

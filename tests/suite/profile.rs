@@ -718,3 +718,43 @@ fn a_census_does_not_follow_a_pancake_in_the_full_model() {
     let asked = asked.into_inner();
     assert!(asked < 1_000_000, "stop asked {asked} times");
 }
+
+/// Adversary pass of 2026-11-28: a table symmetric about z = α with faces at both poles (a
+/// barrel) has U′(π/2) = −6e-16 from its fitted arcs, and its equator well was filed as
+/// well_pi beside the well by its lower face: two tori of one family, the cell `failed` in
+/// an atlas and the equator's torus dropped. A slope within the representation error is
+/// none: the three wells are well_0, well_equator and well_pi, mirror images.
+#[test]
+fn a_symmetric_barrels_equator_well_is_the_equators() {
+    use rubber_atlas::family::Family;
+    let rows = vec![
+        vec![0.0, -1.0],
+        vec![0.8, -1.0, 1.0],
+        vec![0.97, -0.5],
+        vec![1.0, 0.0],
+        vec![0.97, 0.5],
+        vec![0.8, 1.0, 1.0],
+        vec![0.0, 1.0],
+    ];
+    let shape = ProfileShape::new(Profile::from_points(&rows).unwrap(), 0.0).unwrap();
+    let body = Body::new(shape, 0.9, 2.0).unwrap();
+    for (kappa, energy) in [(0.05, 1.2), (0.1, 1.25)] {
+        let cell = solve_cell(&body, kappa, energy, &CellOptions::default()).unwrap();
+        let families: Vec<Family> = cell.components.iter().map(|c| c.family).collect();
+        assert_eq!(
+            families,
+            [Family::Well0, Family::WellEquator, Family::WellPi],
+            "{cell:?}"
+        );
+        let (lo, mid, hi) = (
+            &cell.components[0],
+            &cell.components[1],
+            &cell.components[2],
+        );
+        assert!((mid.theta_min + mid.theta_max - PI).abs() < 1e-9, "{mid:?}");
+        assert!(
+            (lo.rotation_number + hi.rotation_number).abs() < 1e-9,
+            "{lo:?} {hi:?}"
+        );
+    }
+}
