@@ -1061,7 +1061,7 @@ pub fn fold_until<S: Shape>(
     };
     let mut reach = 1.0;
     let (bracket, energy, fc, fd) = loop {
-        let (a, b) = inside
+        let bracket = inside
             .iter()
             .flatten()
             .copied()
@@ -1069,11 +1069,10 @@ pub fn fold_until<S: Shape>(
             .fold((top.energy, top.energy), |(lo, hi), e| {
                 (lo.min(e), hi.max(e))
             });
-        if a == b {
+        if bracket.0 == bracket.1 {
             return Ok(None);
         }
-        let (mut a, mut b) = (a, b);
-        let bracket = (a, b);
+        let (mut a, mut b) = bracket;
         let (mut c, mut d) = (b - ratio * (b - a), a + ratio * (b - a));
         let (mut fc, mut fd) = (value(c, &mut start), value(d, &mut start));
         while (b - a).abs() > 1e-9 * (1.0 + top.energy.abs()) {

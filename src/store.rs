@@ -211,9 +211,7 @@ impl OutputLock {
             "its lock file keeps changing under this process".into(),
         ))
     }
-}
 
-impl OutputLock {
     /// Whether the lock file's path still names the file this claim locked. A lock file
     /// removed while its run was writing (by hand, or by a clean-up script after a
     /// preemption) lets a second process claim the output afresh, remove the partial file and

@@ -306,7 +306,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
     /// 1e-10 (an adversary pass).
     fn equator_dip(&self) -> Option<(f64, f64)> {
         let body = self.body;
-        let a = Angle::new(FRAC_PI_2);
+        let a = Angle::EQUATOR;
         let u = body.shape.potential_at(a);
         let u1 = body.shape.potential_prime_at(a);
         let u2 = body.shape.potential_second_at(a);
@@ -1696,17 +1696,9 @@ impl<S: Shape> EffectivePotential<'_, S> {
             (upper, -from_upper, -rise)
         };
         let share = step.abs() / length;
-        let (sin_step, cos_step) = libm::sincos(step);
-        let (drop, drop_error) = if cos_step > -0.4 {
-            let (d, scale) =
-                divided_difference(self, plain.angle, turning.angle, sin_step, cos_step);
-            let drop = -sin_step * d;
-            (drop, 4.0 * EPS * (drop.abs() + sin_step.abs() * scale))
-        } else {
-            let drop = self.value(turning.angle) - self.value(plain.angle);
-            let scales = self.value_scale(turning.angle) + self.value_scale(plain.angle);
-            (drop, 4.0 * EPS * scales)
-        };
+        // V(b) − V(k).
+        let (climb, drop_error) = self.rise_with_error(turning.angle, plain.angle, step);
+        let drop = -climb;
         let tilt = share * other;
         let excess = drop + tilt;
         let error = drop_error + 4.0 * EPS * (excess.abs() + tilt.abs()) + share * rise_error;
@@ -1892,11 +1884,18 @@ impl<S: Shape> EffectivePotential<'_, S> {
         let lower = end(component.lower, turning);
         let upper = end(component.upper, turning);
         // A libration's interior ends on the straight level of its turning points.
-        let span = self.separation(&lower.site, &upper.site);
-        let rise = turning.then(|| self.rise_with_error(lower.angle, upper.angle, span));
-        let on_level = |site: Site| match rise {
-            Some(rise) => self.on_turning_level(end(site, false), &lower, &upper, span, rise),
-            None => Some(end(site, false)),
+        // (The turning points' span and rise only where there is an interior end: this runs
+        // for every libration.)
+        let line = std::cell::OnceCell::new();
+        let on_level = |site: Site| {
+            if !turning {
+                return Some(end(site, false));
+            }
+            let &(span, rise) = line.get_or_init(|| {
+                let span = self.separation(&lower.site, &upper.site);
+                (span, self.rise_with_error(lower.angle, upper.angle, span))
+            });
+            self.on_turning_level(end(site, false), &lower, &upper, span, rise)
         };
         let mut ends = vec![lower];
         // Maxima and tangencies are near-singular points. Minima are harmless inside a piece
