@@ -1051,6 +1051,39 @@ pub fn compute_cells<S: Shape>(
     Block::concat(variables, axis.len(), blocks)
 }
 
+/// The most components of {V ≤ ε} at any one of `points` (with `bodies`), from V's
+/// critical points alone (as [`census`] counts them for a grid): the θ_min layout's room for
+/// cells of bodies whose wells are not known in advance (a profile may have any number).
+/// Consecutive points of one body and κ share the critical points; `stop` is heard between
+/// chunks (the count is then meaningless).
+pub fn most_components<S: Shape>(
+    points: &[CellPoint],
+    bodies: &[Body<S>],
+    stop: &(dyn Fn() -> bool + Sync),
+) -> usize {
+    points
+        .par_chunks(POINTS_PER_TASK)
+        .zip(bodies.par_chunks(POINTS_PER_TASK))
+        .map(|(points, bodies)| {
+            if stop() {
+                return 0;
+            }
+            let mut most = 0;
+            let mut row: Option<([u64; 5], EffectivePotential<'_, _>)> = None;
+            for (p, body) in points.iter().zip(bodies) {
+                let key = [p.alpha, p.beta, p.nu, p.eta, p.kappa].map(f64::to_bits);
+                if row.as_ref().is_none_or(|(k, _)| *k != key) {
+                    row = Some((key, EffectivePotential::new(body, p.kappa)));
+                }
+                let potential = &row.as_ref().expect("set above").1;
+                most = most.max(potential.families(p.energy).map_or(0, |f| f.len()));
+            }
+            most
+        })
+        .max()
+        .unwrap_or(0)
+}
+
 /// The middle of a component's θ-range on the circle, in (−π, π]: at κ = 0 the angles are
 /// lifted (θ up to 3π), so a mirror image at θ < 0 may be held as one beyond π.
 fn leaning_angle(c: &ComponentResult) -> f64 {

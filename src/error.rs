@@ -51,6 +51,10 @@ pub enum AtlasError {
     /// An atlas file, a shard or a resume journal that cannot be used as asked.
     #[error("{path}: {reason}")]
     Atlas { path: String, reason: String },
+    /// A file the work was writing failed part-way (the resume journal, the partial atlas
+    /// file, its rename into place): a failed run (the command's exit 1), not a bad input.
+    #[error("{path}: {reason}")]
+    WriteFailed { path: String, reason: String },
     /// A request larger than this machine can hold (the caller may insist).
     #[error("{reason}")]
     TooLarge { reason: String },
@@ -81,6 +85,15 @@ impl AtlasError {
     #[cfg_attr(not(feature = "hdf5"), allow(dead_code))]
     pub(crate) fn atlas(path: &std::path::Path, reason: impl std::fmt::Display) -> Self {
         AtlasError::Atlas {
+            path: path.display().to_string(),
+            reason: reason.to_string(),
+        }
+    }
+
+    /// An [`AtlasError::WriteFailed`] naming `path`.
+    #[cfg_attr(not(feature = "hdf5"), allow(dead_code))]
+    pub(crate) fn write_failed(path: &std::path::Path, reason: impl std::fmt::Display) -> Self {
+        AtlasError::WriteFailed {
             path: path.display().to_string(),
             reason: reason.to_string(),
         }

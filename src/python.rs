@@ -293,13 +293,18 @@ fn cells<'py>(
     let vars = atlas::variables(&fields);
     // The points, the blocks and their concatenation: about twice the output per cell.
     // Room for every slot of the layout while computing; the empty ones are dropped after.
-    let room = ComponentAxis::full(layout, COMPONENT_SLOTS);
-    let per_cell: usize = vars.iter().map(|v| v.kind.bytes_per_cell(room.len())).sum();
-    check_memory(
-        n as f64 * (std::mem::size_of::<CellPoint>() + 2 * per_cell) as f64,
-        allow_large,
-        "give fewer cells at a time, or allow_large=True",
-    )?;
+    // (An edged body's θ_min slots are counted below, as `run`'s census counts them; the
+    // memory check takes the ellipsoid's.)
+    let mut room = ComponentAxis::full(layout, COMPONENT_SLOTS);
+    let check_room = |room: &ComponentAxis| {
+        let per_cell: usize = vars.iter().map(|v| v.kind.bytes_per_cell(room.len())).sum();
+        check_memory(
+            n as f64 * (std::mem::size_of::<CellPoint>() + 2 * per_cell) as f64,
+            allow_large,
+            "give fewer cells at a time, or allow_large=True",
+        )
+    };
+    check_room(&room)?;
     let pool = pool(threads)?;
     let points: Vec<CellPoint> = (0..n).map(|i| point(&slices, i)).collect();
     let options = CellOptions {
@@ -325,10 +330,14 @@ fn cells<'py>(
         }
         Some(crate::EdgedKind::Profile(profile)) => {
             let bodies = profile_bodies(&points, profile)?;
+            room = counted_room(py, &pool, &points, &bodies, room)?;
+            check_room(&room)?;
             solve_cells(py, &pool, &points, &bodies, &vars, &room, &options)?
         }
         Some(kind) => {
             let bodies = edged_bodies(&points, kind)?;
+            room = counted_room(py, &pool, &points, &bodies, room)?;
+            check_room(&room)?;
             solve_cells(py, &pool, &points, &bodies, &vars, &room, &options)?
         }
     };
@@ -441,6 +450,26 @@ fn edged_bodies(
         crate::Body::new(crate::EdgedShape::of(kind, p.alpha, p.beta)?, p.nu, p.eta)
     })
     .map_err(value_error)
+}
+
+/// The θ_min layout's room for cells of edged `bodies`, whose wells are not known in advance:
+/// as many slots as the most components of one cell, counted as `run`'s census counts them
+/// (a symmetric barrel's κ = 0 cells have four, where the ellipsoid's room is three). The
+/// family layout's room, every family, is kept.
+fn counted_room<S: crate::Shape>(
+    py: Python<'_>,
+    pool: &Option<rayon::ThreadPool>,
+    points: &[CellPoint],
+    bodies: &[crate::Body<S>],
+    room: ComponentAxis,
+) -> PyResult<ComponentAxis> {
+    if room.layout != Layout::ThetaMin {
+        return Ok(room);
+    }
+    let most = interruptible(py, pool, |stop| {
+        atlas::most_components(points, bodies, stop)
+    })?;
+    Ok(ComponentAxis::full(Layout::ThetaMin, most.max(1)))
 }
 
 /// [`atlas::compute_cells`] of `bodies` with the GIL released, stopped by Ctrl-C; the options

@@ -535,7 +535,18 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
             }
         }
         progress.writing();
-        file.close()
+        file.close()?;
+        // Asked to stop while the file was written: stopped as at any other moment, the
+        // file not put in place (every unit is in the journal: a resumed run only writes
+        // it). It used to finish and exit 0 after Ctrl-C: an adversary pass.
+        if progress.interrupted() {
+            return Err(AtlasError::Interrupted {
+                path: out.display().to_string(),
+                done: 0,
+                total,
+            });
+        }
+        Ok(())
     })();
     if let Err(e) = written {
         if claim.is_held() {
@@ -550,7 +561,7 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
     }
     // (Not where the claim was lost: the partial file and the journal may be another's now.)
     claim.check_held(out)?;
-    std::fs::rename(&tmp, out).map_err(|e| AtlasError::atlas(out, e))?;
+    std::fs::rename(&tmp, out).map_err(|e| AtlasError::write_failed(out, e))?;
     journal.remove()?;
     summary.seconds = started.elapsed().as_secs_f64();
     Ok(summary)
@@ -769,14 +780,19 @@ pub fn merge_until(
                 file.write_encoded(&u, &encoded)?;
             }
         }
-        file.close()
+        file.close()?;
+        // (A signal while the file was closed: nothing put in place, as at any unit.)
+        if stop() {
+            return Err(AtlasError::Stopped);
+        }
+        Ok(())
     })();
     if let Err(e) = written {
         let _ = std::fs::remove_file(&tmp);
         return Err(e);
     }
     claim.check_held(out)?;
-    std::fs::rename(&tmp, out).map_err(|e| AtlasError::atlas(out, e))?;
+    std::fs::rename(&tmp, out).map_err(|e| AtlasError::write_failed(out, e))?;
     summary.seconds = started.elapsed().as_secs_f64();
     Ok(summary)
 }

@@ -232,6 +232,31 @@ def test_a_profile_is_refused_where_it_does_not_fit(call, error, words):
     assert words in str(e.value) and "\n" not in str(e.value), str(e.value)
 
 
+# A barrel with faces, symmetric about its equator: at kappa = 0 its four wells on the circle
+# (the faces' and the equator's mirror images) are four components.
+BARREL = [[0.0, -1.0], [0.8, -1.0, 1], [0.97, -0.5], [1.0, 0.0], [0.97, 0.5], [0.8, 1.0, 1], [0.0, 1.0]]
+
+
+def test_cells_in_theta_min_order_have_room_for_every_component_of_a_profile(tmp_path):
+    # (The room was the ellipsoid's three slots: the barrel's kappa = 0 cells came out failed in
+    # Python only, while `run` sized its axis from the census: an adversary pass.)
+    table = tmp_path / "barrel.txt"
+    table.write_text("\n".join(" ".join(repr(float(x)) for x in r) for r in BARREL) + "\n")
+    kappa, energy = np.array([0.0, 0.0, 0.05]), np.array([1.1, 1.2, 1.2])
+    ds = ra.cells(0.0, None, 0.9, 2.0, kappa, energy, shape="profile", profile=BARREL, layout="theta_min",
+                  threads=1)
+    assert ds.sizes["component"] == 4
+    for i in range(len(kappa)):
+        out = json.loads(run("cell", "--shape", "profile", "--profile", table, "--alpha", "0", "--nu", "0.9",
+                             "--eta", "2", "--kappa", repr(float(kappa[i])), "--energy", repr(float(energy[i])),
+                             "--json"))
+        cell = ds.isel(cell=i)
+        assert int(cell.cell_status) == 0, cell.cell_status  # ok
+        assert int(cell.n_components) == len(out["components"]) == (4 if kappa[i] == 0 else 3)
+        for slot, e in enumerate(out["components"]):
+            assert_component_equals(cell.isel(component=slot), e, KEYS, i)
+
+
 def test_a_profile_is_recorded_from_its_lower_pole_whichever_way_it_is_given():
     """As the command's files and JSON hold it (files.md): the Python result held it top first."""
     down = ra.cells(-0.1, None, 0.8, 1.7, kappa=0.5, energy=1.5, shape="profile", profile=EGG[::-1],

@@ -548,7 +548,7 @@ impl AtlasFile {
                     Some(code) if code != 0 => format!(": {system}"),
                     _ => String::new(),
                 };
-                return Err(AtlasError::atlas(
+                return Err(AtlasError::write_failed(
                     &self.path,
                     format!("writing {} failed{reason}", v.name),
                 ));
@@ -617,10 +617,12 @@ impl AtlasFile {
     pub fn close(self) -> Result<()> {
         let path = self.path.clone();
         drop(self.datasets);
-        self.file.close().map_err(|e| AtlasError::atlas(&path, e))?;
+        self.file
+            .close()
+            .map_err(|e| AtlasError::write_failed(&path, e))?;
         std::fs::File::open(&path)
             .and_then(|f| f.sync_all())
-            .map_err(|e| AtlasError::atlas(&path, e))
+            .map_err(|e| AtlasError::write_failed(&path, e))
     }
 }
 

@@ -143,8 +143,8 @@ impl Journal {
             w.inner.write_all(&sum.to_le_bytes())?;
             w.inner.flush()
         };
-        write().map_err(|e| AtlasError::atlas(&tmp, e))?;
-        std::fs::rename(&tmp, &path).map_err(|e| AtlasError::atlas(&path, e))
+        write().map_err(|e| AtlasError::write_failed(&tmp, e))?;
+        std::fs::rename(&tmp, &path).map_err(|e| AtlasError::write_failed(&path, e))
     }
 
     /// A unit read back — its chunks and counts — if its file is there, whole, of this scene,
@@ -205,7 +205,12 @@ impl Journal {
 
     /// Removes the journal (after the atlas file is in place).
     pub fn remove(self) -> Result<()> {
-        std::fs::remove_dir_all(&self.dir).map_err(|e| AtlasError::atlas(&self.dir, e))
+        match std::fs::remove_dir_all(&self.dir) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                Err(AtlasError::write_failed(&self.dir, e))
+            }
+            _ => Ok(()),
+        }
     }
 }
 

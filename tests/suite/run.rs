@@ -144,13 +144,18 @@ fn bad_scenes_are_refused_with_one_line_and_nothing_written() {
             "{key}: {stderr}"
         );
         assert!(!stderr.contains("panicked"));
-        let left: Vec<_> = std::fs::read_dir(dir.path())
-            .unwrap()
-            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-            .filter(|n| n.starts_with("bad.h5"))
-            .collect();
+        let left = files_named(dir.path(), "bad.h5");
         assert!(left.is_empty(), "{to}: left {left:?}");
     }
+}
+
+/// The names in `dir` that start with `prefix` (an output and whatever a run leaves beside it).
+fn files_named(dir: &Path, prefix: &str) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with(prefix))
+        .collect()
 }
 
 #[test]
@@ -1553,12 +1558,41 @@ fn the_census_of_a_huge_grid_stops_when_asked() {
     assert!(asked <= 1000, "stop asked {asked} times");
 }
 
+/// A scene `name` of one ellipsoid and `n` × `n` cells, and a fresh run of it into
+/// `dir/<name>.h5`, for runs in this process (through the library, with a progress of the
+/// test's own).
+fn in_process_run(
+    dir: &Path,
+    name: &str,
+    n: usize,
+) -> (rubber_atlas::scene::Scene, rubber_atlas::sweep::RunRequest) {
+    let scene = rubber_atlas::scene::Scene::parse(
+        &format!(
+            "name = \"{name}\"\n[body]\nnu = 0.5\neta = 0.5\n[axes]\nalpha = [0.5]\n\
+             beta = [3.0]\nkappa = {{ start = 0.05, stop = 2.0, num = {n} }}\n\
+             energy = {{ start = 0.5, stop = 4.5, num = {n} }}\n"
+        ),
+        &format!("{name}.toml"),
+    )
+    .unwrap();
+    let request = rubber_atlas::sweep::RunRequest {
+        out: dir.join(format!("{name}.h5")),
+        resume: false,
+        force: false,
+        update: false,
+        output_current: false,
+        shard: rubber_atlas::atlas::Shard::WHOLE,
+        attributes: Vec::new(),
+    };
+    (scene, request)
+}
+
 /// A run stopped part way takes back the cells of the units it drops: what the progress
 /// says is done is what the journal keeps (after Ctrl-C the progress line had counted the
 /// dropped unit's cells as done; an adversary pass).
 #[test]
 fn a_stopped_run_counts_only_the_cells_it_keeps() {
-    use rubber_atlas::sweep::{Progress, RunRequest};
+    use rubber_atlas::sweep::Progress;
     use std::sync::atomic::{AtomicU64, Ordering};
     struct Counting {
         done: AtomicU64,
@@ -1582,22 +1616,7 @@ fn a_stopped_run_counts_only_the_cells_it_keeps() {
         }
     }
     let dir = tempfile::tempdir().unwrap();
-    let scene = rubber_atlas::scene::Scene::parse(
-        "name = \"stopped\"\n[body]\nnu = 0.5\neta = 0.5\n[axes]\nalpha = [0.5]\nbeta = [3.0]\n\
-         kappa = { start = 0.05, stop = 2.0, num = 64 }\n\
-         energy = { start = 0.5, stop = 4.5, num = 64 }\n",
-        "stopped.toml",
-    )
-    .unwrap();
-    let request = RunRequest {
-        out: dir.path().join("stopped.h5"),
-        resume: false,
-        force: false,
-        update: false,
-        output_current: false,
-        shard: rubber_atlas::atlas::Shard::WHOLE,
-        attributes: Vec::new(),
-    };
+    let (scene, request) = in_process_run(dir.path(), "stopped", 64);
     // Stopped after a row and a half of 64 cells: the unit in flight is dropped part way.
     let progress = Counting {
         done: AtomicU64::new(0),
@@ -1646,4 +1665,58 @@ fn a_claim_whose_lock_file_was_removed_publishes_nothing() {
     );
     drop(second);
     assert!(!lock.exists());
+}
+
+/// A journal removed while the run writes it is a failed run: exit 1 (not 2, which says the
+/// input was bad), one line naming the journal, and no output nor partial file left behind.
+#[test]
+fn a_journal_removed_mid_run_fails_the_run_with_exit_1() {
+    let (_dir, scene, _reference, out, journal) = slow_run();
+    let mut child = Command::new(BIN)
+        .args(["run", &scene, "--out", out.to_str().unwrap(), "--quiet"])
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    wait_for_units(&mut child, &journal, 1);
+    std::fs::remove_dir_all(&journal).unwrap();
+    let output = child.wait_with_output().unwrap();
+    let text = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{text}");
+    assert_eq!(text.lines().count(), 1, "{text}");
+    assert!(text.contains("o.h5.partial.d"), "{text}");
+    assert!(!out.exists(), "{text}");
+    let left = files_named(out.parent().unwrap(), "o.h5");
+    assert!(left.is_empty(), "{left:?}");
+}
+
+/// A signal while the finished file is written stops the run as at any other moment: the
+/// file is not put in place, the journal keeps every unit, and a resumed run writes it
+/// without computing a cell (the run used to finish and exit 0 after Ctrl-C there).
+#[test]
+fn a_run_asked_to_stop_while_it_writes_the_file_keeps_every_unit_for_resume() {
+    use rubber_atlas::sweep::{Progress, Silent};
+    use std::sync::atomic::{AtomicBool, Ordering};
+    #[derive(Default)]
+    struct StopWhileWriting(AtomicBool);
+    impl Progress for StopWhileWriting {
+        fn writing(&self) {
+            self.0.store(true, Ordering::SeqCst);
+        }
+        fn interrupted(&self) -> bool {
+            self.0.load(Ordering::SeqCst)
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let (scene, mut request) = in_process_run(dir.path(), "w", 16);
+    let err = rubber_atlas::sweep::run(&scene, &request, &StopWhileWriting::default()).unwrap_err();
+    let rubber_atlas::AtlasError::Interrupted { done, total, .. } = err else {
+        panic!("{err}");
+    };
+    assert_eq!((done, total), (256, 256));
+    assert!(!request.out.exists());
+    assert!(dir.path().join("w.h5.partial.d").exists());
+    request.resume = true;
+    let summary = rubber_atlas::sweep::run(&scene, &request, &Silent).unwrap();
+    assert_eq!(summary.cells_computed, 0, "{summary:?}");
+    assert!(request.out.exists() && !dir.path().join("w.h5.partial.d").exists());
 }
