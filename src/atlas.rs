@@ -858,16 +858,17 @@ pub fn census(scene: &Scene, stop: &(dyn Fn() -> bool + Sync)) -> Census {
     // (Over every body of a grid of up to 1e12 of them: `stop` is heard between bodies, and
     // the pass ends once every family is possible; it used to run on, deaf to Ctrl-C and
     // SIGTERM for minutes, at 1e6 × 1e6 bodies: an adversary pass.)
-    let mut possible = [false; 4];
+    let ceiling = Family::mask(Family::possible_for(scene.shape.as_ref()));
+    let mut possible = [false; Family::ALL.len()];
     'bodies: for &alpha in &scene.alpha.values {
         for &second in &scene.second.values {
-            if possible == [true; 4] || stop() {
+            if possible == ceiling || stop() {
                 break 'bodies;
             }
             // An edged body's families are not told in advance: the census is whole.
             let body = match scene.shape {
                 None => crate::family::possible_for_ellipsoid(alpha, second, kappa_zero),
-                Some(_) => [true; 4],
+                Some(_) => ceiling,
             };
             for (p, b) in possible.iter_mut().zip(body) {
                 *p |= b;

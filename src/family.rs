@@ -29,20 +29,56 @@ pub enum Family {
     WellEquator = 2,
     /// κ = 0 and ε above the top of U: rolling over the top along a meridian.
     OverTheTop = 3,
+    /// A second torus on the side θ < π/2, round a shallower well than `well_0`'s (an
+    /// edged body's, e.g. a profile's; the ellipsoid has at most one well a side).
+    #[serde(rename = "well_0_second")]
+    Well0Second = 4,
+    /// A second torus on the side θ > π/2, round a shallower well than `well_pi`'s.
+    WellPiSecond = 5,
 }
 
 impl Family {
     /// Every family, in code order.
-    pub const ALL: [Family; 4] = [
+    pub const ALL: [Family; 6] = [
+        Family::Well0,
+        Family::WellPi,
+        Family::WellEquator,
+        Family::OverTheTop,
+        Family::Well0Second,
+        Family::WellPiSecond,
+    ];
+    /// The families of a body with at most one well on each side of the equator (the
+    /// ellipsoid), in code order.
+    pub const ONE_WELL_A_SIDE: [Family; 4] = [
         Family::Well0,
         Family::WellPi,
         Family::WellEquator,
         Family::OverTheTop,
     ];
     /// The codes, as the files' `flag_values`.
-    pub const VALUES: [u8; 4] = [0, 1, 2, 3];
+    pub const VALUES: [u8; 6] = [0, 1, 2, 3, 4, 5];
     /// The names, as the files' `flag_meanings`.
-    pub const MEANINGS: &'static str = "well_0 well_pi well_equator over_the_top";
+    pub const MEANINGS: &'static str =
+        "well_0 well_pi well_equator over_the_top well_0_second well_pi_second";
+
+    /// The families a body of `kind` (None: the ellipsoid) can have: the ellipsoid has at
+    /// most one well on each side of the equator (paper §4); an edged body's wells are not
+    /// told in advance (a profile may have two on one side).
+    pub fn possible_for(kind: Option<&crate::EdgedKind>) -> &'static [Family] {
+        match kind {
+            None => &Family::ONE_WELL_A_SIDE,
+            Some(_) => &Family::ALL,
+        }
+    }
+
+    /// Which families (by code) are among `families`.
+    pub fn mask(families: &[Family]) -> [bool; Family::ALL.len()] {
+        let mut mask = [false; Family::ALL.len()];
+        for f in families {
+            mask[usize::from(f.code())] = true;
+        }
+        mask
+    }
 
     /// The family's code in the files.
     pub fn code(self) -> u8 {
@@ -56,6 +92,8 @@ impl Family {
             Family::WellPi => "well_pi",
             Family::WellEquator => "well_equator",
             Family::OverTheTop => "over_the_top",
+            Family::Well0Second => "well_0_second",
+            Family::WellPiSecond => "well_pi_second",
         }
     }
 
@@ -106,6 +144,35 @@ pub fn of_sides(sides: impl IntoIterator<Item = Side>, outer: Family) -> Option<
         (false, false, true) => Family::WellEquator,
         _ => outer,
     })
+}
+
+/// Tells apart the tori of one side's family in one cell (a profile may have two wells on a
+/// side): `families[i]` is component i's family by [`of_sides`], `depths[i]` the value of
+/// V at its deepest well. The torus round the deepest well of the side keeps `well_0` /
+/// `well_pi`; the others become `well_0_second` / `well_pi_second`. So the family goes on
+/// through the level where a shallow well (an edge's, say) opens beside the main one, and
+/// changes hands only where the two wells' depths cross. Mirror images at κ = 0 (equal
+/// depths, to within rounding) keep one family. A third torus on one side is a second
+/// `…_second` (the family layout then keeps one of them and marks the cell failed).
+pub fn rank_by_depth(families: &mut [Family], depths: &[f64]) {
+    for (main, second) in [
+        (Family::Well0, Family::Well0Second),
+        (Family::WellPi, Family::WellPiSecond),
+    ] {
+        let deepest = families
+            .iter()
+            .zip(depths)
+            .filter(|(f, _)| **f == main)
+            .map(|(_, &v)| v)
+            .fold(f64::INFINITY, f64::min);
+        // Depths closer than this are one well seen twice (a mirror pair at κ = 0).
+        let same = 1e-9 * deepest.abs().max(1.0);
+        for (f, &v) in families.iter_mut().zip(depths) {
+            if *f == main && v > deepest + same {
+                *f = second;
+            }
+        }
+    }
 }
 
 /// How the component axis of an atlas is laid out.
@@ -178,12 +245,16 @@ impl Census {
 /// `kappa_zero` every family is possible. The boundary β² = 1 + |α| is widened by a margin,
 /// so that rounding never leaves out a family: a superset only costs the census its early
 /// end.
-pub fn possible_for_ellipsoid(alpha: f64, beta: f64, kappa_zero: bool) -> [bool; 4] {
+pub fn possible_for_ellipsoid(
+    alpha: f64,
+    beta: f64,
+    kappa_zero: bool,
+) -> [bool; Family::ALL.len()] {
     if kappa_zero {
-        return [true; 4];
+        return Family::mask(&Family::ONE_WELL_A_SIDE);
     }
+    let mut possible = [false; Family::ALL.len()];
     let two_wells = beta * beta > (1.0 + alpha.abs()) * (1.0 - 1e-6);
-    let mut possible = [false; 4];
     let mut allow = |f: Family| possible[usize::from(f.code())] = true;
     if alpha == 0.0 {
         allow(Family::WellEquator);
@@ -208,7 +279,7 @@ pub fn possible_for_ellipsoid(alpha: f64, beta: f64, kappa_zero: bool) -> [bool;
 
 impl Census {
     /// Whether this census has found every family `possible` allows (and so can end).
-    pub fn covers(&self, possible: &[bool; 4]) -> bool {
+    pub fn covers(&self, possible: &[bool; Family::ALL.len()]) -> bool {
         self.families
             .iter()
             .zip(possible)
@@ -247,13 +318,15 @@ impl ComponentAxis {
         ComponentAxis { layout, labels }
     }
 
-    /// Room for any cell: every family, or `slots` components by θ_min.
-    pub fn full(layout: Layout, slots: usize) -> ComponentAxis {
+    /// Room for any cell of a body that can have `families`: each of them, or `slots`
+    /// components by θ_min.
+    pub fn full(layout: Layout, families: &[Family], slots: usize) -> ComponentAxis {
         let mut census = Census {
             most: slots,
             ..Census::default()
         };
-        census.families = [true; Family::ALL.len()];
+        census.add(families);
+        census.most = slots;
         ComponentAxis::of(layout, &census)
     }
 

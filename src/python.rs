@@ -295,7 +295,11 @@ fn cells<'py>(
     // Room for every slot of the layout while computing; the empty ones are dropped after.
     // (An edged body's θ_min slots are counted below, as `run`'s census counts them; the
     // memory check takes the ellipsoid's.)
-    let mut room = ComponentAxis::full(layout, COMPONENT_SLOTS);
+    let mut room = ComponentAxis::full(
+        layout,
+        crate::family::Family::possible_for(kind.as_ref()),
+        COMPONENT_SLOTS,
+    );
     let check_room = |room: &ComponentAxis| {
         let per_cell: usize = vars.iter().map(|v| v.kind.bytes_per_cell(room.len())).sum();
         check_memory(
@@ -469,7 +473,7 @@ fn counted_room<S: crate::Shape>(
     let most = interruptible(py, pool, |stop| {
         atlas::most_components(points, bodies, stop)
     })?;
-    Ok(ComponentAxis::full(Layout::ThetaMin, most.max(1)))
+    Ok(ComponentAxis::full(Layout::ThetaMin, &[], most.max(1)))
 }
 
 /// [`atlas::compute_cells`] of `bodies` with the GIL released, stopped by Ctrl-C; the options

@@ -239,7 +239,12 @@ pub fn footprint(scene: &Scene, shard: Shard, threads: usize) -> Footprint {
     };
     let unit_cells = betas * rows * ne;
     // The component axis before its census: at most every slot of the layout.
-    let slots = ComponentAxis::full(scene.layout, COMPONENT_SLOTS).len();
+    let slots = ComponentAxis::full(
+        scene.layout,
+        crate::family::Family::possible_for(scene.shape.as_ref()),
+        COMPONENT_SLOTS,
+    )
+    .len();
     let bytes_per_cell = atlas::scene_variables(scene)
         .iter()
         .map(|v| v.kind.bytes_per_cell(slots))

@@ -814,9 +814,12 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             Levels::Nodes(nodes) => nodes,
         };
         let last_node = nodes.len() - 1;
-        Ok(node_runs(&nodes, energy)
+        let runs = node_runs(&nodes, energy);
+        let families = self.families_of_runs(&nodes, &runs);
+        Ok(runs
             .into_iter()
-            .map(|(first, last)| {
+            .zip(families)
+            .map(|((first, last), family)| {
                 // A run that starts or ends at a node reaches the top of the circle itself
                 // (κ = 0, a separatrix); otherwise its ends are crossings of V = ε.
                 let lower = if first == 0 {
@@ -829,7 +832,10 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 } else {
                     self.turning_point(&nodes[last], &nodes[last + 1], energy)
                 };
-                self.make_component(&nodes, lower, first, upper, last, energy)
+                Component {
+                    family,
+                    ..self.make_component(&nodes, lower, first, upper, last, energy)
+                }
             })
             .collect())
     }
@@ -839,11 +845,36 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
     pub fn families(&self, energy: f64) -> Result<Vec<Family>> {
         Ok(match self.levels(energy)? {
             Levels::OverTheTop(_) => vec![Family::OverTheTop],
-            Levels::Nodes(nodes) => node_runs(&nodes, energy)
-                .into_iter()
-                .map(|(first, last)| self.family_of_run(&nodes[first..=last]))
-                .collect(),
+            Levels::Nodes(nodes) => self.families_of_runs(&nodes, &node_runs(&nodes, energy)),
         })
+    }
+
+    /// The families of the components whose interiors hold the nodes of `runs` (index
+    /// ranges into `nodes`), in order: each by [`EffectivePotential::family_of_run`], and
+    /// two tori on one side told apart by the depths of their wells
+    /// ([`family::rank_by_depth`]).
+    fn families_of_runs(
+        &self,
+        nodes: &[Option<CriticalPoint>],
+        runs: &[(usize, usize)],
+    ) -> Vec<Family> {
+        let mut families: Vec<Family> = runs
+            .iter()
+            .map(|&(first, last)| self.family_of_run(&nodes[first..=last]))
+            .collect();
+        if families.len() > 1 {
+            let depths: Vec<f64> = runs
+                .iter()
+                .map(|&(first, last)| {
+                    nodes[first..=last]
+                        .iter()
+                        .map(node_value)
+                        .fold(f64::INFINITY, f64::min)
+                })
+                .collect();
+            family::rank_by_depth(&mut families, &depths);
+        }
+        families
     }
 
     /// The nodes that cut the θ-axis into pieces where V is monotone: the critical points

@@ -202,7 +202,8 @@ class RubberAccessor:
         (a well whose minimum is at θ < π/2), "well_pi" (at θ > π/2), "well_equator" (α = 0
         with the single minimum at θ = π/2) and "over_the_top" (κ = 0, rolling over the
         top); a torus above a saddle, round both wells, belongs to the family of the well V
-        keeps at large κ ("well_pi" for α > 0). A family's rotation number is continuous
+        keeps at large κ ("well_pi" for α > 0). A profile with two wells on one side has a
+        second torus there, round the shallower well: "well_0_second" or "well_pi_second". A family's rotation number is continuous
         over the plane except across a critical curve, so its resonance curves are contours
         of one field. See docs/model.md.
 

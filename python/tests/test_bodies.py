@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import rubber_atlas as ra
-from conftest import assert_component_equals, run
+from conftest import assert_component_equals, run, same_double
 
 KEYS = ["theta_min", "theta_max", "period", "omega_theta", "omega_psi", "rotation_number", "drift",
         "drift_radius", "error_estimate"]
@@ -255,6 +255,38 @@ def test_cells_in_theta_min_order_have_room_for_every_component_of_a_profile(tmp
         assert int(cell.n_components) == len(out["components"]) == (4 if kappa[i] == 0 else 3)
         for slot, e in enumerate(out["components"]):
             assert_component_equals(cell.isel(component=slot), e, KEYS, i)
+
+
+def test_two_wells_on_one_side_are_two_families(tmp_path):
+    # The egg at alpha = 0.1, kappa = 0.25: a shallow well (near the rim, theta ~ 2.1) opens at
+    # energy ~ 1.0 beside the main well (theta ~ 2.5), both beyond pi/2. The family layout kept
+    # one torus and marked the cell failed (an adversary pass); now the main well's torus stays
+    # well_pi, and N of well_pi goes on continuously through the level where the second opens.
+    energy = np.array([0.99, 0.995, 0.9985, 1.0, 1.001])
+    common = dict(nu=0.8, eta=1.7, kappa=0.25, energy=energy, shape="profile", profile=EGG, threads=1)
+    by_family = ra.cells(0.1, None, **common)
+    by_theta = ra.cells(0.1, None, layout="theta_min", **common)
+    assert (by_family.cell_status.values == 0).all(), by_family.cell_status.values
+    assert list(by_family.component.values) == [1, 5]
+    assert by_family.rubber.families() == ["well_pi", "well_pi_second"]
+    two = int(np.argmax(by_theta.n_components.values == 2))
+    assert two == 3 and (by_theta.n_components.values[:3] == 1).all()
+    # The main well's torus is the one farther from the equator (larger theta_min) there.
+    cell_f, cell_t = by_family.isel(cell=two), by_theta.isel(cell=two)
+    main, shallow = cell_f.sel(component=1), cell_f.sel(component=5)
+    assert float(main.theta_min) == float(cell_t.isel(component=1).theta_min) > float(shallow.theta_min)
+    for slot_f, slot_t in [(1, 1), (5, 0)]:
+        for key in KEYS:
+            assert same_double(cell_f.sel(component=slot_f)[key], cell_t.isel(component=slot_t)[key]), key
+    # Continuity: N of well_pi moves by less than it does over the three cells before.
+    n = by_family.sel(component=1).rotation_number.values
+    steps = np.abs(np.diff(n[:4]))
+    assert steps[-1] < 3 * steps[:-1].max(), n
+    table = tmp_path / "egg.txt"
+    table.write_text("\n".join(" ".join(repr(float(x)) for x in r + [0.0] * (3 - len(r))) for r in EGG) + "\n")
+    out = json.loads(run("cell", "--shape", "profile", "--profile", table, "--alpha", "0.1", "--nu", "0.8",
+                         "--eta", "1.7", "--kappa", "0.25", "--energy", repr(float(energy[two])), "--json"))
+    assert [c["family"] for c in out["components"]] == ["well_pi_second", "well_pi"]
 
 
 def test_a_profile_is_recorded_from_its_lower_pole_whichever_way_it_is_given():

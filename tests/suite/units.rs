@@ -13,7 +13,8 @@ mod atlas {
         let body = rubber_atlas::EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 0.5).unwrap();
         let potential = EffectivePotential::new(&body, 0.8);
         let variables = variables(&Field::ALL);
-        let axis = ComponentAxis::full(rubber_atlas::family::Layout::ThetaMin, COMPONENT_SLOTS);
+        let axis =
+            ComponentAxis::full(rubber_atlas::family::Layout::ThetaMin, &[], COMPONENT_SLOTS);
         let mut block = Block::empty(&variables, 3, axis.len());
         let options = CellOptions::default();
         // A NaN energy makes the solver return an error; the cells around it are solved.
@@ -267,7 +268,24 @@ mod family {
                 format!("\"{}\"", f.name())
             );
         }
-        assert_eq!(Family::from_code(5), None);
+        assert_eq!(Family::from_code(6), None);
+    }
+
+    #[test]
+    fn two_tori_of_one_side_are_told_apart_by_depth() {
+        use Family::*;
+        // A shallow well beside the main one on the lower side, and a well on the upper.
+        let mut families = [Well0, WellPi, WellPi];
+        rank_by_depth(&mut families, &[0.5, 1.0, 0.9]);
+        assert_eq!(families, [Well0, WellPiSecond, WellPi]);
+        // Mirror images at kappa = 0 (equal depths but for rounding) stay one family.
+        let mut families = [WellPi, Well0, WellPi];
+        rank_by_depth(&mut families, &[0.7, 0.2, 0.7 + 1e-15]);
+        assert_eq!(families, [WellPi, Well0, WellPi]);
+        // A third on one side is a second second (the family layout marks that cell failed).
+        let mut families = [Well0, Well0, Well0];
+        rank_by_depth(&mut families, &[0.3, 0.1, 0.2]);
+        assert_eq!(families, [Well0Second, Well0, Well0Second]);
     }
 
     #[test]
