@@ -13,6 +13,17 @@ macro_rules! say {
     }};
 }
 
+/// `println!` for what a command says after its output file is in place (`run`'s and
+/// `merge`'s summary): a line that cannot reach standard output (a closed pipe, `> /dev/full`)
+/// is lost, and the exit status stays the work's (a complete atlas exited 1: adversary pass of
+/// 2026-11-28).
+macro_rules! tell {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
 mod cli;
 mod progress;
 mod stop;
@@ -81,6 +92,17 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    // A command that writes an atlas must not be killed by a closed pipe on its progress or
+    // its summary: that left its lock and an empty journal, which blocked the next run
+    // (`run … 2>&1 | head -c 10`, exit 141: adversary pass of 2026-11-28). Lines into a
+    // closed pipe are lost instead, and the run ends as it would have.
+    #[cfg(unix)]
+    if matches!(args.command, cli::Command::Run(_) | cli::Command::Merge(_)) {
+        // SAFETY: ignoring a signal before any thread starts.
+        unsafe {
+            libc::signal(libc::SIGPIPE, libc::SIG_IGN);
+        }
+    }
     match cli::run(args) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e)

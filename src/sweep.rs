@@ -572,35 +572,20 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
     Ok(summary)
 }
 
-/// Merges the shard files `shards` of one scene into `out`; the arrays equal those of a
-/// single run bit for bit. Refuses shards of different scenes or program versions,
-/// duplicates, and missing parts.
-pub fn merge(
-    shards: &[PathBuf],
-    out: &Path,
-    force: bool,
-    extra_attributes: &[(String, AttrValue)],
-) -> Result<Summary> {
-    merge_until(shards, out, force, extra_attributes, &|| false)
+/// The shard files of one scene, opened and checked for a merge: the scene (from the first
+/// shard), its variables and component axis, and each file in its shard's position.
+pub struct OpenShards {
+    scene: Scene,
+    variables: Vec<Variable>,
+    axis: ComponentAxis,
+    by_index: Vec<Option<(PathBuf, AtlasFile)>>,
 }
 
-/// [`merge`], given up when `stop` says so (asked before each unit is copied): then
-/// [`AtlasError::Stopped`], with the partial file removed and the output as it was.
-pub fn merge_until(
-    shards: &[PathBuf],
-    out: &Path,
-    force: bool,
-    extra_attributes: &[(String, AttrValue)],
-    stop: &dyn Fn() -> bool,
-) -> Result<Summary> {
-    let started = Instant::now();
-    let claim = crate::store::OutputLock::acquire(out)?;
-    if out.exists() && !force {
-        return Err(AtlasError::atlas(
-            out,
-            "exists; use --force to overwrite it",
-        ));
-    }
+/// Opens the shard files `shards` of a merge into `out` and checks that they are the whole
+/// of one scene, made by this build and undamaged (what [`merge_until`] checks before it
+/// writes anything); `opening` is told each file before it is read (a damaged file can
+/// crash HDF5: a caller that asks in a child process learns which).
+pub fn open_shards(shards: &[PathBuf], out: &Path, opening: &dyn Fn(&Path)) -> Result<OpenShards> {
     if shards.is_empty() {
         return Err(AtlasError::atlas(out, "no shard files given"));
     }
@@ -624,6 +609,7 @@ pub fn merge_until(
     }
     // The scene, from the first shard; every shard must carry the same one.
     let first = shards[0].as_path();
+    opening(first);
     let scene_text = read_root_text(first, "scene")?;
     let scene = Scene::parse(&scene_text, &first.display().to_string())?;
     let variables = atlas::scene_variables(&scene);
@@ -633,6 +619,7 @@ pub fn merge_until(
     let mut by_index: Vec<Option<(PathBuf, AtlasFile)>> = Vec::new();
     let mut count = None;
     for path in shards {
+        opening(path);
         let (index, n) = shard_attributes(path)?;
         let shard = Shard { index, count: n };
         shard
@@ -640,6 +627,16 @@ pub fn merge_until(
             .map_err(|e| AtlasError::atlas(path, e))?;
         let own = AtlasFile::read_axis(path)?;
         if own != axis {
+            // (Another scene's shard said "made by different builds?": an adversary pass.)
+            if read_root_text(path, "scene_fingerprint")? != fingerprint {
+                return Err(AtlasError::atlas(
+                    path,
+                    format!(
+                        "is not a shard of the same scene as {} (or was made by another build)",
+                        first.display()
+                    ),
+                ));
+            }
             return Err(AtlasError::atlas(
                 path,
                 format!(
@@ -729,6 +726,50 @@ pub fn merge_until(
         ));
     }
 
+    Ok(OpenShards {
+        scene,
+        variables,
+        axis,
+        by_index,
+    })
+}
+
+/// Merges the shard files `shards` of one scene into `out`; the arrays equal those of a
+/// single run bit for bit. Refuses shards of different scenes or program versions,
+/// duplicates, and missing parts.
+pub fn merge(
+    shards: &[PathBuf],
+    out: &Path,
+    force: bool,
+    extra_attributes: &[(String, AttrValue)],
+) -> Result<Summary> {
+    merge_until(shards, out, force, extra_attributes, &|| false)
+}
+
+/// [`merge`], given up when `stop` says so (asked before each unit is copied): then
+/// [`AtlasError::Stopped`], with the partial file removed and the output as it was.
+pub fn merge_until(
+    shards: &[PathBuf],
+    out: &Path,
+    force: bool,
+    extra_attributes: &[(String, AttrValue)],
+    stop: &dyn Fn() -> bool,
+) -> Result<Summary> {
+    let started = Instant::now();
+    let claim = crate::store::OutputLock::acquire(out)?;
+    if out.exists() && !force {
+        return Err(AtlasError::atlas(
+            out,
+            "exists; use --force to overwrite it",
+        ));
+    }
+    let OpenShards {
+        scene,
+        variables,
+        axis,
+        by_index,
+    } = open_shards(shards, out, &|_| {})?;
+    let shape = scene.shape();
     let tmp = temporary_path(out);
     if tmp.exists() {
         std::fs::remove_file(&tmp).map_err(|e| AtlasError::atlas(&tmp, e))?;

@@ -330,7 +330,7 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
     reporter.finish();
     if summary.up_to_date {
         if !args.quiet {
-            println!(
+            tell!(
                 "{} is complete and current (this scene, this build); nothing to do",
                 out.display()
             );
@@ -417,23 +417,25 @@ pub(super) fn print_summary(summary: &sweep::Summary, out: &std::path::Path, thr
     let [ok, no_motion, failed] = summary.cells_by_status;
     let [c_ok, c_tol, c_fixed, c_sep, c_limit, c_face] = summary.components_by_status;
     let rate = summary.cells_computed as f64 / summary.seconds.max(1e-9);
-    println!("wrote {}", out.display());
-    println!(
+    tell!("wrote {}", out.display());
+    tell!(
         "cells: {} (with motion {ok}, no motion {no_motion}, failed {failed}); components: {}",
-        summary.cells, summary.components
+        summary.cells,
+        summary.components
     );
-    println!(
+    tell!(
         "components by status: ok {c_ok}, tolerance_not_reached {c_tol}, fixed_point {c_fixed}, \
          separatrix {c_sep}, high_energy_limit {c_limit}, reaches_face {c_face}"
     );
-    println!(
+    tell!(
         "units: {} ({} resumed from an interrupted run, {} computed now)",
         summary.units,
         summary.units_resumed,
         summary.units - summary.units_resumed
     );
-    println!(
+    tell!(
         "time: {:.2} s on {threads} thread(s), {} cells computed, {rate:.0} cells per second",
-        summary.seconds, summary.cells_computed
+        summary.seconds,
+        summary.cells_computed
     );
 }

@@ -1720,3 +1720,87 @@ fn a_run_asked_to_stop_while_it_writes_the_file_keeps_every_unit_for_resume() {
     assert_eq!(summary.cells_computed, 0, "{summary:?}");
     assert!(request.out.exists() && !dir.path().join("w.h5.partial.d").exists());
 }
+
+/// A run whose progress and summary go into a closed pipe (`run … 2>&1 | head -c 10`) ends
+/// as it would have, with its file in place: it was killed by SIGPIPE at its first progress
+/// line, leaving its lock and an empty journal that blocked the next run.
+#[test]
+fn a_run_into_a_closed_pipe_finishes_its_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = small_scene(dir.path());
+    let out = dir.path().join("piped.h5");
+    let mut child = Command::new(BIN)
+        .args([
+            "run",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Both pipes' reading ends closed before the run writes a line.
+    drop(child.stdout.take());
+    drop(child.stderr.take());
+    let status = child.wait().unwrap();
+    assert!(status.success(), "{status:?}");
+    assert!(out.exists());
+    assert_eq!(files_named(dir.path(), "piped.h5"), ["piped.h5"]);
+}
+
+/// A shard whose HDF5 metadata is damaged so that reading it crashes HDF5 (a length in its
+/// global heap: a flipped bit) is refused in one line, exit 2, naming it, with no lock or
+/// partial file left: `merge` died of a segmentation fault there (an adversary pass). The
+/// shards are read first in a child process; the test flips bits until one crashes it.
+#[test]
+fn a_shard_that_crashes_hdf5_is_refused_by_merge() {
+    use std::os::unix::process::ExitStatusExt;
+    let dir = tempfile::tempdir().unwrap();
+    let scene = small_scene(dir.path());
+    let s = scene.to_str().unwrap();
+    let shard = |i: usize| dir.path().join(format!("small.shard-{i}-of-2.h5"));
+    for i in 1..=2 {
+        let out = shard(i);
+        let n = format!("{i}/2");
+        ok(&run(&[
+            "run",
+            s,
+            "--shard",
+            &n,
+            "--out",
+            out.to_str().unwrap(),
+            "--quiet",
+        ]));
+    }
+    let good = std::fs::read(shard(2)).unwrap();
+    let bad = dir.path().join("bad.h5");
+    let out = dir.path().join("merged.h5");
+    let merge = |extra: &[&str]| {
+        let mut args: Vec<String> = vec![
+            "merge".into(),
+            shard(1).to_str().unwrap().to_owned(),
+            bad.to_str().unwrap().to_owned(),
+            "--out".into(),
+            out.to_str().unwrap().to_owned(),
+        ];
+        args.extend(extra.iter().map(|a| a.to_string()));
+        Command::new(BIN).args(&args).output().unwrap()
+    };
+    let crashing = (1500..6000).find(|&offset| {
+        let mut bytes = good.clone();
+        bytes[offset] ^= 1;
+        std::fs::write(&bad, &bytes).unwrap();
+        merge(&["--probe-shards"]).status.signal() == Some(libc::SIGSEGV)
+    });
+    let offset = crashing.expect("some flipped bit crashes HDF5's reading of the shard");
+    let output = merge(&[]);
+    let text = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "offset {offset}: {text}");
+    assert_eq!(text.lines().count(), 1, "{text}");
+    assert!(
+        text.contains("bad.h5") && text.contains("damaged"),
+        "{text}"
+    );
+    assert!(files_named(dir.path(), "merged.h5").is_empty());
+}
