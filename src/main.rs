@@ -157,6 +157,9 @@ fn main() -> ExitCode {
                                 | rubber_atlas::AtlasError::Scene { .. }
                                 | rubber_atlas::AtlasError::Atlas { .. }
                                 | rubber_atlas::AtlasError::Unsupported { .. }
+                                // A request refused before any work for its size, as `run`'s
+                                // (a trajectory's step count exited 1: an adversary pass).
+                                | rubber_atlas::AtlasError::TooLarge { .. }
                         )
                     )
                 });

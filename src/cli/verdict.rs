@@ -171,6 +171,13 @@ pub(super) fn verdict(args: VerdictArgs) -> Result<()> {
                     b.quantity
                 );
             }
+            if found.boundaries.is_empty() {
+                // (Only the header was printed: an adversary pass.)
+                println!(
+                    "  no boundary found: the verdict is the same at every beta of the scan \
+                     (--scan sets how many)"
+                );
+            }
         }
         return Ok(());
     }

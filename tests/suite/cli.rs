@@ -1267,7 +1267,8 @@ fn a_trajectory_beyond_the_step_budget_is_refused_at_once_with_its_estimate() {
     for length in [["--periods", "1e9"], ["--t-end", "1e12"]] {
         let o = run(&trajectory_args(&[length[0], length[1], "--out", out]));
         let err = stderr(&o);
-        assert_eq!(o.status.code(), Some(1), "{err}");
+        // Exit 2, as `run`'s refusals for size (it was 1: an adversary pass).
+        assert_eq!(o.status.code(), Some(2), "{err}");
         assert_eq!(err.lines().count(), 1, "{err}");
         assert!(
             err.contains("integrator steps") && err.contains("--allow-large"),
@@ -1987,4 +1988,29 @@ fn resonance_of_zero_on_a_symmetric_body_names_the_region() {
     assert!(json["note"]
         .as_str()
         .is_some_and(|n| n.contains("N = 0 on every torus")));
+}
+
+/// `verdict --boundaries` over a β-range where the verdict does not change says so: it
+/// printed its header line alone (an adversary pass).
+#[test]
+fn boundaries_that_find_none_say_so() {
+    let o = run(&[
+        "verdict",
+        "--boundaries",
+        "--alpha",
+        "0.5",
+        "--beta-min",
+        "0.7",
+        "--beta-max",
+        "0.72",
+        "--scan",
+        "4",
+        "--nu",
+        "0.5",
+        "--eta",
+        "0.5",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("no boundary found"), "{text}");
 }
