@@ -1022,27 +1022,16 @@ pub fn compute_cells<S: Shape>(
                 return Block::empty(variables, 0, axis.len());
             }
             let mut block = Block::empty(variables, points.len(), axis.len());
-            // Consecutive cells of one body and κ (a row of a grid) share V's critical
-            // points, as the cells of an atlas row do: found once.
-            let mut row: Option<(usize, EffectivePotential<'_, _>)> = None;
-            for (j, (p, body)) in points.iter().zip(bodies).enumerate() {
+            visit_with_potentials(points, bodies, |j, p, potential| {
                 // Asked to stop: the rest stays fill (the caller drops the block).
                 if stop() {
-                    break;
+                    return false;
                 }
-                let same_row = |i: usize| {
-                    let key =
-                        |q: &CellPoint| [q.alpha, q.beta, q.nu, q.eta, q.kappa].map(f64::to_bits);
-                    key(&points[i]) == key(p)
-                };
-                if !row.as_ref().is_some_and(|(i, _)| same_row(*i)) {
-                    row = Some((j, EffectivePotential::new(body, p.kappa)));
-                }
-                let potential = &row.as_ref().expect("set above").1;
                 fill_cell(&mut block, variables, axis, j, (p.kappa, p.energy), || {
                     solve_level(potential, p.energy, options)
                 });
-            }
+                true
+            });
             block
         })
         .collect();
@@ -1052,11 +1041,30 @@ pub fn compute_cells<S: Shape>(
     Block::concat(variables, axis.len(), blocks)
 }
 
+/// Visits `points` (with `bodies`) in order, each with V at its κ: `visit(index, point, V)`
+/// until it returns false. Consecutive points of one body and κ (a row of a grid) share V's
+/// critical points, as the cells of an atlas row do: found once.
+fn visit_with_potentials<S: Shape>(
+    points: &[CellPoint],
+    bodies: &[Body<S>],
+    mut visit: impl FnMut(usize, &CellPoint, &EffectivePotential<'_, S>) -> bool,
+) {
+    let key = |q: &CellPoint| [q.alpha, q.beta, q.nu, q.eta, q.kappa].map(f64::to_bits);
+    let mut row: Option<([u64; 5], EffectivePotential<'_, S>)> = None;
+    for (j, (p, body)) in points.iter().zip(bodies).enumerate() {
+        if row.as_ref().is_none_or(|(k, _)| *k != key(p)) {
+            row = Some((key(p), EffectivePotential::new(body, p.kappa)));
+        }
+        if !visit(j, p, &row.as_ref().expect("set above").1) {
+            return;
+        }
+    }
+}
+
 /// The most components of {V ≤ ε} at any one of `points` (with `bodies`), from V's
 /// critical points alone (as [`census`] counts them for a grid): the θ_min layout's room for
 /// cells of bodies whose wells are not known in advance (a profile may have any number).
-/// Consecutive points of one body and κ share the critical points; `stop` is heard between
-/// chunks (the count is then meaningless).
+/// `stop` is heard between chunks (the count is then meaningless).
 pub fn most_components<S: Shape>(
     points: &[CellPoint],
     bodies: &[Body<S>],
@@ -1070,15 +1078,10 @@ pub fn most_components<S: Shape>(
                 return 0;
             }
             let mut most = 0;
-            let mut row: Option<([u64; 5], EffectivePotential<'_, _>)> = None;
-            for (p, body) in points.iter().zip(bodies) {
-                let key = [p.alpha, p.beta, p.nu, p.eta, p.kappa].map(f64::to_bits);
-                if row.as_ref().is_none_or(|(k, _)| *k != key) {
-                    row = Some((key, EffectivePotential::new(body, p.kappa)));
-                }
-                let potential = &row.as_ref().expect("set above").1;
+            visit_with_potentials(points, bodies, |_, p, potential| {
                 most = most.max(potential.families(p.energy).map_or(0, |f| f.len()));
-            }
+                true
+            });
             most
         })
         .max()

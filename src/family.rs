@@ -321,12 +321,10 @@ impl ComponentAxis {
     /// Room for any cell of a body that can have `families`: each of them, or `slots`
     /// components by θ_min.
     pub fn full(layout: Layout, families: &[Family], slots: usize) -> ComponentAxis {
-        let mut census = Census {
+        let census = Census {
+            families: Family::mask(families),
             most: slots,
-            ..Census::default()
         };
-        census.add(families);
-        census.most = slots;
         ComponentAxis::of(layout, &census)
     }
 

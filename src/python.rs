@@ -293,8 +293,8 @@ fn cells<'py>(
     let vars = atlas::variables(&fields);
     // The points, the blocks and their concatenation: about twice the output per cell.
     // Room for every slot of the layout while computing; the empty ones are dropped after.
-    // (An edged body's θ_min slots are counted below, as `run`'s census counts them; the
-    // memory check takes the ellipsoid's.)
+    // (An edged body's θ_min slots are counted below, as `run`'s census counts them, and
+    // the memory checked again for them.)
     let mut room = ComponentAxis::full(
         layout,
         crate::family::Family::possible_for(kind.as_ref()),

@@ -832,10 +832,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 } else {
                     self.turning_point(&nodes[last], &nodes[last + 1], energy)
                 };
-                Component {
-                    family,
-                    ..self.make_component(&nodes, lower, first, upper, last, energy)
-                }
+                self.make_component(&nodes, (lower, upper), (first, last), energy, family)
             })
             .collect())
     }
@@ -1004,16 +1001,15 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         }
     }
 
-    /// The component between `lower` and `upper`, whose interior holds nodes first..=last
-    /// (the nodes equal to an end are not interior).
+    /// The component of `family` between `lower` and `upper`, whose interior holds the nodes
+    /// of `run`, first..=last (the nodes equal to an end are not interior).
     fn make_component(
         &self,
         nodes: &[Option<CriticalPoint>],
-        lower: Site,
-        first: usize,
-        upper: Site,
-        last: usize,
+        (lower, upper): (Site, Site),
+        (first, last): (usize, usize),
         energy: f64,
+        family: Family,
     ) -> Component {
         let interior: Vec<CriticalPoint> = nodes[first..=last]
             .iter()
@@ -1034,7 +1030,6 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             .filter(|p| p.site.theta >= lower.theta && p.site.theta <= upper.theta)
             .copied()
             .collect();
-        let family = self.family_of_run(&nodes[first..=last]);
         let at_minimum = closed.len() == 1
             && closed[0].kind == CriticalKind::Minimum
             && energy - closed[0].value <= 4.0 * EPS * closed[0].scale;

@@ -76,7 +76,8 @@ pub(super) fn merge(args: MergeArgs) -> Result<()> {
     if let Some(path) = shard_that_crashes(&args) {
         return Err(rubber_atlas::AtlasError::Atlas {
             path: path.display().to_string(),
-            reason: "is damaged: reading it crashed HDF5 (in a child process, so nothing was                      written); run that shard again"
+            reason: "is damaged: reading it crashed HDF5 (in a child process, so nothing was \
+                     written); run that shard again"
                 .into(),
         }
         .into());

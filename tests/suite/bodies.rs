@@ -774,22 +774,9 @@ fn a_critical_point_on_a_kink_with_v_rising_through_it_is_a_shoulder() {
 /// band of sphere round θ = π/2, whose family is the equator's.
 #[test]
 fn the_symmetric_wheel_has_three_families() {
-    use rubber_atlas::family::Family;
     let body = Body::new(EdgedShape::wheel(0.0, 0.5).unwrap(), 0.7, 1.3).unwrap();
     let cell = solve_cell(&body, 0.3, 1.05, &CellOptions::default()).unwrap();
-    let families: Vec<Family> = cell.components.iter().map(|c| c.family).collect();
-    assert_eq!(
-        families,
-        [Family::Well0, Family::WellEquator, Family::WellPi],
-        "{cell:?}"
-    );
-    let (lo, mid, hi) = (
-        &cell.components[0],
-        &cell.components[1],
-        &cell.components[2],
-    );
-    assert!((mid.theta_min + mid.theta_max - PI).abs() < 1e-12);
-    assert!((lo.rotation_number + hi.rotation_number).abs() < 1e-14);
+    crate::assert_mirror_families(&cell, 1e-12, 1e-14);
 }
 
 /// A planar trajectory onto a face is refused (the motion ends there); one that stays on

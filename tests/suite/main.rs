@@ -55,6 +55,28 @@ pub fn full_model_distance<S: rubber_atlas::Shape>(
     (t.x_c[n] - t.x_c[0]).hypot(t.y_c[n] - t.y_c[0])
 }
 
+/// A cell of a body symmetric about its equator with three tori, `well_0`, `well_equator`
+/// and `well_pi`: the middle one centred on π/2 (to `centre_tol`), the outer two mirror
+/// images with opposite N (to `n_tol`).
+pub fn assert_mirror_families(cell: &rubber_atlas::cell::CellResult, centre_tol: f64, n_tol: f64) {
+    use rubber_atlas::family::Family;
+    let families: Vec<Family> = cell.components.iter().map(|c| c.family).collect();
+    assert_eq!(
+        families,
+        [Family::Well0, Family::WellEquator, Family::WellPi],
+        "{cell:?}"
+    );
+    let [lo, mid, hi] = [0, 1, 2].map(|i| &cell.components[i]);
+    assert!(
+        (mid.theta_min + mid.theta_max - std::f64::consts::PI).abs() < centre_tol,
+        "{mid:?}"
+    );
+    assert!(
+        (lo.rotation_number + hi.rotation_number).abs() < n_tol,
+        "{lo:?} {hi:?}"
+    );
+}
+
 /// On the N = 0 resonance curve of `body` in the window κ ∈ `kappa_window`, ε up to
 /// `energy_max`, the cell at the curve's first point with κ in `near` has N = 0, is unbounded,
 /// its torus crosses `kink`, and the full equations carry the centre of mass n·|Δζ| from its

@@ -726,7 +726,6 @@ fn a_census_does_not_follow_a_pancake_in_the_full_model() {
 /// none: the three wells are well_0, well_equator and well_pi, mirror images.
 #[test]
 fn a_symmetric_barrels_equator_well_is_the_equators() {
-    use rubber_atlas::family::Family;
     let rows = vec![
         vec![0.0, -1.0],
         vec![0.8, -1.0, 1.0],
@@ -740,21 +739,6 @@ fn a_symmetric_barrels_equator_well_is_the_equators() {
     let body = Body::new(shape, 0.9, 2.0).unwrap();
     for (kappa, energy) in [(0.05, 1.2), (0.1, 1.25)] {
         let cell = solve_cell(&body, kappa, energy, &CellOptions::default()).unwrap();
-        let families: Vec<Family> = cell.components.iter().map(|c| c.family).collect();
-        assert_eq!(
-            families,
-            [Family::Well0, Family::WellEquator, Family::WellPi],
-            "{cell:?}"
-        );
-        let (lo, mid, hi) = (
-            &cell.components[0],
-            &cell.components[1],
-            &cell.components[2],
-        );
-        assert!((mid.theta_min + mid.theta_max - PI).abs() < 1e-9, "{mid:?}");
-        assert!(
-            (lo.rotation_number + hi.rotation_number).abs() < 1e-9,
-            "{lo:?} {hi:?}"
-        );
+        crate::assert_mirror_families(&cell, 1e-9, 1e-9);
     }
 }
