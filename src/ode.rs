@@ -28,20 +28,33 @@ pub struct SampledSolution<const N: usize> {
     pub steps: usize,
 }
 
+/// The steps of one DOP853 run.
+#[derive(Debug, Clone, Copy)]
+pub struct Steps {
+    /// The first step (0: automatic).
+    pub first: f64,
+    /// The longest step (∞: no bound but the run's length).
+    pub longest: f64,
+    /// The accepted steps after which the run stops short of its end (`u32::MAX`: none;
+    /// the solver keeps every step it takes: bounding them bounds its memory).
+    pub most: u32,
+}
+
 /// Runs DOP853 on `system` from (t0, y0) towards t1 (it may stop earlier when the system's
-/// `solout` asks to) at relative and absolute tolerance `tol`, first step `h0` (0: automatic).
-/// With `max_steps` below `u32::MAX` it also stops after that many accepted steps, short of
-/// t1 (the solver keeps every step it takes: bounding them bounds its memory).
+/// `solout` asks to) at relative and absolute tolerance `tol`, with the given `steps`.
 /// Returns the last time and state and the number of accepted steps.
 pub fn run_dop853<const N: usize, F: System<f64, SVector<f64, N>>>(
     system: F,
-    t0: f64,
-    t1: f64,
+    (t0, t1): (f64, f64),
     y0: SVector<f64, N>,
     tol: f64,
-    h0: f64,
-    max_steps: u32,
+    steps: Steps,
 ) -> Result<(f64, SVector<f64, N>, usize)> {
+    let Steps {
+        first: h0,
+        longest: max_step,
+        most: max_steps,
+    } = steps;
     let mut solver = Dop853::from_param(
         system,
         t0,
@@ -54,7 +67,7 @@ pub fn run_dop853<const N: usize, F: System<f64, SVector<f64, N>>>(
         0.0,
         0.333,
         6.0,
-        t1 - t0,
+        max_step.min(t1 - t0),
         h0,
         max_steps,
         1000,
@@ -134,8 +147,17 @@ pub fn integrate_sampled<const N: usize, R: Rate<N>>(
             if stop() {
                 return Err(AtlasError::Stopped);
             }
-            let (t_last, y_last, run_steps) =
-                run_dop853(Adapter(rate), t, t1, y, tol, h_last, STEPS_PER_RUN)?;
+            let (t_last, y_last, run_steps) = run_dop853(
+                Adapter(rate),
+                (t, t1),
+                y,
+                tol,
+                Steps {
+                    first: h_last,
+                    longest: f64::INFINITY,
+                    most: STEPS_PER_RUN,
+                },
+            )?;
             steps += run_steps;
             let stalled = t_last <= t;
             (t, y) = (t_last, y_last);

@@ -6,7 +6,7 @@
 
 use crate::body::Shape;
 use crate::error::{AtlasError, Result};
-use crate::ode::run_dop853;
+use crate::ode::{run_dop853, Steps};
 use crate::reduced::ReducedSystem;
 use crate::torus::{
     Component, DriftEstimate, EffectivePotential, MotionKind, PeriodIntegrals, SaddleTerms,
@@ -16,8 +16,98 @@ use ode_solvers::System;
 use std::cell::RefCell;
 use std::f64::consts::TAU;
 
-/// State [θ, p, ψ, x_c, y_c, ∫ U (|a| + |p|) dt] with a = κ/(J sinθ).
+/// State [(θ − θ₀)/ℓ_θ, p/ℓ_p, ψ, x_c, y_c, ∫ U (|a| + |p|) dt] with p = θ̇ and
+/// a = κ/(J sinθ), in the component's own units ([`Units`]).
 type State = SVector<f64, 6>;
+
+/// The origin and units of θ and p in the state, and the longest step. DOP853's tolerance
+/// weighs each variable by tol (1 + |y|): in raw θ and p a libration of width 6e-4 about π/2
+/// was held only to tol/6e-4 of its width, and both runs (tol, tol/100) shared that bias
+/// (T 7× its estimate off at tol 1e-5; an adversary pass). A libration is therefore measured
+/// from the end nearer its pole, in the smallest of its width and that end's distance from
+/// the pole, and p in its largest value; a rotation keeps θ and p as they are.
+///
+/// A step may move θ by at most a few times the narrowest feature the orbit sees (a needle's
+/// Z round π/2, an oblate body's at the poles, a dip of B or of J; the widths the quadrature
+/// sets its steps by), the tighter runs by fewer ([`ladder`]): runs at every tolerance
+/// stepped over a needle's π/2 (β = 2.2e-5) alike and agreed on a T 1.3e-3 off.
+#[derive(Clone, Copy)]
+struct Units {
+    /// θ₀.
+    origin: f64,
+    /// ℓ_θ.
+    angle: f64,
+    /// ℓ_p.
+    rate: f64,
+    /// The time θ takes at most to cross the narrowest feature (∞: none).
+    feature_time: f64,
+    /// The longest step in time.
+    max_step: f64,
+}
+
+impl Units {
+    fn of<S: Shape>(
+        potential: &EffectivePotential<'_, S>,
+        energy: f64,
+        component: &Component,
+    ) -> Self {
+        let (low, high) = (component.theta_min(), component.theta_max());
+        let width = high - low;
+        // The largest θ̇ on the orbit, p² = 2 (ε − V)/B, sampled across it.
+        let system = ReducedSystem::new(potential.body, potential.kappa);
+        let peak = (0..=64)
+            .map(|i| {
+                let theta = low + width * i as f64 / 64.0;
+                2.0 * (energy - system.effective_potential(theta))
+                    / potential.body.reduced_inertia(theta)
+            })
+            .filter(|x| x.is_finite())
+            .fold(0.0_f64, f64::max)
+            .sqrt();
+        let shape = potential.body.shape.angular_feature_scale();
+        let feature = potential
+            .dips_seen(low, high)
+            .map(|(_, w)| w)
+            .fold(if shape < 1.0 { shape } else { f64::INFINITY }, f64::min);
+        let feature_time = if peak > 0.0 {
+            feature / peak
+        } else {
+            f64::INFINITY
+        };
+        let unit = |x: f64| if x.is_finite() && x > 0.0 { x } else { 1.0 };
+        if component.kind == MotionKind::Rotation {
+            return Self {
+                origin: 0.0,
+                angle: 1.0,
+                rate: 1.0,
+                feature_time,
+                max_step: f64::INFINITY,
+            };
+        }
+        let to_pi = component.upper.from_pi.max(0.0);
+        let (origin, to_pole) = if to_pi < low {
+            (high, to_pi)
+        } else {
+            (low, low)
+        };
+        let angle = width.min(to_pole.max(1e-8 * width));
+        Self {
+            origin,
+            angle: unit(angle),
+            rate: unit(peak),
+            feature_time,
+            max_step: f64::INFINITY,
+        }
+    }
+
+    fn theta(&self, y: &State) -> f64 {
+        self.origin + self.angle * y[0]
+    }
+
+    fn theta_dot(&self, y: &State) -> f64 {
+        self.rate * y[1]
+    }
+}
 
 #[derive(Clone, Copy)]
 enum EventKind {
@@ -37,6 +127,7 @@ struct EventRecord {
 
 struct PeriodSystem<'a, 'r, S: Shape> {
     system: ReducedSystem<'a, S>,
+    units: Units,
     event: EventKind,
     /// Where the observer writes (None: plain integration, no event watching).
     record: Option<&'r RefCell<EventRecord>>,
@@ -44,7 +135,7 @@ struct PeriodSystem<'a, 'r, S: Shape> {
 
 impl<S: Shape> PeriodSystem<'_, '_, S> {
     fn rate(&self, y: &State) -> State {
-        let (theta, p, psi) = (y[0], y[1], y[2]);
+        let (theta, p, psi) = (self.units.theta(y), self.units.theta_dot(y), y[2]);
         let (vx, vy) = self.system.centre_velocity(theta, p, psi);
         let u = self.system.body.shape.potential(theta);
         let along = if self.system.kappa == 0.0 {
@@ -53,8 +144,8 @@ impl<S: Shape> PeriodSystem<'_, '_, S> {
             self.system.kappa / (self.system.body.integral_factor(theta) * theta.sin())
         };
         State::from([
-            p,
-            self.system.theta_acceleration(theta, p),
+            p / self.units.angle,
+            self.system.theta_acceleration(theta, p) / self.units.rate,
             self.system.psi_rate(theta),
             vx,
             vy,
@@ -63,11 +154,15 @@ impl<S: Shape> PeriodSystem<'_, '_, S> {
         ])
     }
 
-    /// g(y) and dg/dt.
+    /// g(y) and dg/dt, in the state's units.
     fn event(&self, y: &State) -> (f64, f64) {
+        let (theta, p) = (self.units.theta(y), self.units.theta_dot(y));
         match self.event {
-            EventKind::Momentum => (y[1], self.system.theta_acceleration(y[0], y[1])),
-            EventKind::Angle(target) => (y[0] - target, y[1]),
+            EventKind::Momentum => (
+                y[1],
+                self.system.theta_acceleration(theta, p) / self.units.rate,
+            ),
+            EventKind::Angle(target) => ((theta - target) / self.units.angle, p / self.units.angle),
         }
     }
 }
@@ -110,7 +205,12 @@ fn run<S: Shape>(
     t1: f64,
     tol: f64,
 ) -> Result<(State, usize)> {
-    let (t, y, steps) = run_dop853(system, t0, t1, y0, tol, 0.0, STEPS_PER_PERIOD)?;
+    let steps = Steps {
+        first: 0.0,
+        longest: system.units.max_step,
+        most: STEPS_PER_PERIOD,
+    };
+    let (t, y, steps) = run_dop853(system, (t0, t1), y0, tol, steps)?;
     if steps >= STEPS_PER_PERIOD as usize {
         return Err(AtlasError::Integration {
             time: t,
@@ -146,7 +246,7 @@ fn one_period<S: Shape>(
     potential: &EffectivePotential<'_, S>,
     energy: f64,
     component: &Component,
-    tol: f64,
+    (tol, widths_per_step): (f64, f64),
 ) -> Result<(PeriodRun, usize)> {
     let system = ReducedSystem::new(potential.body, potential.kappa);
     let theta0 = component.theta_min();
@@ -158,18 +258,27 @@ fn one_period<S: Shape>(
         }
         _ => (0.0, EventKind::Momentum),
     };
+    let mut units = Units::of(potential, energy, component);
+    units.max_step = widths_per_step * units.feature_time;
     let plain = PeriodSystem {
         system,
+        units,
         event,
         record: None,
     };
     let record = RefCell::new(EventRecord::default());
     let watched = PeriodSystem {
-        system,
-        event,
         record: Some(&record),
+        ..plain
     };
-    let y0 = State::from([theta0, p0, 0.0, 0.0, 0.0, 0.0]);
+    let y0 = State::from([
+        (theta0 - units.origin) / units.angle,
+        p0 / units.rate,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+    ]);
     // Run until the event fires; the horizon is only a safeguard.
     let (_, mut steps) = run(watched, 0.0, y0, 1e7, tol)?;
     let ((ta, ya), (tb, yb)) = record
@@ -206,6 +315,7 @@ fn one_period<S: Shape>(
     // never better than the rounding of t itself (which matters where ψ̇ is huge: near a
     // pole at small κ, ψ̇ ~ 1/κ at θ_min).
     let (_, rate) = plain.event(&y);
+    let (theta_end, p_end) = (units.theta(&y), units.theta_dot(&y));
     let timing = (tol * y[1].abs().max(1.0) / rate.abs().max(f64::MIN_POSITIVE))
         .max(2.0 * f64::EPSILON * (ta + s));
     // A libration's run must come back to θ_min: near a separatrix the energy error can carry
@@ -214,12 +324,12 @@ fn one_period<S: Shape>(
     let strayed = match event {
         EventKind::Momentum => {
             let length = component.theta_max() - component.theta_min();
-            (y[0] - theta0).abs() > 1e-2 * length.max(f64::MIN_POSITIVE)
+            (theta_end - theta0).abs() > 1e-2 * length.max(f64::MIN_POSITIVE)
         }
         EventKind::Angle(_) => false,
     };
-    let end_energy =
-        0.5 * potential.body.reduced_inertia(y[0]) * y[1] * y[1] + system.effective_potential(y[0]);
+    let end_energy = 0.5 * potential.body.reduced_inertia(theta_end) * p_end * p_end
+        + system.effective_potential(theta_end);
     let run = PeriodRun {
         period: ta + s,
         psi_advance: y[2],
@@ -232,8 +342,40 @@ fn one_period<S: Shape>(
     Ok((run, steps))
 }
 
-/// T, Δψ and Δζ of a libration or rotation by two ODE runs, at `tol` and at tol/100; the
-/// values are the tighter run's and the error estimates the difference between the two.
+/// The tolerances of the three runs, `tol`, tol/10, tol/100 (or from 1e-13 down to 1e-15
+/// where tol is below 1e-13: DOP853 is not asked below 1e-15), and how many of the
+/// narrowest feature's widths one step may cross: 4, 2, 1.
+fn ladder(tol: f64) -> [(f64, f64); 3] {
+    let top = tol.max(1e-13);
+    [(top, 4.0), (top * 0.1, 2.0), (top * 0.01, 1.0)]
+}
+
+/// How much the tightest run's difference from the middle one may be, relative to the middle
+/// one's from the loosest, for the runs to count as converging: a tolerance-proportional
+/// method shrinks it tenfold per step of the ladder.
+const CONVERGING: f64 = 1.0 / 3.0;
+
+/// The error estimate of the tightest run's value from the distances between the loose and
+/// the middle run's values (`first`) and between the middle and the tight one's (`last`):
+/// where the distances shrink at least threefold, their sum, the loose run's error, which a
+/// run a hundred times tighter falls well below; else ten times the larger one (the runs are
+/// not yet in their asymptotic regime, and agreement between two of them may be chance: two
+/// runs at tol and tol/100 off T by the same 3e-5 agreed to 4e-7). The last distance alone
+/// fell short of the error up to 18 times (random bodies at tol 1e-5).
+fn ladder_error(first: f64, last: f64) -> f64 {
+    if last <= CONVERGING * first {
+        first + last
+    } else {
+        10.0 * first.max(last)
+    }
+}
+
+/// T, Δψ and Δζ of a libration or rotation by three ODE runs at the tolerances of
+/// [`ladder`]; the values are the tightest run's, their error estimates come from the
+/// differences between the runs ([`ladder_error`]).
+///
+/// The estimate is not a bound: runs that step over the same narrow feature share their
+/// error. It is what an independent check can give; the quadrature's estimates are bounds.
 pub fn integrate<S: Shape>(
     potential: &EffectivePotential<'_, S>,
     energy: f64,
@@ -256,8 +398,19 @@ pub fn integrate<S: Shape>(
                 .to_string(),
         });
     }
-    let (loose, n1) = one_period(potential, energy, component, tol)?;
-    let (tight, n2) = one_period(potential, energy, component, (tol * 1e-2).max(1e-15))?;
+    let [loose_tol, middle_tol, tight_tol] = ladder(tol);
+    let (loose, n0) = one_period(potential, energy, component, loose_tol)?;
+    let (middle, n1) = one_period(potential, energy, component, middle_tol)?;
+    let (tight, n2) = one_period(potential, energy, component, tight_tol)?;
+    let runs = [&loose, &middle, &tight];
+    // Each value's estimate from the three runs' values.
+    let ladder_of = |value: &dyn Fn(&PeriodRun) -> [f64; 2]| {
+        let distance = |a: &PeriodRun, b: &PeriodRun| {
+            let (a, b) = (value(a), value(b));
+            (a[0] - b[0]).hypot(a[1] - b[1])
+        };
+        ladder_error(distance(runs[0], runs[1]), distance(runs[1], runs[2]))
+    };
     // Rounding accumulates over the steps of a run: a few ulps per step.
     let eps = 8.0 * f64::EPSILON * (n2 as f64).max(1.0);
     // The event's timing error moves the end of the period by dt: T by dt, Δψ by |ψ̇| dt,
@@ -268,30 +421,29 @@ pub fn integrate<S: Shape>(
         .psi_rate(crate::torus::Site::at(theta0).angle())
         .abs();
     // Near a saddle T is ill-conditioned in ε: the energy the runs drift off by moves T by
-    // δε/(λ |ε − V_s|) per passage, which the difference of the two runs need not show.
+    // δε/(λ |ε − V_s|) per passage, which the differences of the runs need not show.
     let double = if component.kind == MotionKind::Rotation {
         1.0
     } else {
         2.0
     };
-    let energy_error = tight.energy_error.max(loose.energy_error);
+    let energy_error = runs.iter().map(|r| r.energy_error).fold(0.0, f64::max);
     let saddle =
         potential.saddle_conditioning(energy, component, tight.period, double, energy_error);
     let (saddle_t, saddle_psi) = (saddle.period, saddle.psi_advance);
-    let mut period_error =
-        (tight.period - loose.period).abs() + eps * tight.period + timing + saddle_t;
-    let mut psi_advance_error = (tight.psi_advance - loose.psi_advance).abs()
+    let mut period_error = ladder_of(&|r| [r.period, 0.0]) + eps * tight.period + timing + saddle_t;
+    let mut psi_advance_error = ladder_of(&|r| [r.psi_advance, 0.0])
         + eps * tight.psi_advance.abs()
         + psi_rate * timing
         + saddle_psi;
     // A run that strayed into another orbit measured nothing of this one.
-    let strayed = tight.strayed || loose.strayed;
+    let strayed = runs.iter().any(|r| r.strayed);
     if strayed {
         period_error = period_error.max(tight.period.abs());
         psi_advance_error = psi_advance_error.max(tight.psi_advance.abs()).max(TAU);
     }
     let drift = with_drift.then(|| {
-        let error = (tight.drift[0] - loose.drift[0]).hypot(tight.drift[1] - loose.drift[1])
+        let error = ladder_of(&|r| r.drift)
             + eps * tight.scale
             + tight.scale / tight.period * (timing + saddle_t)
             + saddle.drift
@@ -316,7 +468,7 @@ pub fn integrate<S: Shape>(
         // (The runs' own energy drift, not a level offset: kept.)
         saddle: SaddleTerms::default(),
         level_residual: None,
-        work: n1 + n2,
+        work: n0 + n1 + n2,
         converged: true,
     })
 }

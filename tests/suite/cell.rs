@@ -1115,3 +1115,83 @@ fn the_ode_method_gives_no_values_where_it_cannot_resolve_a_turning_point_by_pi(
         }
     }
 }
+
+/// The ODE method's three runs (tol, tol/10, tol/100) on cells where two runs at tol and
+/// tol/100 agreed by chance or shared a bias (an adversary pass and random bodies at tol
+/// 1e-5): a libration 6e-4 wide about a needle's π/2 (T 7.4 times its estimate off: the
+/// tolerance weighed raw θ), a needle's libration across π/2 at β = 2.2e-5 (N 97 times: every
+/// run stepped over the turn), and a libration from 3e-5 to within 2e-5 of π (T 89 times: the
+/// runs at 1e-5 and 1e-7 were both 3e-5 off). Each value with status `ok` is within its
+/// estimate of the quadrature's at 1e-12.
+#[test]
+fn the_ode_estimate_is_not_fooled_by_runs_that_agree_by_chance() {
+    let cells = [
+        (
+            -0.025128056621013806,
+            0.009423044230387216,
+            1.4173002049237637,
+            10.121145854160224,
+            43.97586584079392,
+            966.9479095400138,
+        ),
+        (
+            -0.9733634751262843,
+            2.247333508182882e-05,
+            0.20617008053684252,
+            0.0015372467983919415,
+            0.06513216371091984,
+            0.013115980287375168,
+        ),
+        (
+            0.9401764087389822,
+            0.0008607053015455712,
+            1.4762562620354842,
+            153.4992101467571,
+            -5.9098512546256186e-05,
+            3.9932317376626467,
+        ),
+    ];
+    for (alpha, beta, nu, eta, kappa, energy) in cells {
+        let b = EllipsoidBody::ellipsoid(alpha, beta, nu, eta).unwrap();
+        let q = solve(&b, kappa, energy, Method::Quadrature, 1e-12);
+        for tol in [1e-4, 1e-5, 1e-6, 1e-7] {
+            let o = solve(&b, kappa, energy, Method::Ode, tol);
+            assert_eq!(o.components.len(), q.components.len());
+            for (co, cq) in o.components.iter().zip(&q.components) {
+                assert_eq!(cq.status, Status::Ok);
+                if co.status != Status::Ok {
+                    continue;
+                }
+                for (name, x, e, y, f) in [
+                    (
+                        "T",
+                        co.period,
+                        co.errors.period,
+                        cq.period,
+                        cq.errors.period,
+                    ),
+                    (
+                        "N",
+                        co.rotation_number,
+                        co.errors.rotation_number,
+                        cq.rotation_number,
+                        cq.errors.rotation_number,
+                    ),
+                    (
+                        "drift",
+                        co.drift,
+                        co.errors.drift,
+                        cq.drift,
+                        cq.errors.drift,
+                    ),
+                ] {
+                    assert!(
+                        (x - y).abs() <= e + f,
+                        "beta {beta} kappa {kappa} tol {tol:e} {name}: ode {x} ± {e:e}, \
+                         quadrature {y} ± {f:e}"
+                    );
+                }
+            }
+        }
+    }
+}
