@@ -669,10 +669,19 @@ fn level_offset_error<S: Shape>(
     // a pole: p up to 1.5 measured), the end moves out at 1/|V′(e)| and the dwell there
     // grows with it: the bound takes the end's distance over its slope in place of the
     // depth, 2 ‖X‖ / min(ε − V_min, |V′(e)| |e − θ_b|).
+    // And where V is nearly flat at a shoulder inside the libration or beyond an end, before
+    // the next critical point (beside a cusp of the diagram), the level responds to ε on the
+    // shoulder's scale ([`EffectivePotential::shoulder_gap`]): 1e-10 below the cusp of the
+    // paper's body (α = 0.5, β = 3, ν = η = 0.5, κ_c), |V′(e)| |e − θ_b| put the slope
+    // 1/(4d) too low (d the end's distance from the inflection) and T was 152 times its
+    // estimate off, its turning point's ulp of ε moving it; 1e-8 above κ_c, just above the
+    // shoulder's level, 83 times. (A maximum beyond an end is a saddle: its terms hold it.)
+    let beyond = |i: usize, pole: f64| component.neighbours[i].map_or(pole, |p| p.site.theta);
+    let shoulder = potential.shoulder_gap(energy, beyond(0, 0.0), beyond(1, PI));
     let reach = [0, 1]
         .iter()
         .map(|&i| rates[i].1 .0.abs() * potential.separation(&sites[i], &bottom.site).abs())
-        .fold(f64::INFINITY, f64::min);
+        .fold(shoulder, f64::min);
     let bounds = |delta: f64, spread: f64| {
         // (Less V_min's rounding: a depth within it would shrink the bound.)
         let depth = (energy - bottom.value - 4.0 * eps * bottom.scale).max(delta);

@@ -248,6 +248,10 @@ pub struct EffectivePotential<'a, S: Shape> {
     split_angles: Vec<f64>,
     /// 1/η in double-double, for [`precise_sample`].
     inverse_eta: DoubleDouble,
+    /// The extrema of sin³θ V′ in (0, π) that are not critical points (κ ≠ 0, a shape
+    /// without kinks): where V′ is least on a stretch of V, a shoulder, near-flat beside a
+    /// cusp of the diagram ([`Self::shoulder_gap`]). Found by the critical-point scan.
+    shoulders: Vec<Site>,
 }
 
 /// Number of scan cells for critical points; between scan nodes the pole-free function
@@ -265,8 +269,9 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             dips: Vec::new(),
             split_angles: Vec::new(),
             inverse_eta: DoubleDouble::from_f64(1.0).div(DoubleDouble::from_f64(body.eta)),
+            shoulders: Vec::new(),
         };
-        v.critical = v.find_critical_points();
+        (v.critical, v.shoulders) = v.find_critical_points();
         v.dips = body
             .shape
             .slope_zeros()
@@ -652,7 +657,8 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         (slope, psi, psi_slope)
     }
 
-    fn find_critical_points(&self) -> Vec<CriticalPoint> {
+    /// The critical points, and the shoulders ([`Self::shoulders`]).
+    fn find_critical_points(&self) -> (Vec<CriticalPoint>, Vec<Site>) {
         let shape = &self.body.shape;
         // Roots of g = sin³θ V′ = −κ² cosθ + sin³θ U′ (no pole; U′'s roots in (0, π) for
         // κ = 0), bracketed between the roots of g′ = κ² sinθ + 3 sin²θ cosθ U′ + sin³θ U″
@@ -680,8 +686,9 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         // A flat U at κ = 0 (the homogeneous sphere) has no isolated critical points: every
         // energy above U is uniform rolling; only θ = 0 and π are kept as reference points.
         let flat = self.kappa == 0.0 && scan.iter().all(|s| g(s.angle()) == 0.0);
+        let extrema = self.sign_changes(&dg, &scan);
         let mut cuts = vec![scan[0]];
-        cuts.extend(self.sign_changes(&dg, &scan));
+        cuts.extend(&extrema);
         cuts.push(scan[scan.len() - 1]);
         cuts.dedup();
         let mut roots = if flat {
@@ -788,7 +795,37 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 CriticalKind::Inflection
             };
         }
-        points
+        let shoulders = if self.kappa != 0.0 && shape.kinks().is_empty() {
+            extrema
+                .into_iter()
+                .filter(|e| points.iter().all(|p| p.site.theta != e.theta))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        (points, shoulders)
+    }
+
+    /// The least height over which V is nearly flat at a shoulder strictly between `lower`
+    /// and `upper` ([`Self::shoulders`]): |ε − V_k| + |s|^{3/2} / √(|V‴|/6) at each, with
+    /// s = V′ there. In the model V = V_k + s x + c x³ it is the rise across the shoulder's
+    /// flat stretch, |x| ≲ √(|s/c|), plus ε's distance from it: the level responds to ε on that
+    /// scale (at s = 0, the cusp, an end a distance d before the inflection has
+    /// V_k − ε = c d³ and dT/dε = T_end / (6 c d³)). ∞ where there is none.
+    pub(crate) fn shoulder_gap(&self, energy: f64, lower: f64, upper: f64) -> f64 {
+        self.shoulders
+            .iter()
+            .filter(|k| k.theta > lower && k.theta < upper)
+            .map(|k| {
+                let a = k.angle();
+                let slope = self.slope(a).abs();
+                let h = 1e-5 * k.theta.min(k.from_pi).min(1.0);
+                let third = (self.curvature_at(Site::at(k.theta + h).angle())
+                    - self.curvature_at(Site::at(k.theta - h).angle()))
+                    / (2.0 * h);
+                (energy - self.value(a)).abs() + slope * slope.sqrt() / (third.abs() / 6.0).sqrt()
+            })
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// The components of {V ≤ ε}, sorted by θ_min. For κ ≠ 0 they lie in (0, π); for κ = 0

@@ -1018,7 +1018,7 @@ def cells(
         False; `threads` not a whole number.
     KeyboardInterrupt
         Ctrl-C stops a call within one cell's time (0.2 s measured on 4 million cells; an ODE
-        cell that gives up takes up to about 3 s).
+        cell can take several seconds: 5.7 s the slowest of 249 random ones).
 
     See Also
     --------

@@ -272,7 +272,25 @@ FIXED_POINTS = [
 ]
 
 
-@pytest.mark.parametrize("alpha, beta, nu, eta, kappa, energy, tol", SHAPE_ROUNDING + UNPLACED + NEEDLE + FIXED_POINTS)
+# By the cusp of the paper's body (κ_c = 1.0802205680829111, where σ_u meets σ_s0 in an
+# inflection of V at level 3.6731983583…): 1e-9, 1e-10 and 1e-11 below that level, the turning
+# point sits beside the inflection, where an ulp of ε moves T by T / (6 (V_c − ε)), and the
+# level's rounding was bounded with the slope 1/(|V′(e)| |e − θ_b|): T was 3.7, 152 and 20 times
+# its estimate off (an adversary pass). At κ_c + 1e-8 and κ_c + 1e-5, 1e-10 above the
+# shoulder's level (V′ small but not 0 there, the shoulder inside the libration): 83 times at
+# tol 1e-10, and 5.9 times at status `ok` at tol 1e-6.
+CUSP = [
+    (0.5, 3.0, 0.5, 0.5, 1.0802205680829111, 3.6731983547337888, 1e-6),
+    (0.5, 3.0, 0.5, 0.5, 1.0802205680829111, 3.673198358039667, 1e-10),
+    (0.5, 3.0, 0.5, 0.5, 1.0802205680829111, 3.673198358370255, 1e-12),
+    (0.5, 3.0, 0.5, 0.5, 1.080220578082911, 3.6731983721961328, 1e-10),
+    (0.5, 3.0, 0.5, 0.5, 1.0802305680829112, 3.6732117806241136, 1e-6),
+]
+
+
+@pytest.mark.parametrize(
+    "alpha, beta, nu, eta, kappa, energy, tol", SHAPE_ROUNDING + UNPLACED + NEEDLE + FIXED_POINTS + CUSP
+)
 def test_hard_cells_are_within_their_estimates(alpha, beta, nu, eta, kappa, energy, tol):
     for comp, truth in components_against_reference(alpha, beta, nu, eta, kappa, energy, tol):
         where = f"beta {beta} energy {energy} tol {tol} {comp['family']}"
