@@ -1737,7 +1737,8 @@ def _check_csv_fields(path: Path) -> None:
             comma, end = b == 44, b == 10
             following = b[1:]
             damaged = damaged or bool(
-                (comma[:-1] & (end[1:] | (following == 44) | (following == 13)) | end[:-1] & comma[1:]).any())
+                (comma[:-1] & (end[1:] | (following == 44) | (following == 13)) | end[:-1] & comma[1:]).any()
+                or ((b == 32) | (b == 9)).any())
             commas += int(np.count_nonzero(comma[1:]))
             ends += int(np.count_nonzero(end[1:]))
             before = chunk[-1:]
@@ -1781,6 +1782,12 @@ def _locate_csv_damage(path: Path) -> None:
                     r = row + int(np.searchsorted(ends, empty.min()))
                     raise _DamagedTable(f"{path}: data row {r} has an empty field: the table was edited or damaged; "
                                         "write it again")
+                # (rubber-atlas writes no spaces; pandas reads " 1.0" as 1.0.)
+                space = np.flatnonzero((b == 32) | (b == 9))
+                if space.size:
+                    r = row + int(np.searchsorted(ends, space[0]))
+                    raise _DamagedTable(f"{path}: data row {r} has a space in a field: the table was edited or "
+                                        "damaged; write it again")
                 row += ends.size
             if not chunk:
                 break
@@ -1788,7 +1795,9 @@ def _locate_csv_damage(path: Path) -> None:
 
 def _check_csv_numbers(path: Path, frame) -> None:
     """Refuses a CSV table with a field that is not a number: every column rubber-atlas writes
-    is numeric (NaN and inf included)."""
+    is numeric (NaN and inf included). A NaN or an infinity must be written as rubber-atlas
+    writes them (``NaN``, ``inf``, ``-inf``), and no field has a space: pandas also reads
+    ``1e999`` as inf, ``NA`` or ``null`` as NaN and `` 1.0`` as 1.0 (an adversary pass)."""
     import pandas as pd
 
     for name in frame.columns:
@@ -1797,6 +1806,18 @@ def _check_csv_numbers(path: Path, frame) -> None:
             row = int(np.flatnonzero(values.isna() & frame[name].notna())[0])
             raise _DamagedTable(f"{path}: column {name!r}, data row {row}: {frame[name].iloc[row]!r} is not a "
                                 "number: the table was edited or damaged; write it again")
+    special = [name for name in frame.columns
+               if frame[name].dtype.kind == "f" and not np.isfinite(frame[name].to_numpy()).all()]
+    if not special:
+        return
+    # (Only the columns that hold one, as text: a second read of those alone.)
+    text = pd.read_csv(path, comment="#", usecols=special, dtype=str, keep_default_na=False, low_memory=False)
+    for name in special:
+        odd = ~np.isfinite(frame[name].to_numpy()) & ~text[name].isin(("NaN", "inf", "-inf")).to_numpy()
+        if odd.any():
+            row = int(np.flatnonzero(odd)[0])
+            raise _DamagedTable(f"{path}: column {name!r}, data row {row}: {text[name].iloc[row]!r} is not a "
+                                "number as rubber-atlas writes them: the table was edited or damaged; write it again")
 
 
 def _typed_columns(path: Path, frame, types: dict):

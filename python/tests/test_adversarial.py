@@ -542,6 +542,13 @@ def test_read_table_refuses_edited_rows(tmp_path):
     nan = edited("nan.csv", ",".join(fields[:4] + ["NaN", "inf"] + fields[6:]) + "\n")
     back = ra.read_table(nan)
     assert np.isnan(back.psi[3]) and np.isinf(back.x_c[3])
+    # But only as rubber-atlas writes them, and with no space: 1e999 was read as inf, NA as NaN
+    # and " 1.0" as 1.0 (adversary pass 23).
+    for value, words in [("1e999", ("column 'psi'", "data row 3", "'1e999'")),
+                         ("NA", ("column 'psi'", "data row 3", "'NA'")),
+                         (" " + fields[4], ("data row 3", "space"))]:
+        odd = edited("odd.csv", ",".join(fields[:4] + [value] + fields[5:]) + "\n")
+        refused(ValueError, lambda: ra.read_table(odd), *words)
 
 
 def test_read_table_refuses_edited_headers_and_typed_columns_and_reads_an_empty_table(tmp_path):
