@@ -41,7 +41,7 @@ struct Units {
     rate: f64,
     /// The time θ takes at most to cross the narrowest feature (∞: none).
     feature_time: f64,
-    /// The longest step in time.
+    /// The longest step in time (set per run: [`ladder`]).
     max_step: f64,
 }
 
@@ -260,6 +260,7 @@ fn one_period<S: Shape>(
     potential: &EffectivePotential<'_, S>,
     energy: f64,
     component: &Component,
+    units: Units,
     (tol, widths_per_step): (f64, f64),
 ) -> Result<(PeriodRun, usize)> {
     let system = ReducedSystem::new(potential.body, potential.kappa);
@@ -272,8 +273,10 @@ fn one_period<S: Shape>(
         }
         _ => (0.0, EventKind::Momentum),
     };
-    let mut units = Units::of(potential, energy, component);
-    units.max_step = widths_per_step * units.feature_time;
+    let units = Units {
+        max_step: widths_per_step * units.feature_time,
+        ..units
+    };
     let plain = PeriodSystem {
         system,
         units,
@@ -416,12 +419,15 @@ pub fn integrate<S: Shape>(
     // time to cross the feature says how many steps the capped runs need. Beyond half the
     // budget the component gets no values at once (an oblate body at β = 2.9e4, 1.3e-4 from
     // its pole, had the three runs give up after 1e6 steps each: 16.6 s for nothing).
-    let feature_time = Units::of(potential, energy, component).feature_time;
-    if feature_time.is_finite() {
-        let (rough, _) = one_period(potential, energy, component, (1e-3, f64::INFINITY))?;
+    let units = Units::of(potential, energy, component);
+    let mut work = 0;
+    if units.feature_time.is_finite() {
+        let (rough, steps) =
+            one_period(potential, energy, component, units, (1e-3, f64::INFINITY))?;
+        work += steps;
         let needed: f64 = ladder(tol)
             .iter()
-            .map(|&(_, widths)| rough.period / (widths * feature_time))
+            .map(|&(_, widths)| rough.period / (widths * units.feature_time))
             .sum();
         if needed > 0.5 * STEPS_PER_PERIOD as f64 {
             return Err(AtlasError::Integration {
@@ -434,9 +440,10 @@ pub fn integrate<S: Shape>(
         }
     }
     let [loose_tol, middle_tol, tight_tol] = ladder(tol);
-    let (loose, n0) = one_period(potential, energy, component, loose_tol)?;
-    let (middle, n1) = one_period(potential, energy, component, middle_tol)?;
-    let (tight, n2) = one_period(potential, energy, component, tight_tol)?;
+    let (loose, n0) = one_period(potential, energy, component, units, loose_tol)?;
+    let (middle, n1) = one_period(potential, energy, component, units, middle_tol)?;
+    let (tight, n2) = one_period(potential, energy, component, units, tight_tol)?;
+    work += n0 + n1 + n2;
     let runs = [&loose, &middle, &tight];
     // Each value's estimate from the three runs' values.
     let ladder_of = |value: &dyn Fn(&PeriodRun) -> [f64; 2]| {
@@ -503,7 +510,7 @@ pub fn integrate<S: Shape>(
         // (The runs' own energy drift, not a level offset: kept.)
         saddle: SaddleTerms::default(),
         level_residual: None,
-        work: n0 + n1 + n2,
+        work,
         converged: true,
     })
 }
