@@ -854,7 +854,10 @@ fn level_offset_error<S: Shape>(
     // accurate than the cell's, their errors entering times δ/h. Near a pole at small κ
     // (X varies on the scale of κ there) and where that scale is below it, the step is
     // 256 times the a-priori bound (never below: the sharp δ may be far below an ulp of ε,
-    // where ε ± h would round back to ε).
+    // where ε ± h would round back to ε). Never beyond a quarter of the shoulder's gap
+    // either: X′ grows without bound as ε nears a cusp's level (∝ 1/(V_k − ε) at the cusp),
+    // and a difference across it measures a secant far below X′(ε): at the cusp point of the
+    // paper's body (gap 1.1e-13, the step 1.9e-12) T was 2.1 times its estimate off.
     let variation = depth.min(reach).min(saddles).min(kink_levels);
     let narrow = 256.0 * a_priori;
     let h = if near_pole {
@@ -863,7 +866,8 @@ fn level_offset_error<S: Shape>(
         narrow.max(1e-3 * variation)
     }
     .min(0.25 * depth)
-    .min(0.25 * saddles);
+    .min(0.25 * saddles)
+    .min(0.25 * shoulder);
     if h < 16.0 * a_priori {
         return crude.plus(tilted);
     }
