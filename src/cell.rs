@@ -677,7 +677,37 @@ fn level_offset_error<S: Shape>(
     // estimate off, its turning point's ulp of ε moving it; 1e-8 above κ_c, just above the
     // shoulder's level, 83 times. (A maximum beyond an end is a saddle: its terms hold it.)
     let beyond = |i: usize, pole: f64| component.neighbours[i].map_or(pole, |p| p.site.theta);
-    let shoulder = potential.shoulder_gap(energy, beyond(0, 0.0), beyond(1, PI));
+    // A pole where U has a maximum (U″ < 0, no face) is at κ = 0 a separatrix's level, and
+    // for small κ the wall rounds the top off on the level scale κ √|U″|: beside it X(ε)
+    // varies on |ε − U_pole| + κ √|U″| like a shoulder's, however steep V′ is at an end (at
+    // κ = 1e-20, ε = U_pole, V′(e) |e − θ_b| was 1.2e-8 and T 500 times its estimate off).
+    let shape = &potential.body.shape;
+    // (At κ = 0 the top is a critical point, with its saddle terms.)
+    let pole_top = sites[..2]
+        .iter()
+        .filter(|e| potential.kappa != 0.0 && chart(e) < 0.1)
+        .filter_map(|e| {
+            let (pole, index) = if e.theta <= e.from_pi {
+                (Angle { sin: 0.0, cos: 1.0 }, 0)
+            } else {
+                (
+                    Angle {
+                        sin: 0.0,
+                        cos: -1.0,
+                    },
+                    1,
+                )
+            };
+            let curvature = shape.potential_second_at(pole);
+            (!shape.faces()[index] && curvature < 0.0).then(|| {
+                (energy - shape.potential_at(pole)).abs()
+                    + potential.kappa.abs() * (-curvature).sqrt()
+            })
+        })
+        .fold(f64::INFINITY, f64::min);
+    let shoulder = potential
+        .shoulder_gap(energy, beyond(0, 0.0), beyond(1, PI))
+        .min(pole_top);
     let reach = [0, 1]
         .iter()
         .map(|&i| rates[i].1 .0.abs() * potential.separation(&sites[i], &bottom.site).abs())

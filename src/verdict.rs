@@ -40,7 +40,8 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 /// The smallest κ-line of case 1: below it N has its κ → 0 limits (±1/2 near one pole,
-/// O(κ) across both), see [`crate::limits::small_kappa_limit`].
+/// O(κ) across both, and between them in a band of width ~κ √|U″| round the level of a pole
+/// where U has a maximum), see [`crate::limits::small_kappa_limit`].
 pub const KAPPA_FLOOR: f64 = 1e-6;
 /// The largest κ-line: above it N differs from N∞(λ) by O(1/ε) ≤ O(1/κ²) = 1e-8.
 pub const KAPPA_CEIL: f64 = 1e4;
@@ -939,7 +940,7 @@ pub fn verdict_until(
         limits: [
             "bottom: each line starts at the deepest minimum of V (the linearised N of the stable permanent rotation, limits::bottom_rotation_number)",
             "high energy: each line runs to epsilon = 1e12 V_low, where N = slope kappa / sqrt(epsilon) + O(1/epsilon); beyond the last line, N = N_inf(lambda) + O(1/kappa^2) (limits::HighEnergyLimit)",
-            "kappa -> 0 (case 1): below kappa = 1e-6, N -> +1/2 or -1/2 near one pole and O(kappa) across both (limits::small_kappa_limit, tested against cells)",
+            "kappa -> 0 (case 1): below kappa = 1e-6, N -> +1/2 or -1/2 near one pole and O(kappa) across both, between them (+-1/4 at the level of a pole where U has a maximum) in a band of epsilon of width about kappa sqrt|U''| there, with no integer (limits::small_kappa_limit, tested against cells)",
             "separatrices: levels 1e-1 ... 1e-13 (relative) on both sides of every maximum of V, where N -> +-infinity",
         ]
         .into_iter()

@@ -290,9 +290,22 @@ CUSP = [
     (0.5, 3.0, 0.5, 0.5, 1.0802305680829112, 3.6732117806241136, 1e-6),
 ]
 
+# At the level of a pole where U has a maximum (U(0) = 1 + α for β² < 1 + α), κ ≤ 1e-15: the
+# wall rounds the top off on the level scale κ √|U″| (1e-20 here), far below the rounding of U
+# itself, and an end's V′(e) |e − θ_b| (1e-8) put dT/dε far too low: T was 501 times its
+# estimate off and N 329 times at κ = 1e-20, ε = 1.5 (an adversary pass; every status
+# `tolerance_not_reached`). The estimates now take the pole's level as a shoulder's.
+POLE_TOP = [
+    (0.5, 0.5, 0.5, 0.5, 1e-20, 1.5, 1e-12),
+    (0.5, 0.5, 0.5, 0.5, 1e-20, 1.4999999999999998, 1e-12),
+    (0.5, 0.5, 0.5, 0.5, 1e-20, 1.4999999999999858, 1e-12),
+    (0.5, 0.5, 0.5, 0.5, 1e-15, 1.5, 1e-12),
+    (0.3, 0.7, 0.8, 2.0, 1e-20, 1.3, 1e-10),
+]
+
 
 @pytest.mark.parametrize(
-    "alpha, beta, nu, eta, kappa, energy, tol", SHAPE_ROUNDING + UNPLACED + NEEDLE + FIXED_POINTS + CUSP
+    "alpha, beta, nu, eta, kappa, energy, tol", SHAPE_ROUNDING + UNPLACED + NEEDLE + FIXED_POINTS + CUSP + POLE_TOP
 )
 def test_hard_cells_are_within_their_estimates(alpha, beta, nu, eta, kappa, energy, tol):
     for comp, truth in components_against_reference(alpha, beta, nu, eta, kappa, energy, tol):

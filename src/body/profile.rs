@@ -40,12 +40,14 @@ pub struct ProfileArc {
     pub anchor_z: f64,
     anchor_sin: f64,
     anchor_cos: f64,
+    /// θ_end − θ_start to full relative precision (from the angles' offsets from the chords,
+    /// not their difference: near π each holds only an absolute 4e-16).
+    turn: f64,
 }
 
 impl ProfileArc {
     fn new(
-        theta_start: f64,
-        theta_end: f64,
+        (theta_start, theta_end, turn): (f64, f64, f64),
         radius: f64,
         anchor_theta: f64,
         anchor: [f64; 2],
@@ -67,6 +69,7 @@ impl ProfileArc {
             anchor_z: anchor[1],
             anchor_sin,
             anchor_cos,
+            turn,
         }
     }
 
@@ -147,7 +150,7 @@ fn merge_arcs_of_one_circle(arcs: Vec<ProfileArc>) -> Vec<ProfileArc> {
                 return first;
             }
             let (start, end) = (first.point(first.theta_start), last.point(last.theta_end));
-            let turn = last.theta_end - first.theta_start;
+            let turn = group.iter().map(|a| a.turn).sum::<f64>();
             let radius = chord_length(start, end) / (2.0 * (0.5 * turn).sin());
             let (anchor_theta, anchor) = if last.theta_end == PI {
                 (PI, end)
@@ -155,8 +158,7 @@ fn merge_arcs_of_one_circle(arcs: Vec<ProfileArc>) -> Vec<ProfileArc> {
                 (first.theta_start, start)
             };
             ProfileArc::new(
-                first.theta_start,
-                last.theta_end,
+                (first.theta_start, last.theta_end, turn),
                 radius,
                 anchor_theta,
                 anchor,
@@ -200,6 +202,14 @@ fn chord_angle(a: [f64; 2], b: [f64; 2]) -> f64 {
 
 fn chord_length(a: [f64; 2], b: [f64; 2]) -> f64 {
     (b[0] - a[0]).hypot(b[1] - a[1])
+}
+
+/// a b − c d with one rounding's error or so, however they cancel (Kahan's algorithm with
+/// fused multiply-adds).
+fn difference_of_products(a: f64, b: f64, c: f64, d: f64) -> f64 {
+    let cd = c * d;
+    let error = (-c).mul_add(d, cd);
+    a.mul_add(b, -cd) + error
 }
 
 impl Profile {
@@ -297,20 +307,36 @@ impl Profile {
         let edge =
             |i: usize| rows[i][2] == 1.0 || (i == first && faces[0]) || (i == last && faces[1]);
         // The tangent's direction angle at every smooth point: 0 at the bottom pole, π at the
-        // top, and elsewhere that of the circle through the point and its two neighbours.
+        // top, and elsewhere that of the circle through the point and its two neighbours. With
+        // it, to full relative precision, its offsets from the chords either side: `before`,
+        // the tangent where the meridian arrives at a point less the chord into it, and
+        // `after`, the chord out of it less the tangent where it leaves. The arcs' radii
+        // divide by these (not by differences of angles near π, which hold an absolute 4e-16
+        // each: a biarc turning 3.2e-4 to a flat top had its radius 8.6e-13 off, relative,
+        // and the period of a libration in that well, T ∝ r^−½, 4.3e-13 off).
         let mut tangent = vec![f64::NAN; n];
-        for (i, slot) in tangent.iter_mut().enumerate().take(last + 1).skip(first) {
-            if edge(i) {
-                continue;
-            }
-            *slot = if i == 0 {
+        let mut before = vec![f64::NAN; n];
+        let mut after = vec![f64::NAN; n];
+        // π less the chord angle from `a` to `b`, where that is small (up to a top pole).
+        let from_pi = |a: [f64; 2], b: [f64; 2]| (b[1] - a[1]).atan2(a[0] - b[0]);
+        for i in (first..=last).filter(|&i| !edge(i)) {
+            tangent[i] = if i == 0 {
+                after[0] = chord_angle(at(0), at(1));
                 0.0
             } else if i == n - 1 {
+                before[i] = from_pi(at(i - 1), at(i));
                 PI
             } else {
                 let (a, b, c) = (at(i - 1), at(i), at(i + 1));
-                let (psi1, psi2) = (chord_angle(a, b), chord_angle(b, c));
-                let turn = psi2 - psi1;
+                // The turn between the chords from the cross and dot products of their
+                // directions (each with one rounding: `difference_of_products`; of unit vectors,
+                // so that neither underflows on a tiny body nor overflows on a huge one).
+                let (l1, l2) = (chord_length(a, b), chord_length(b, c));
+                let u = [(b[0] - a[0]) / l1, (b[1] - a[1]) / l1];
+                let v = [(c[0] - b[0]) / l2, (c[1] - b[1]) / l2];
+                let cross = difference_of_products(u[0], v[1], u[1], v[0]);
+                let dot = difference_of_products(u[0], v[0], -u[1], v[1]);
+                let turn = cross.atan2(dot);
                 if !(turn > 0.0 && turn < PI) {
                     return refuse(format!(
                         "is not convex at point {i} (rho = {}, z = {}): the meridian must turn one way, \
@@ -319,8 +345,11 @@ impl Profile {
                         crate::error::show(b[1])
                     ));
                 }
-                let (l1, l2) = (chord_length(a, b), chord_length(b, c));
-                psi1 + (l1 * turn.sin()).atan2(l2 + l1 * turn.cos())
+                // The inscribed angles at the neighbours: tan = sin t / (l₂/l₁ + cos t) at c
+                // (the tangent less the chord in) and sin t / (l₁/l₂ + cos t) at a.
+                before[i] = cross.atan2(l2 / l1 + dot);
+                after[i] = cross.atan2(l1 / l2 + dot);
+                chord_angle(a, b) + before[i]
             };
         }
         let straight = |i: usize| AtlasError::Profile {
@@ -342,11 +371,14 @@ impl Profile {
             let chord = |j: usize| chord_angle(at(j), at(j + 1));
             let bottom_fixed = i == 0 || (i == first && faces[0]);
             let top_fixed = i == n - 1 || (i == last && faces[1]);
+            // (The chord in is the middle of the arc's turn: the tangent arrives as far beyond
+            // it as the smooth point's left it behind.)
             arrive[i] = if bottom_fixed {
                 0.0
             } else if edge(i - 1) {
                 return Err(straight(i - 1));
             } else {
+                before[i] = after[i - 1];
                 2.0 * chord(i - 1) - tangent[i - 1]
             };
             leave[i] = if top_fixed {
@@ -354,6 +386,7 @@ impl Profile {
             } else if edge(i + 1) {
                 return Err(straight(i));
             } else {
+                after[i] = before[i + 1];
                 2.0 * chord(i) - tangent[i + 1]
             };
             // An edge whose turn is within rounding (a few ulps: a tip flag on a pole whose
@@ -377,6 +410,22 @@ impl Profile {
                 };
                 arrive[i] = common;
                 leave[i] = common;
+                // (Past a bottom face or tip the chord out is the turn from 0 itself; before a
+                // top one the chord in is π less its own.)
+                if i > first {
+                    before[i] = if top_fixed {
+                        from_pi(at(i - 1), at(i))
+                    } else {
+                        common - chord(i - 1)
+                    };
+                }
+                if i < last {
+                    after[i] = if bottom_fixed {
+                        chord(i)
+                    } else {
+                        chord(i) - common
+                    };
+                }
             }
         }
         let mut arcs: Vec<ProfileArc> = Vec::new();
@@ -387,7 +436,14 @@ impl Profile {
         };
         // The normal turns round an edge from where the meridian arrives to where it leaves
         // (arrive ≤ leave above; none where they are equal).
-        let edge_arc = |i: usize| ProfileArc::new(arrive[i], leave[i], 0.0, arrive[i], at(i));
+        let edge_arc = |i: usize| {
+            ProfileArc::new(
+                (arrive[i], leave[i], leave[i] - arrive[i]),
+                0.0,
+                arrive[i],
+                at(i),
+            )
+        };
         for i in first..last {
             let (a, b) = (at(i), at(i + 1));
             let psi = chord_angle(a, b);
@@ -408,38 +464,39 @@ impl Profile {
             } else {
                 tangent[i + 1]
             };
-            if !(t0 < psi && psi < t1 && t1 - t0 < PI) {
+            // The chord less the tangent leaving a, and the tangent arriving at b less the chord.
+            let (lead, lag) = (after[i], before[i + 1]);
+            if !(lead > 0.0 && lag > 0.0 && lead + lag < PI && t0 < psi && psi < t1) {
                 return Err(not_convex("the chord leaves the tangents' range"));
             }
-            if t1 == 2.0 * psi - t0 || t0 == 2.0 * psi - t1 {
+            if lead == lag {
                 // One arc: beside an edge whose tangent was taken from this chord.
-                let radius = length / (2.0 * (0.5 * (t1 - t0)).sin());
+                let radius = length / (2.0 * lead.sin());
                 if !(radius.is_finite() && radius > 0.0) {
                     return Err(not_convex("no arc turning one way joins them"));
                 }
                 let anchor = if edge(i + 1) { (t0, a) } else { (t1, b) };
                 push(
                     &mut arcs,
-                    ProfileArc::new(t0, t1, radius, anchor.0, anchor.1),
+                    ProfileArc::new((t0, t1, lead + lag), radius, anchor.0, anchor.1),
                 );
                 continue;
             }
             // Two arcs (a biarc), the joint's tangent in the middle of the range where both
-            // turn the same way as the meridian.
-            let lo = t0.max(2.0 * psi - t1);
-            let hi = t1.min(2.0 * psi - t0);
-            let tj = 0.5 * (lo + hi);
-            let (m1, m2) = (0.5 * (t0 + tj), 0.5 * (tj + t1));
-            let det = (m2 - m1).sin();
-            let c1 = length * (m2 - psi).sin() / det;
-            let c2 = length * (psi - m1).sin() / det;
-            let r1 = c1 / (2.0 * (0.5 * (tj - t0)).sin());
-            let r2 = c2 / (2.0 * (0.5 * (t1 - tj)).sin());
+            // turn the same way as the meridian, [ψ − min, ψ + min] of the two offsets: the
+            // chord ψ itself. The first turns `lead` over the chord c₁, the second `lag` over
+            // c₂, the joint at c₁ = L sin(lag/2) / sin((lead + lag)/2) from a (and c₂ likewise)
+            // on the chords' triangle with angles lead/2 and lag/2 at a and b.
+            let det = (0.5 * (lead + lag)).sin();
+            let c1 = length * (0.5 * lag).sin() / det;
+            let c2 = length * (0.5 * lead).sin() / det;
+            let r1 = c1 / (2.0 * (0.5 * lead).sin());
+            let r2 = c2 / (2.0 * (0.5 * lag).sin());
             if !(r1.is_finite() && r2.is_finite() && r1 > 0.0 && r2 > 0.0) {
                 return Err(not_convex("no two arcs turning one way join them"));
             }
-            push(&mut arcs, ProfileArc::new(t0, tj, r1, t0, a));
-            push(&mut arcs, ProfileArc::new(tj, t1, r2, t1, b));
+            push(&mut arcs, ProfileArc::new((t0, psi, lead), r1, t0, a));
+            push(&mut arcs, ProfileArc::new((psi, t1, lag), r2, t1, b));
         }
         if edge(last) {
             push(&mut arcs, edge_arc(last));
