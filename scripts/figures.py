@@ -264,8 +264,7 @@ def fig_bodies(out: Path, n: int = 121, targets=("0", "1/4", "-1/4", "1/7", "-1/
                          energy=xr.DataArray(energy, dims="energy"), shape=shape, cut=cut,
                          fields=["rotation_number"], layout="theta_min", progress=False, **extra)
         n_low = cells.rotation_number.isel(component=0).transpose("energy", "kappa")
-        cmap = plt.get_cmap("RdBu_r").copy()
-        cmap.set_bad("0.8")
+        cmap = plt.get_cmap("RdBu_r").with_extremes(bad="0.8")
         mesh = ax.pcolormesh(kappa, energy, n_low, cmap=cmap, vmin=-1.0, vmax=1.0, shading="nearest")
         for i, t in enumerate(targets):
             curves = ra.resonance(alpha, None, nu, eta, t, shape=shape, cut=cut, kappa_min=k0, kappa_max=k1,
