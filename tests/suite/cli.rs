@@ -799,6 +799,31 @@ fn requests_beyond_any_machine_are_refused_within_a_second() {
             start.elapsed()
         );
     }
+    // Past 2^53 cells (1e24 here) a run is refused even with --allow-large, at once: it sat in
+    // its census with no word.
+    let beyond = d.join("beyond.toml");
+    std::fs::write(
+        &beyond,
+        "name = \"beyond\"\n[body]\nnu = 0.5\neta = 0.5\n[axes]\n\
+         alpha = { start = 0.1, stop = 0.5, num = 1000000 }\n\
+         beta = { start = 1.0, stop = 3.0, num = 1000000 }\n\
+         kappa = { start = 0.0, stop = 2.0, num = 1000000 }\n\
+         energy = { start = 0.5, stop = 4.5, num = 1000000 }\n",
+    )
+    .unwrap();
+    let start = std::time::Instant::now();
+    assert_refused(
+        &[
+            "run",
+            beyond.to_str().unwrap(),
+            "--out",
+            atlas.to_str().unwrap(),
+            "--allow-large",
+        ],
+        "(2^53)",
+        Some(&out.join("none")),
+    );
+    assert!(start.elapsed() < std::time::Duration::from_secs(2));
     // The refusal names the shard count that fits memory and disk, also for grids that need
     // more than 4096 shards or are short of disk alone (1e5 × 1e5 bodies of one cell each
     // named none, or 2 for a 9.5 TB file: the disk was not counted).
