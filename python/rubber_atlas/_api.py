@@ -12,6 +12,7 @@ import os
 import sys
 import time
 import functools
+import gc
 import warnings
 from decimal import Decimal
 from fractions import Fraction
@@ -1234,11 +1235,11 @@ def open_atlas(path: str | Path, check: bool = False, **kwargs) -> xr.Dataset:
     except TypeError as e:
         if "keyword" in str(e):
             raise  # a keyword open_dataset does not take: the caller's mistake, as it is
-        raise ValueError(f"{path}: not a rubber-atlas atlas, or a damaged one: {_one_line(e)}") from None
+        raise ValueError(f"{path}: not a rubber-atlas atlas, or a damaged one: {_dropped(e)}") from None
     except (OSError, ValueError, KeyError, RuntimeError, AttributeError, IndexError) as e:
         # (A damaged object header makes h5py raise almost anything: KeyError, RuntimeError,
         # TypeError "Unknown string encoding", …)
-        raise ValueError(f"{path}: not a rubber-atlas atlas, or a damaged one: {_one_line(e)}") from None
+        raise ValueError(f"{path}: not a rubber-atlas atlas, or a damaged one: {_dropped(e)}") from None
     if not _is_atlas(ds):
         ds.close()
         raise ValueError(f"{path}: not a rubber-atlas atlas (a file of `rubber-atlas run` or `merge` has the "
@@ -1252,6 +1253,30 @@ def open_atlas(path: str | Path, check: bool = False, **kwargs) -> xr.Dataset:
             ds.close()
             raise
     return ds
+
+
+def _dropped(error: BaseException) -> str:
+    """`error` in one line, its traceback dropped at once: a file h5netcdf failed to open lives
+    on in those frames, half made, and its finaliser's own AttributeError ('File' object has no
+    attribute '_writable') was printed as "Exception ignored in …" after the one line that
+    refuses the file. Those finaliser errors are dropped here; any other still reaches
+    sys.unraisablehook."""
+    message = _one_line(error)
+    previous = sys.unraisablehook
+
+    def quiet(report):
+        finaliser = str(getattr(report.object, "__module__", "")).startswith("h5netcdf")
+        if not (isinstance(report.exc_value, AttributeError) and finaliser):
+            previous(report)
+
+    sys.unraisablehook = quiet
+    try:
+        error.__traceback__ = None
+        error.__context__ = None
+        gc.collect()
+    finally:
+        sys.unraisablehook = previous
+    return message
 
 
 def _survives_reading(path: Path) -> None:
