@@ -262,15 +262,15 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
     } else {
         0.0
     };
-    // Beyond 2^53 cells a cell's index is no longer exact as a double, and no machine would
-    // finish such a run: refused even with --allow-large (a grid of 1e24 cells sat in its
-    // census with no word: adversary pass 26).
+    // Beyond 2^64 cells no 64-bit index counts them, and no machine would finish such a run:
+    // refused even with --allow-large (a grid of 1e24 cells sat in its census with no word:
+    // adversary pass 26).
     if need.cells > MOST_CELLS {
         return Err(AtlasError::Atlas {
             path: out.display().to_string(),
             reason: format!(
-                "the run has {:.3e} cells, beyond the {MOST_CELLS:.3e} (2^53) one atlas can \
-                 index, even with --allow-large: use fewer points on the axes",
+                "the run has {:.3e} cells, beyond the {MOST_CELLS:.3e} (2^64) a 64-bit index \
+                 counts, even with --allow-large: use fewer points on the axes",
                 need.cells
             ),
         }
@@ -357,8 +357,8 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
     Ok(())
 }
 
-/// The most cells one run may have: 2^53, below which every cell's index is exact as a double.
-const MOST_CELLS: f64 = 9_007_199_254_740_992.0;
+/// The most cells one run may have: 2^64, what a 64-bit index counts.
+const MOST_CELLS: f64 = 18_446_744_073_709_551_616.0;
 
 /// A shard count that tiles the grid and whose shards each fit in half the available memory
 /// and in the free disk beside `out` (a machine like this one), as a phrase for the refusal.

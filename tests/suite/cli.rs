@@ -799,7 +799,7 @@ fn requests_beyond_any_machine_are_refused_within_a_second() {
             start.elapsed()
         );
     }
-    // Past 2^53 cells (1e24 here) a run is refused even with --allow-large, at once: it sat in
+    // Past 2^64 cells (1e24 here) a run is refused even with --allow-large, at once: it sat in
     // its census with no word.
     let beyond = d.join("beyond.toml");
     std::fs::write(
@@ -820,7 +820,7 @@ fn requests_beyond_any_machine_are_refused_within_a_second() {
             atlas.to_str().unwrap(),
             "--allow-large",
         ],
-        "(2^53)",
+        "(2^64)",
         Some(&out.join("none")),
     );
     assert!(start.elapsed() < std::time::Duration::from_secs(2));
