@@ -75,6 +75,14 @@ pub struct Angle {
 impl Angle {
     /// θ = π/2 exactly (sin 1, cos 0), which no rounded θ gives: cos(FRAC_PI_2) is 6e-17.
     pub const EQUATOR: Angle = Angle { sin: 1.0, cos: 0.0 };
+    /// θ = 0 and θ = π exactly (sin π as a double is 1.2e-16).
+    pub const POLES: [Angle; 2] = [
+        Angle { sin: 0.0, cos: 1.0 },
+        Angle {
+            sin: 0.0,
+            cos: -1.0,
+        },
+    ];
 
     /// The angle θ itself.
     #[inline]

@@ -687,17 +687,8 @@ fn level_offset_error<S: Shape>(
         .iter()
         .filter(|e| potential.kappa != 0.0 && chart(e) < 0.1)
         .filter_map(|e| {
-            let (pole, index) = if e.theta <= e.from_pi {
-                (Angle { sin: 0.0, cos: 1.0 }, 0)
-            } else {
-                (
-                    Angle {
-                        sin: 0.0,
-                        cos: -1.0,
-                    },
-                    1,
-                )
-            };
+            let index = usize::from(e.theta > e.from_pi);
+            let pole = Angle::POLES[index];
             let curvature = shape.potential_second_at(pole);
             (!shape.faces()[index] && curvature < 0.0).then(|| {
                 (energy - shape.potential_at(pole)).abs()
