@@ -408,7 +408,7 @@ impl Ellipsoid {
         cos: DoubleDouble,
     ) -> (DoubleDouble, DoubleDouble, f64) {
         let bs = sin.mul_f64(self.beta);
-        let z = bs.mul(bs).add(cos.mul(cos)).sqrt();
+        let z = bs.mul(bs).add_same_sign(cos.mul(cos)).sqrt();
         let offset = cos.mul_f64(self.alpha);
         let error = crate::dd::RELATIVE_ERROR * (z.hi + offset.hi.abs());
         (z, z.add(offset), error)
@@ -652,7 +652,7 @@ impl Shape for Ellipsoid {
             .mul_f64(self.beta)
             .add_f64(-1.0);
         let slope = sin.mul(b.mul(cos).div(z).add_f64(-self.alpha));
-        let r2 = u.mul(u).add(slope.mul(slope));
+        let r2 = u.mul(u).add_same_sign(slope.mul(slope));
         (r2.hi.is_finite() && r2.lo.is_finite()).then_some((u, error, r2))
     }
 
@@ -791,8 +791,9 @@ impl<S: Shape> Body<S> {
             .shape
             .potential_and_contact_distance_sq_double_double(sin, cos)?;
         let scaled_inertia = r2.mul_f64(self.eta).add_f64(1.0);
-        let axial = sin.mul(sin).mul_f64(self.nu).add(cos.mul(cos));
-        let scaled_integral_factor_sq = axial.add(potential.mul(potential).mul_f64(self.eta));
+        let axial = sin.mul(sin).mul_f64(self.nu).add_same_sign(cos.mul(cos));
+        let scaled_integral_factor_sq =
+            axial.add_same_sign(potential.mul(potential).mul_f64(self.eta));
         let finite = |x: DoubleDouble| x.hi.is_finite() && x.lo.is_finite();
         (finite(scaled_inertia)
             && finite(scaled_integral_factor_sq)

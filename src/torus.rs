@@ -3205,17 +3205,22 @@ pub(super) const PRECISE_NODE_ROUNDING: f64 = 6.0 * EPS;
 /// of `piece`) is taken where this one is not to be had (a shape with no double-double form,
 /// an end with no sharp pair, a node within a placed end's shift, an overflow), or where the
 /// two differ by more than the double one's bound (of `plain`, the piece with its gaps in
-/// double: that would be a fault here).
+/// double: that would be a fault here). `known` is that node in double where it was taken
+/// already (the level's nodes before they are taken again): it is not computed twice.
 fn precise_sample<S: Shape>(
     v: &EffectivePotential<'_, S>,
     piece: &Piece,
     plain: &Piece,
     energy: f64,
     node: IntervalNode,
+    known: Option<NodeSample>,
 ) -> Result<NodeSample> {
     if let Some(precise) = precise_node(v, piece, node) {
         // (Checked against the node in double with its gap in double: the cheaper one.)
-        let double = sample(v, plain, energy, node)?;
+        let double = match known {
+            Some(double) => double,
+            None => sample(v, plain, energy, node)?,
+        };
         let within = |a: f64, b: f64| (a - b).abs() <= 0.5 * double.rounding * b.abs();
         if within(precise.dt, double.dt) && within(precise.dpsi, double.dpsi) {
             return Ok(precise);

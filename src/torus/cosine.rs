@@ -254,10 +254,9 @@ fn integrate_on<S: Shape>(
             if converged && (within || (improves && drift_freed)) {
                 resampled = true;
                 precise = can_be_precise;
-                let intervals = samples.intervals;
-                match Samples::new(v, piece, map, energy, intervals, precise) {
+                match samples.taken_again(v, piece, map, energy, precise) {
                     Some(resampled) => samples = resampled,
-                    None => return Ok(Err(samples.nodes.len() + intervals + 1)),
+                    None => return Ok(Err(2 * samples.nodes.len())),
                 }
                 continue;
             }
@@ -307,7 +306,7 @@ fn integrate_on<S: Shape>(
         let current = if resampled { piece } else { &plain };
         let at = |node| {
             if resampled && precise {
-                precise_sample(v, piece, &plain, energy, node)
+                precise_sample(v, piece, &plain, energy, node, None)
             } else {
                 sample(v, current, energy, node)
             }
@@ -360,12 +359,42 @@ impl Samples {
             let node = map.node(n, j);
             nodes.push(
                 if precise {
-                    precise_sample(v, piece, &in_double, energy, node)
+                    precise_sample(v, piece, &in_double, energy, node, None)
                 } else {
                     sample(v, piece, energy, node)
                 }
                 .ok()?,
             );
+        }
+        nodes.push(end_sample(v, piece, map, false)?);
+        Some(Self {
+            intervals: n,
+            nodes,
+            drifts: Vec::new(),
+        })
+    }
+
+    /// The same nodes taken again for `piece` (with its sharp ends), in double-double where
+    /// `precise` ([`precise_sample`], checked against these nodes, which are its nodes in
+    /// double: the same sites, the gaps in double), else in double with the sharp gaps.
+    fn taken_again<S: Shape>(
+        &self,
+        v: &EffectivePotential<'_, S>,
+        piece: &Piece,
+        map: &Map,
+        energy: f64,
+        precise: bool,
+    ) -> Option<Self> {
+        let n = self.intervals;
+        if !precise {
+            return Self::new(v, piece, map, energy, n, false);
+        }
+        let in_double = piece.in_double();
+        let mut nodes = Vec::with_capacity(2 * LAST_INTERVALS + 1);
+        nodes.push(end_sample(v, piece, map, true)?);
+        for (j, &double) in self.nodes.iter().enumerate().take(n).skip(1) {
+            let node = map.node(n, j);
+            nodes.push(precise_sample(v, piece, &in_double, energy, node, Some(double)).ok()?);
         }
         nodes.push(end_sample(v, piece, map, false)?);
         Some(Self {
