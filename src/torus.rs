@@ -2890,13 +2890,19 @@ impl PieceSamples {
                     // (The matrix's row i against the rates: the same linear map as the
                     // transforms, without their set-up, which dominated the drift's cost on
                     // the few nodes of most pieces.)
+                    //
+                    // Column by column: each ψ_i still sums its terms in the order of the rates
+                    // (bit for bit the row's dot product), but the nodes' sums run side by
+                    // side, where one row's sum was a chain of dependent additions (half the
+                    // drift's time on a truncated ball).
                     Some(matrix) => {
-                        let rates: Vec<f64> = rates.collect();
-                        out.extend(
-                            matrix
-                                .chunks_exact(rates.len())
-                                .map(|row| row.iter().zip(&rates).map(|(m, r)| m * r).sum::<f64>()),
-                        );
+                        let count = kind.count(level);
+                        out.resize(count, -0.0);
+                        for (column, rate) in matrix.chunks_exact(count).zip(rates) {
+                            for (psi, m) in out.iter_mut().zip(column) {
+                                *psi += m * rate;
+                            }
+                        }
                     }
                     None => chebyshev_psi_along(kind, level, rates, out),
                 }
@@ -2944,8 +2950,9 @@ fn chebyshev_psi_along(
 /// piece: 17,000 entries).
 const PSI_MATRIX_LEVELS: u32 = 7;
 
-/// [`chebyshev_psi_along`] of `kind` on `level` as a row-major count × count matrix (its
-/// columns the images of the unit vectors), built once; `None` above [`PSI_MATRIX_LEVELS`].
+/// [`chebyshev_psi_along`] of `kind` on `level` as a column-major count × count matrix (its
+/// columns, stored one after another, the images of the unit vectors), built once; `None`
+/// above [`PSI_MATRIX_LEVELS`].
 fn chebyshev_psi_matrix(kind: ChebyshevPiece, level: u32) -> Option<&'static [f64]> {
     const LEVELS: usize = PSI_MATRIX_LEVELS as usize + 1;
     static MATRICES: [[OnceLock<Vec<f64>>; LEVELS]; 3] =
@@ -2963,9 +2970,7 @@ fn chebyshev_psi_matrix(kind: ChebyshevPiece, level: u32) -> Option<&'static [f6
                 (0..count).map(|i| f64::from(i == j)),
                 &mut column,
             );
-            for (i, value) in column.iter().enumerate() {
-                matrix[i * count + j] = *value;
-            }
+            matrix[j * count..(j + 1) * count].copy_from_slice(&column);
         }
         matrix
     }))
