@@ -2735,25 +2735,54 @@ impl PieceSamples {
         self.sample_sums().size[part]
     }
 
+    /// In one pass over the nodes, the ten sums side by side (each [`Self::sum`]'s terms in
+    /// its order: the same values, where ten passes made ten chains of dependent additions).
     fn sample_sums(&self) -> &SampleSums {
         self.sums.get_or_init(|| {
-            let levels = |f: fn(&NodeSample) -> f64| {
-                std::array::from_fn(|k| {
-                    let k = k as u32;
-                    let exists = match self.rule {
-                        Rule::TanhSinh => k < 3 || self.level >= 4,
-                        Rule::Chebyshev(_) => self.level > k,
-                    };
-                    if exists {
-                        self.sum(k, f)
-                    } else {
-                        f64::NAN
+            let weights: [Option<Weights>; 4] = std::array::from_fn(|k| {
+                let k = k as u32;
+                let exists = match self.rule {
+                    Rule::TanhSinh => k < 3 || self.level >= 4,
+                    Rule::Chebyshev(_) => self.level > k,
+                };
+                exists.then(|| self.weights(k))
+            });
+            let mut by_level = [[CompensatedSum::default(); 4]; 2];
+            let mut size = [CompensatedSum::default(); 2];
+            for (i, n) in self.nodes.iter().enumerate() {
+                for (k, w) in weights.iter().enumerate() {
+                    if i % (1 << k) != 0 {
+                        continue;
                     }
-                })
+                    let weight = match w {
+                        Some(Weights::Uniform(_)) => 1.0,
+                        Some(Weights::Table(table)) => match table.get(i >> k) {
+                            Some(&w) => w,
+                            None => continue,
+                        },
+                        None => continue,
+                    };
+                    let term = |x: f64| match w {
+                        Some(Weights::Table(_)) => weight * x,
+                        _ => x,
+                    };
+                    by_level[DT][k].add(term(n.dt));
+                    by_level[DPSI][k].add(term(n.dpsi));
+                    if k == 0 {
+                        size[DT].add(term(n.dt.abs()));
+                        size[DPSI].add(term(n.dpsi.abs()));
+                    }
+                }
+            }
+            let value = |k: usize, sum: CompensatedSum| match weights[k] {
+                Some(Weights::Uniform(step)) => step * sum.value(),
+                Some(Weights::Table(_)) => sum.value(),
+                None => f64::NAN,
             };
             SampleSums {
-                by_level: [levels(|n| n.dt), levels(|n| n.dpsi)],
-                size: [self.sum(0, |n| n.dt.abs()), self.sum(0, |n| n.dpsi.abs())],
+                by_level: [DT, DPSI]
+                    .map(|part| std::array::from_fn(|k| value(k, by_level[part][k]))),
+                size: [DT, DPSI].map(|part| value(0, size[part])),
             }
         })
     }
