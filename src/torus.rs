@@ -2754,18 +2754,16 @@ impl PieceSamples {
                     if i % (1 << k) != 0 {
                         continue;
                     }
+                    // (A uniform level's step multiplies its sum, a table's weights each term.)
                     let weight = match w {
-                        Some(Weights::Uniform(_)) => 1.0,
+                        Some(Weights::Uniform(_)) => None,
                         Some(Weights::Table(table)) => match table.get(i >> k) {
-                            Some(&w) => w,
+                            Some(&w) => Some(w),
                             None => continue,
                         },
                         None => continue,
                     };
-                    let term = |x: f64| match w {
-                        Some(Weights::Table(_)) => weight * x,
-                        _ => x,
-                    };
+                    let term = |x: f64| weight.map_or(x, |w| w * x);
                     by_level[DT][k].add(term(n.dt));
                     by_level[DPSI][k].add(term(n.dpsi));
                     if k == 0 {

@@ -129,8 +129,7 @@ fn integrate_on<S: Shape>(
     // Whether the resampled nodes have their integrands in double-double too: decided where
     // the nodes are taken again.
     let mut precise = false;
-    let Some(mut samples) = Samples::new(v, &plain, map, energy, first_intervals(tol), false)
-    else {
+    let Some(mut samples) = Samples::new(v, &plain, map, energy, first_intervals(tol)) else {
         // (A node of the first level outside the allowed set: at most that level spent.)
         return Ok(Err(first_intervals(tol) + 1));
     };
@@ -343,34 +342,16 @@ struct Samples {
 }
 
 impl Samples {
+    /// The nodes of `piece` on `intervals` steps, in double.
     fn new<S: Shape>(
         v: &EffectivePotential<'_, S>,
         piece: &Piece,
         map: &Map,
         energy: f64,
         intervals: usize,
-        precise: bool,
     ) -> Option<Self> {
-        let n = intervals;
-        let mut nodes = Vec::with_capacity(2 * LAST_INTERVALS + 1);
-        nodes.push(end_sample(v, piece, map, true)?);
-        let in_double = piece.in_double();
-        for j in 1..n {
-            let node = map.node(n, j);
-            nodes.push(
-                if precise {
-                    precise_sample(v, piece, &in_double, energy, node, None)
-                } else {
-                    sample(v, piece, energy, node)
-                }
-                .ok()?,
-            );
-        }
-        nodes.push(end_sample(v, piece, map, false)?);
-        Some(Self {
-            intervals: n,
-            nodes,
-            drifts: Vec::new(),
+        Self::taken(v, piece, map, intervals, |_, node| {
+            sample(v, piece, energy, node)
         })
     }
 
@@ -385,16 +366,28 @@ impl Samples {
         energy: f64,
         precise: bool,
     ) -> Option<Self> {
-        let n = self.intervals;
         if !precise {
-            return Self::new(v, piece, map, energy, n, false);
+            return Self::new(v, piece, map, energy, self.intervals);
         }
         let in_double = piece.in_double();
+        Self::taken(v, piece, map, self.intervals, |j, node| {
+            precise_sample(v, piece, &in_double, energy, node, Some(self.nodes[j]))
+        })
+    }
+
+    /// The two ends' samples and `at(j, node)` at each interior node j of `intervals` steps.
+    fn taken<S: Shape>(
+        v: &EffectivePotential<'_, S>,
+        piece: &Piece,
+        map: &Map,
+        intervals: usize,
+        at: impl Fn(usize, IntervalNode) -> Result<NodeSample>,
+    ) -> Option<Self> {
+        let n = intervals;
         let mut nodes = Vec::with_capacity(2 * LAST_INTERVALS + 1);
         nodes.push(end_sample(v, piece, map, true)?);
-        for (j, &double) in self.nodes.iter().enumerate().take(n).skip(1) {
-            let node = map.node(n, j);
-            nodes.push(precise_sample(v, piece, &in_double, energy, node, Some(double)).ok()?);
+        for j in 1..n {
+            nodes.push(at(j, map.node(n, j)).ok()?);
         }
         nodes.push(end_sample(v, piece, map, false)?);
         Some(Self {
