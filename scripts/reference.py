@@ -606,6 +606,33 @@ def reference(alpha, beta, nu, eta, kappa, energy, digits: int = DIGITS) -> list
     return Cell(alpha, beta, nu, eta, kappa, digits).components(energy)
 
 
+def _libration_rates(alpha, beta, nu, eta, kappa, energy, theta_min, theta_max, degree, digits):
+    """For `libration_drift`s (inside mpmath.workdps(digits)): the function φ ↦ (dt/dφ, ψ̇ dt/dφ,
+    dθ/dφ, U, κ/(J sinθ)) at θ = θ_min + L (1 − cos φ)/2, the turning points refined to `digits`,
+    and the Gauss–Legendre rule of `degree` on [−1, 1]."""
+    cell = Cell(alpha, beta, nu, eta, kappa, digits)
+    e = mpmath.mpf(energy)
+
+    def end(theta):
+        return mpmath.findroot(lambda x: cell.potential(at(x)) - e, mpmath.mpf(theta), tol=mpmath.mpf(10) ** (-digits + 5))
+
+    lo, hi = end(theta_min), end(theta_max)
+    length = hi - lo
+
+    def rates(phi):
+        theta = lo + length * (1 - mpmath.cos(phi)) / 2
+        s, c = mpmath.sin(theta), mpmath.cos(theta)
+        slope = length * mpmath.sin(phi) / 2
+        gap = e - cell.potential(at(theta))
+        dt = mpmath.sqrt(cell.inertia(s, c) / (2 * gap)) * abs(slope) if gap > 0 else mpmath.mpf(0)
+        j = cell.integral_factor(s, c)
+        u = cell._z(s, c) + cell.alpha * c
+        return dt, -cell.kappa * c / (j * s * s) * dt, slope, u, cell.kappa / (j * s)
+
+    rule = mpmath.calculus.quadrature.GaussLegendre(mpmath.mp)
+    return rates, rule.calc_nodes(degree, mpmath.mp.prec)
+
+
 def libration_drift(alpha, beta, nu, eta, kappa, energy, theta_min, theta_max, degree: int = 6,
                     digits: int = DIGITS):
     """(|Δζ|, Δψ) of the libration of the ellipsoid cell (α, β, ν, η, κ ≠ 0, ε) between the
@@ -618,28 +645,8 @@ def libration_drift(alpha, beta, nu, eta, kappa, energy, theta_min, theta_max, d
     Gauss–Legendre on [0, 2π] with 3·2^(degree−1) nodes, and ψ(φ) at each node by a rule of its
     own over [0, φ]: no symmetry of the orbit and nothing of the solver's (a trapezoid rule and a
     spectral antiderivative over the way out alone). Compare two degrees for its error."""
-    cell = Cell(alpha, beta, nu, eta, kappa, digits)
     with mpmath.workdps(digits):
-        e = mpmath.mpf(energy)
-
-        def end(theta):
-            return mpmath.findroot(lambda x: cell.potential(at(x)) - e, mpmath.mpf(theta), tol=mpmath.mpf(10) ** (-digits + 5))
-
-        lo, hi = end(theta_min), end(theta_max)
-        length = hi - lo
-        rule = mpmath.calculus.quadrature.GaussLegendre(mpmath.mp)
-        unit = rule.calc_nodes(degree, mpmath.mp.prec)
-
-        def rates(phi):
-            # dt/dφ, ψ̇ dt/dφ, dθ/dφ and U, κ/(J sinθ) at φ.
-            theta = lo + length * (1 - mpmath.cos(phi)) / 2
-            s, c = mpmath.sin(theta), mpmath.cos(theta)
-            slope = length * mpmath.sin(phi) / 2
-            gap = e - cell.potential(at(theta))
-            dt = mpmath.sqrt(cell.inertia(s, c) / (2 * gap)) * abs(slope) if gap > 0 else mpmath.mpf(0)
-            j = cell.integral_factor(s, c)
-            u = cell._z(s, c) + cell.alpha * c
-            return dt, -cell.kappa * c / (j * s * s) * dt, slope, u, cell.kappa / (j * s)
+        rates, unit = _libration_rates(alpha, beta, nu, eta, kappa, energy, theta_min, theta_max, degree, digits)
 
         def integral(f, a, b):
             half = (b - a) / 2
@@ -654,6 +661,42 @@ def libration_drift(alpha, beta, nu, eta, kappa, energy, theta_min, theta_max, d
 
         drift = integral(velocity, mpmath.mpf(0), 2 * mpmath.pi)
         return abs(drift), psi_at(2 * mpmath.pi)
+
+
+def libration_drift_graded(alpha, beta, nu, eta, kappa, energy, theta_min, theta_max, degree: int = 4,
+                           grading: int = 30, digits: int = DIGITS):
+    """`libration_drift` on panels of φ graded geometrically towards the turning points (φ = 0,
+    π and 2π; the smallest panel 2^(−grading) π/2 wide), Gauss–Legendre with 3·2^(degree−1)
+    nodes on each, ψ at the nodes integrated from the panel's start by the interpolating
+    polynomial of ψ̇ there, and carried from panel to panel: it resolves a sweep by a pole close to a
+    turning point and a turning point close to a saddle, where the integrand is analytic but
+    nearly singular at the panel's end, which the single rule does not. Compare two degrees
+    for its error."""
+    with mpmath.workdps(digits):
+        rates, unit = _libration_rates(alpha, beta, nu, eta, kappa, energy, theta_min, theta_max, degree, digits)
+
+        # ψ at the nodes of a panel from ψ̇ there: the integrals from the panel's start of the
+        # Lagrange polynomials through its nodes (exact for the interpolant of ψ̇).
+        xs = [x for x, _ in unit]
+
+        def lagrange(j, t):
+            return mpmath.fprod((t - xk) / (xs[j] - xk) for k, xk in enumerate(xs) if k != j)
+
+        antiderivative = [[(x + 1) / 2 * mpmath.fsum(w * lagrange(j, -1 + (x + 1) / 2 * (y + 1)) for y, w in unit)
+                           for j in range(len(xs))] for x in xs]
+        quarter = mpmath.pi / 2
+        near = [quarter * mpmath.mpf(2) ** (-k) for k in range(grading, 0, -1)]
+        way = [mpmath.mpf(0)] + near + [quarter] + [mpmath.pi - h for h in reversed(near)] + [mpmath.pi]
+        breaks = way + [mpmath.pi + b for b in way[1:]]
+        psi, drift = mpmath.mpf(0), mpmath.mpc(0)
+        for a, b in zip(breaks, breaks[1:]):
+            half = (b - a) / 2
+            values = [rates(a + half * (x + 1)) for x in xs]
+            for (_, w), row, (dt, _, slope, u, along) in zip(unit, antiderivative, values):
+                swept = psi + half * mpmath.fsum(r * v[1] for r, v in zip(row, values))
+                drift += half * w * -u * mpmath.expj(swept) * mpmath.mpc(along * dt, slope)
+            psi += half * mpmath.fsum(w * v[1] for (_, w), v in zip(unit, values))
+        return abs(drift), psi
 
 
 def critical_levels(alpha, beta, nu, eta, kappa, digits: int = DIGITS) -> list[tuple[float, float]]:

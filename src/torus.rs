@@ -1300,106 +1300,152 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 }
             }
         }
-        let sum = |f: &dyn Fn(&PieceSamples) -> f64| {
-            samples.iter().map(f).sum::<CompensatedSum>().value()
-        };
-        let period = double * sum(&|s| s.period(0));
-        let psi_advance = double * sum(&|s| s.psi(0));
-        let mut period_error = double * sum(&|s| s.error(DT));
-        let mut psi_advance_error = double * sum(&|s| s.error(DPSI));
-        let period_rounding = double * sum(&|s| s.rounding(|n| n.dt));
-        let psi_rounding = double * sum(&|s| s.rounding(|n| n.dpsi));
-        let psi_variation = double * sum(&|s| s.size(DPSI));
-        let saddle = self.placed_saddle_conditioning(energy, component, period, double, residual);
-        let (saddle_t, saddle_psi) = (saddle.period, saddle.psi_advance);
-        period_error += period_rounding + saddle_t;
-        psi_advance_error += psi_rounding + saddle_psi + self.passage_rounding(component);
-        // A turning point nearer its pole than the rule's last node (e^{−π sinh τ_max} of the
-        // piece) hides the peak of ψ̇ ~ κ/sin²θ there, which turns ψ by up to ±π/2 as θ
-        // passes it by a smooth pole: the sums cannot see it, so its whole size goes into the
-        // estimate. By a face (U rising linearly from the pole, B and J² unequal there) the
-        // turn has no such bound: at ν = 2, η = 4 a disk's passage turns ψ by 7.0, N = √5/2
-        // in the limit κ → 0. There Δψ is unknown.
-        let faces = self.body.shape.faces();
-        let hidden: Vec<bool> = if self.kappa == 0.0 {
-            Vec::new()
-        } else {
-            pieces
-                .iter()
-                .flat_map(|p| [(p.left, p.length), (p.right, p.length)])
-                .filter(|(end, length)| {
-                    end.excess == 0.0 && end.site.theta.min(end.site.from_pi) < HIDDEN_PEAK * length
-                })
-                .map(|(end, _)| faces[usize::from(end.site.from_pi < end.site.theta)])
-                .collect()
-        };
-        if !hidden.is_empty() {
-            psi_advance_error += if hidden.iter().any(|&face| face) {
-                f64::INFINITY
-            } else {
-                PI * hidden.len() as f64
+        // (Once, where the rounding of the nodes in double is what keeps the drift from the
+        // tolerance: the tanh-sinh nodes again in double-double, `take_again_precise`.)
+        let mut retaken = false;
+        loop {
+            let sum = |f: &dyn Fn(&PieceSamples) -> f64| {
+                samples.iter().map(f).sum::<CompensatedSum>().value()
             };
-            converged = false;
-        }
-        let mut drift = None;
-        if with_drift {
-            // Rounding in T and Δψ enters the drift through the phases and the weights.
-            // (And the tails of Δψ: a sweep by a pole cut short turns the rest of the path.)
-            let psi_tail = double * sum(&|s| s.tail(|n| n.dpsi));
-            // (And the time spent by a saddle, at the speed there: `saddle.drift`, absolute.)
-            let phase = period_rounding / period.max(1e-300) + psi_rounding + saddle_psi + psi_tail;
-            let mut known = Vec::new();
-            let mut result = drift_estimate(&samples, psi_advance, double, &mut known);
-            for _ in 0..(MAX_LEVEL - START_LEVEL) {
-                // (What the tolerance leaves after the phases' rounding, which is added below,
-                // as for T and Δψ: refined only to the tolerance itself, 25 librations by the
-                // saddle of the standard slice missed 1e-13 by that rounding. Where it leaves
-                // less than a tenth of that rounding, the tolerance itself, as before: the
-                // drift misses it anyway, and refining further only cost work at 1e-14.)
-                let room = tol - phase;
-                let target = if room > 0.1 * phase {
-                    room
+            let period = double * sum(&|s| s.period(0));
+            let psi_advance = double * sum(&|s| s.psi(0));
+            let mut period_error = double * sum(&|s| s.error(DT));
+            let mut psi_advance_error = double * sum(&|s| s.error(DPSI));
+            let (period_quadrature, psi_quadrature) = (period_error, psi_advance_error);
+            let period_rounding = double * sum(&|s| s.rounding(|n| n.dt));
+            let psi_rounding = double * sum(&|s| s.rounding(|n| n.dpsi));
+            let psi_variation = double * sum(&|s| s.size(DPSI));
+            let saddle =
+                self.placed_saddle_conditioning(energy, component, period, double, residual);
+            let (saddle_t, saddle_psi) = (saddle.period, saddle.psi_advance);
+            period_error += period_rounding + saddle_t;
+            psi_advance_error += psi_rounding + saddle_psi + self.passage_rounding(component);
+            // A turning point nearer its pole than the rule's last node (e^{−π sinh τ_max} of the
+            // piece) hides the peak of ψ̇ ~ κ/sin²θ there, which turns ψ by up to ±π/2 as θ
+            // passes it by a smooth pole: the sums cannot see it, so its whole size goes into the
+            // estimate. By a face (U rising linearly from the pole, B and J² unequal there) the
+            // turn has no such bound: at ν = 2, η = 4 a disk's passage turns ψ by 7.0, N = √5/2
+            // in the limit κ → 0. There Δψ is unknown.
+            let faces = self.body.shape.faces();
+            let hidden: Vec<bool> = if self.kappa == 0.0 {
+                Vec::new()
+            } else {
+                pieces
+                    .iter()
+                    .flat_map(|p| [(p.left, p.length), (p.right, p.length)])
+                    .filter(|(end, length)| {
+                        end.excess == 0.0
+                            && end.site.theta.min(end.site.from_pi) < HIDDEN_PEAK * length
+                    })
+                    .map(|(end, _)| faces[usize::from(end.site.from_pi < end.site.theta)])
+                    .collect()
+            };
+            if !hidden.is_empty() {
+                psi_advance_error += if hidden.iter().any(|&face| face) {
+                    f64::INFINITY
                 } else {
-                    tol.max(0.1 * phase)
+                    PI * hidden.len() as f64
                 };
-                if result.error <= target * result.scale
-                    || samples.iter().any(|s| s.level >= MAX_LEVEL)
-                {
-                    break;
-                }
-                let mut refined = true;
-                for (piece, sample) in pieces.iter().zip(samples.iter_mut()) {
-                    if !sample.refine(self, piece, energy)? {
-                        refined = false;
+                converged = false;
+            }
+            let mut drift = None;
+            if with_drift {
+                // Rounding in T and Δψ enters the drift through the phases and the weights.
+                // (And the tails of Δψ: a sweep by a pole cut short turns the rest of the path.)
+                let psi_tail = double * sum(&|s| s.tail(|n| n.dpsi));
+                // (And the time spent by a saddle, at the speed there: `saddle.drift`, absolute.)
+                let phase =
+                    period_rounding / period.max(1e-300) + psi_rounding + saddle_psi + psi_tail;
+                let mut known = Vec::new();
+                let mut result = drift_estimate(&samples, psi_advance, double, &mut known);
+                for _ in 0..(MAX_LEVEL - START_LEVEL) {
+                    // (What the tolerance leaves after the phases' rounding, which is added below,
+                    // as for T and Δψ: refined only to the tolerance itself, 25 librations by the
+                    // saddle of the standard slice missed 1e-13 by that rounding. Where it leaves
+                    // less than a tenth of that rounding, the tolerance itself, as before: the
+                    // drift misses it anyway, and refining further only cost work at 1e-14.)
+                    let room = tol - phase;
+                    let target = if room > 0.1 * phase {
+                        room
+                    } else {
+                        tol.max(0.1 * phase)
+                    };
+                    if result.error <= target * result.scale
+                        || samples.iter().any(|s| s.level >= MAX_LEVEL)
+                    {
                         break;
                     }
+                    let mut refined = true;
+                    for (piece, sample) in pieces.iter().zip(samples.iter_mut()) {
+                        if !sample.refine(self, piece, energy)? {
+                            refined = false;
+                            break;
+                        }
+                    }
+                    if !refined {
+                        // A Clenshaw–Curtis node outside the allowed set: the drift keeps the
+                        // estimate it has.
+                        break;
+                    }
+                    let psi = double * samples.iter().map(|s| s.psi(0)).sum::<f64>();
+                    result = drift_estimate(&samples, psi, double, &mut known);
                 }
-                if !refined {
-                    // A Clenshaw–Curtis node outside the allowed set: the drift keeps the
-                    // estimate it has.
-                    break;
+                // The tolerance missed by the phases' rounding, but met with the integrands in
+                // double-double, and T and Δψ with them: the nodes again. (At tol 1e-14, 910
+                // librations of the standard slice by a pole, κ < 0.05, missed by their drift
+                // alone, all integrated by the tanh-sinh rule, its nodes in double.)
+                // (Half the bound of each node, as `PieceSamples::rounding` counts it, and an
+                // ulp for its gap.)
+                let precise = 0.5 * (PRECISE_NODE_ROUNDING + EPS);
+                let floor_psi = precise * psi_variation + saddle_psi;
+                let floor_phase = precise + floor_psi + psi_tail;
+                let room = tol * result.scale - saddle.drift;
+                let retake = !retaken
+                    && converged
+                    && hidden.is_empty()
+                    && result.error + phase * result.scale > room
+                    && result.error + floor_phase * result.scale <= room
+                    && period_quadrature + precise * period + saddle_t <= tol * period
+                    && psi_quadrature + floor_psi + self.passage_rounding(component) <= tol * TAU
+                    && pieces.iter().zip(&samples).all(|(piece, sample)| {
+                        sample.rule == Rule::TanhSinh && self.gives_precise_nodes(piece)
+                    });
+                if retake {
+                    for (piece, sample) in pieces.iter().zip(samples.iter_mut()) {
+                        sample.take_again_precise(self, piece, energy)?;
+                    }
+                    retaken = true;
+                    continue;
                 }
-                let psi = double * samples.iter().map(|s| s.psi(0)).sum::<f64>();
-                result = drift_estimate(&samples, psi, double, &mut known);
+                result.error += phase * result.scale + saddle.drift;
+                if !hidden.is_empty() {
+                    // The hidden turn rotates the rest of the path: Δζ is unknown to its size.
+                    result.error += result.scale;
+                }
+                drift = Some(result);
             }
-            result.error += phase * result.scale + saddle.drift;
-            if !hidden.is_empty() {
-                // The hidden turn rotates the rest of the path: Δζ is unknown to its size.
-                result.error += result.scale;
-            }
-            drift = Some(result);
+            return Ok(PeriodIntegrals {
+                period,
+                psi_advance,
+                period_error,
+                psi_advance_error,
+                drift,
+                psi_variation: Some(psi_variation),
+                saddle,
+                level_residual: residual,
+                work: spent + samples.iter().map(|s| s.evaluations).sum::<usize>(),
+                converged,
+            });
         }
-        Ok(PeriodIntegrals {
-            period,
-            psi_advance,
-            period_error,
-            psi_advance_error,
-            drift,
-            psi_variation: Some(psi_variation),
-            saddle,
-            level_residual: residual,
-            work: spent + samples.iter().map(|s| s.evaluations).sum::<usize>(),
-            converged,
+    }
+
+    /// Whether [`precise_sample`] can take the nodes of `piece` in double-double: an end with a
+    /// sharp pair, on a shape that gives the reduction in double-double there.
+    fn gives_precise_nodes(&self, piece: &Piece) -> bool {
+        [&piece.left, &piece.right].iter().any(|end| {
+            end.sharp
+                .as_ref()
+                .is_some_and(|s| self.body.reduction_double_double(s.sin, s.cos).is_some())
         })
     }
 
@@ -2637,6 +2683,9 @@ struct PieceSamples {
     least_level: u32,
     nodes: Vec<NodeSample>,
     evaluations: usize,
+    /// Whether the tanh-sinh nodes are taken with their integrands in double-double
+    /// ([`precise_sample`]; see [`Self::take_again_precise`]).
+    precise: bool,
     /// The sums of dt and of dψ on this level and the three below (`period`, `psi`), and
     /// their L1 sizes on this level, made once per level: the refinement's tests and the
     /// results ask for them many times.
@@ -2667,6 +2716,7 @@ impl PieceSamples {
             least_level: 0,
             evaluations: nodes.len(),
             nodes,
+            precise: false,
             sums: OnceCell::new(),
         })
     }
@@ -2691,6 +2741,7 @@ impl PieceSamples {
             least_level,
             evaluations: nodes.len(),
             nodes,
+            precise: false,
             sums: OnceCell::new(),
         })
     }
@@ -2865,6 +2916,28 @@ impl PieceSamples {
         self.sum(0, |n| 0.5 * n.rounding * f(n).abs())
     }
 
+    /// Take a tanh-sinh piece's nodes again with their integrands in double-double
+    /// ([`precise_sample`], each checked against the node in double it replaces), and its
+    /// refinements likewise. (A Clenshaw–Curtis piece keeps its nodes.)
+    fn take_again_precise<S: Shape>(
+        &mut self,
+        v: &EffectivePotential<'_, S>,
+        piece: &Piece,
+        energy: f64,
+    ) -> Result<()> {
+        if self.rule != Rule::TanhSinh || self.precise {
+            return Ok(());
+        }
+        for (j, n) in self.nodes.iter_mut().enumerate() {
+            let node = IntervalNode::tanh_sinh_tabulated(self.level, j, piece.length);
+            *n = precise_sample(v, piece, piece, energy, node, Some(*n))?;
+        }
+        self.evaluations += self.nodes.len();
+        self.precise = true;
+        self.sums = OnceCell::new();
+        Ok(())
+    }
+
     /// Halve the step: keep the old nodes (now the even ones) and add the odd ones. `false`
     /// (the samples unchanged) where a Clenshaw–Curtis node is not in the allowed set.
     fn refine<S: Shape>(
@@ -2875,11 +2948,15 @@ impl PieceSamples {
     ) -> Result<bool> {
         self.sums = OnceCell::new();
         self.level += 1;
-        let level = self.level;
+        let (level, precise) = (self.level, self.precise);
         match self.rule {
             Rule::TanhSinh => interleave(&mut self.nodes, |j| {
                 let node = IntervalNode::tanh_sinh_tabulated(level, j, piece.length);
-                sample(v, piece, energy, node)
+                if precise {
+                    precise_sample(v, piece, piece, energy, node, None)
+                } else {
+                    sample(v, piece, energy, node)
+                }
             })?,
             Rule::Chebyshev(kind) => {
                 // The new (odd) nodes first: where one is not in the allowed set the samples

@@ -1398,10 +1398,21 @@ def _reading(ds: xr.Dataset):
 
 
 def _cells_dataset(ds, what: str) -> None:
-    """Refuses what is not an atlas or a `cells` result (they have ``cell_status``)."""
+    """Refuses what is not an atlas or a `cells` result (they have ``cell_status``), and one
+    selected along its ``component`` dimension."""
     if not isinstance(ds, xr.Dataset) or "cell_status" not in ds:
         raise ValueError(f"{what} reads an atlas (open_atlas) or a cells result; this is not one (it has no "
                          "cell_status)")
+    _with_components(ds, what)
+
+
+def _with_components(ds: xr.Dataset, what: str) -> None:
+    """Refuses a dataset whose ``component`` dimension was selected away (``isel(component=1)``
+    had given numpy's "iteration over a 0-d array": an adversary pass)."""
+    if "component" not in ds.dims:
+        raise ValueError(f"{what} needs the dataset's component dimension, and this one has none (it was "
+                         "selected along it, e.g. isel(component=1)): call it on the dataset before that "
+                         "selection")
 
 
 def flag_names(variable: xr.DataArray) -> dict[int, str]:
@@ -1462,7 +1473,18 @@ def _component_layout(ds: xr.Dataset) -> str:
 def _existing_slots(ds: xr.Dataset, one: xr.Dataset) -> list[int]:
     """The component slots of the cell `one` (a cell of `ds`) that hold a component."""
     if _component_layout(ds) == "theta_min":
-        return list(range(min(int(one.n_components), ds.sizes["component"])))
+        count = min(int(one.n_components), ds.sizes["component"])
+        # Unmarked (the attributes dropped): slots that contradict that layout (a torus
+        # beyond the first n_components slots, or an empty one among them) are another's.
+        # (Without this, drop_attrs() on a dataset by families gave the empty slot of
+        # well_0 for a cell of one well_pi torus: an adversary pass.)
+        if "component_layout" not in ds.attrs and "family" in one:
+            held = [int(v) != 255 for v in np.asarray(one["family"].values)]
+            if held != [i < count for i in range(len(held))]:
+                raise ValueError("which component slots hold this cell's tori is unknown: the dataset has lost "
+                                 "its attributes (component_layout; e.g. drop_attrs()): open the atlas or "
+                                 "compute the cells again")
+        return list(range(count))
     for name, empty in (("family", 255), ("status", 255)):
         if name in one:
             return [i for i, v in enumerate(np.asarray(one[name].values)) if int(v) != empty]

@@ -52,6 +52,8 @@ def resonances(lo: float, hi: float, max_q: int = 7) -> list[float]:
 
 def _family_codes(ds: xr.Dataset) -> dict[str, int]:
     """{name: code} of the torus families the `family` flags of `ds` know."""
+    if "family" in ds:
+        _api._with_components(ds, "ds.rubber.family (and families)")
     if "family" not in ds:
         # (A dataset of no rubber-atlas at all was told it came from an old version of it:
         # adversary pass of 2026-11-28.)

@@ -766,3 +766,26 @@ def test_a_foreign_dataset_and_a_grid_below_its_range_are_named_as_such():
     for grid in (-1, 0, 3):
         refused(ValueError, lambda: ra.resonance(*BODY, "1/2", grid=grid), f"invalid grid = {grid}",
                 "between 4 and 4096")
+
+
+def test_components_of_a_dataset_that_lost_its_attributes_or_its_component_dimension():
+    """`drop_attrs()` on a result by families made `components` read it by increasing θ_min
+    and return the empty slot of well_0 (family 255, N NaN) for a cell of one well_pi torus;
+    after `isel(component=1)` the accessor raised numpy's "iteration over a 0-d array"
+    (adversary pass 28). Both now refuse in one line, or give the right tori."""
+    ds = ra.cells(0.5, 3.0, 0.5, 0.5, kappa=[0.05, 0.8], energy=[2.5, 3.0, 4.0], progress=False)
+    (torus,) = ds.rubber.components(kappa=0.8, energy=4.0)
+    assert torus["family"] == "well_pi"
+    bare = ds.drop_attrs()
+    with pytest.raises(ValueError, match="lost its attributes"):
+        bare.rubber.components(kappa=0.8, energy=4.0)
+    # (Where the slots agree with either layout, the tori are the same.)
+    held = ds.rubber.components(kappa=0.05, energy=2.5)
+    assert [t["family"] for t in held] == ["well_0", "well_pi"]
+    assert [t["rotation_number"] for t in bare.rubber.components(kappa=0.05, energy=2.5)] == \
+        [t["rotation_number"] for t in held]
+    one = ds.isel(component=1)
+    for call in (lambda: one.rubber.components(kappa=0.8, energy=4.0), lambda: one.rubber.family("well_pi"),
+                 lambda: one.rubber.families(), lambda: ra.components(one, kappa=0.8, energy=4.0)):
+        with pytest.raises(ValueError, match="component dimension"):
+            call()

@@ -237,6 +237,35 @@ def test_the_drift_reaches_1e_14_against_50_digits(alpha, beta, nu, eta, kappa, 
         assert error <= comp["errors"]["rotation_number"] <= 1e-14, where
 
 
+def test_the_drift_of_a_sweep_by_a_pole_reaches_1e_14_against_30_digits():
+    """A libration of the standard slice's body sweeping by the pole θ = π (θ_max 4e-3 from it,
+    κ = 0.0078): the tanh-sinh rule integrates it, and its drift missed tol 1e-14 by its nodes'
+    rounding in double (estimate 4.3e-14, status `tolerance_not_reached`); its nodes are now
+    taken again in double-double. Against `reference.libration_drift_graded` (panels graded to
+    the turning points, two degrees that agree to 1e-19; the single-rule reference agrees with
+    itself only to 6e-8 here), the drift, T and N are `ok` and within their estimates."""
+    import reference
+
+    args = (0.5, 3.0, 0.5, 0.5, 0.00784313725490196, 2.2254901960784315)
+    out = subprocess.run(
+        [BIN, "cell", "--alpha", "0.5", "--beta", "3.0", "--nu", "0.5", "--eta", "0.5",
+         "--kappa", repr(args[4]), "--energy", repr(args[5]), "--tol", "1e-14", "--json"],
+        check=True, capture_output=True, text=True,
+    ).stdout
+    components = json.loads(out)["components"]
+    truths = reference.reference(*args)
+    assert len(components) == len(truths) == 2
+    comp, truth = components[1], truths[1]
+    assert np.pi - comp["theta_max"] < 5e-3
+    drifts = [reference.libration_drift_graded(*args, comp["theta_min"], comp["theta_max"], degree=d, grading=20,
+                                               digits=30)[0] for d in (3, 4)]
+    assert abs(drifts[0] - drifts[1]) < 1e-19
+    assert comp["status"] == "ok"
+    assert abs(comp["drift"] - float(drifts[1])) <= comp["errors"]["drift"]
+    assert abs(comp["period"] - truth.period) <= comp["errors"]["period"] <= 1e-14 * comp["period"]
+    assert abs(comp["rotation_number"] - truth.rotation_number) <= comp["errors"]["rotation_number"] <= 1e-14
+
+
 def test_a_level_across_a_saddle_in_its_rounding_keeps_an_honest_period():
     import reference
 

@@ -181,11 +181,51 @@ fn integrate_on<S: Shape>(
         // (Not the passages' term: the drift's phases left it out before it moved here.)
         let phase = (extra_t - saddle_t) / period + nodes_psi;
         let drift_extra = |d: &DriftEstimate| phase * d.scale + saddle.drift;
+        // The rounding the sums would carry with the nodes taken again (below), once: with
+        // their integrands in double-double where the plain map's nodes (offsets and dθ/dφ a
+        // table value times L) are on a shape that gives the reduction in double-double
+        // ([`precise_sample`]), else with every gap to a few ulps.
+        let can_resample = !resampled && piece.left.sharp.is_some();
+        let can_be_precise = can_resample
+            && matches!(map, Map::Plain { .. })
+            && piece
+                .left
+                .sharp
+                .as_ref()
+                .is_some_and(|s| v.body.reduction_double_double(s.sin, s.cos).is_some());
+        let per_node = if can_be_precise {
+            PRECISE_NODE_ROUNDING + EPS
+        } else {
+            INTEGRAND_ROUNDING + 4.0 * EPS
+        };
+        let floor_t = per_node * t_sums[0] + saddle_t;
+        let floor_nodes_psi = per_node * sums.psi_variation + saddle_psi;
+        let floor_psi = floor_nodes_psi + passage_error;
+        let floor_phase = (floor_t - saddle_t) / period + floor_nodes_psi;
+        // What the drift's quadrature may keep of the tolerance: what the phases' rounding
+        // leaves; where that leaves nothing but the double-double nodes' rounding would leave
+        // room and steps are left, that room (the drift refined so far, the nodes then taken
+        // again: at tol 1e-14, 229 librations of the standard slice by its saddle stopped at
+        // 128 steps with the drift's quadrature at 0.3–0.5 of the tolerance and the phases'
+        // floor at 0.64).
+        let steps_left = samples.intervals < LAST_INTERVALS;
+        let drift_budget = |d: &DriftEstimate| {
+            let (allowed, extra) = (tol * d.scale, drift_extra(d));
+            let floor = floor_phase * d.scale + saddle.drift;
+            if allowed - extra < 0.1 * extra
+                && can_be_precise
+                && allowed - floor > 0.1 * floor
+                && steps_left
+            {
+                allowed - floor
+            } else {
+                budget(allowed, extra)
+            }
+        };
         // The drift (the costly part) only once T and Δψ have converged.
         let drift = (done && with_drift).then(|| samples.drift(rate));
-        done &= drift.is_none_or(|d| {
-            d.error <= budget(tol * d.scale, drift_extra(&d)) || d.error <= LEVEL_FLOOR * d.scale
-        });
+        done &=
+            drift.is_none_or(|d| d.error <= drift_budget(&d) || d.error <= LEVEL_FLOOR * d.scale);
         let drift = drift.map(|mut d| {
             d.error += drift_extra(&d);
             d
@@ -200,28 +240,11 @@ fn integrate_on<S: Shape>(
         let over = t_error + extra_t > tol * period
             || psi_error + extra_psi > tol * TAU
             || drift.is_some_and(|d| d.error > tol * d.scale);
-        if (!done || over) && !resampled && piece.left.sharp.is_some() {
-            // (The plain map's nodes, whose offsets and dθ/dφ are a table value times L, on
-            // a shape that gives the reduction in double-double: [`precise_sample`].)
-            let can_be_precise = matches!(map, Map::Plain { .. })
-                && piece
-                    .left
-                    .sharp
-                    .as_ref()
-                    .is_some_and(|s| v.body.reduction_double_double(s.sin, s.cos).is_some());
-            let per_node = if can_be_precise {
-                PRECISE_NODE_ROUNDING + EPS
-            } else {
-                INTEGRAND_ROUNDING + 4.0 * EPS
-            };
-            let floor_t = per_node * t_sums[0] + saddle_t;
-            let floor_nodes_psi = per_node * sums.psi_variation + saddle_psi;
-            let floor_psi = floor_nodes_psi + passage_error;
+        if (!done || over) && can_resample {
             let converged = samples.intervals >= least
                 && trusted
                 && t_error <= 0.5 * tol * period
                 && psi_error <= 0.5 * tol * TAU;
-            let floor_phase = (floor_t - saddle_t) / period + floor_nodes_psi;
             // (Each of T, Δψ and the drift that misses the tolerance would meet it with the
             // floor; one that meets it needs no room: with N alone at tol 1e-14, T missing and
             // Δψ's floor a hair above half the tolerance had kept 300 librations of the
