@@ -125,6 +125,51 @@ fn the_papers_body_holds_and_uncovered_bodies_are_said_so() {
     assert!(v.evidence.rotation_number_range[1] <= 0.0);
 }
 
+/// Small α, large β: the inside of the N = 0 curve by its fold is a tongue about 1e-3 wide
+/// in ε (N > 0 at κ = 5.1779, ε = 41.254: 5.85e-3 here and against 50 digits). The fold was
+/// traced right, 5.1789099, but its polish took the maximum of N over ε ± 0.04 by one golden
+/// section, which missed the tongue: κ_max was 5.1771500 ± 5.8e-12 at tol 1e-10 and 5.1771400
+/// at 1e-13, with unbounded paths above it (adversary pass 28). Now κ_max is the same at
+/// every tolerance, within its bar of the fold traced by `resonance` in another window (tol
+/// 1e-12: 5.178909869695742 ± 1.5e-13), and N > 0 just below it, as at the second body.
+#[test]
+fn kappa_max_is_the_top_of_a_narrow_tongue_of_the_n_zero_curve() {
+    for (alpha, beta, traced) in [
+        (0.075, 27.844069954726358, 5.178909869695742),
+        (0.1, 44.47567486554115, 6.5616428709926335),
+    ] {
+        let body = EllipsoidBody::ellipsoid(alpha, beta, 0.5, 0.5).unwrap();
+        for tol in [1e-10, 1e-13] {
+            let options = VerdictOptions {
+                tol,
+                ..VerdictOptions::default()
+            };
+            let v = verdict(&body, &options).unwrap();
+            let (k, err) = (v.kappa_max.unwrap(), v.kappa_max_error.unwrap());
+            assert!(
+                (k - traced).abs() <= err + 1e-12,
+                "α = {alpha}, tol {tol}: {k} ± {err}"
+            );
+            assert!(err < 1e-9, "{k} ± {err}");
+        }
+    }
+    // Inside the tongue, above the old κ_max: N > 0, its own solver's (ODE) value too.
+    let body = EllipsoidBody::ellipsoid(0.075, 27.844069954726358, 0.5, 0.5).unwrap();
+    for method in [Method::Quadrature, Method::Ode] {
+        let options = CellOptions {
+            method,
+            ..CellOptions::default()
+        };
+        let cell = solve_cell(&body, 5.1779, 41.254, &options).unwrap();
+        assert!(
+            cell.components
+                .iter()
+                .any(|c| (c.rotation_number - 5.8519e-3).abs() < 1e-6),
+            "{method:?}: {cell:?}"
+        );
+    }
+}
+
 /// On the case line β² = 1 + α the cusp is born at κ_c = 0. One ulp above it (β the double
 /// after √1.5 at α = 0.5, after √1.9 at α = 0.9) the fold search opened a resonance window
 /// from κ = 0, which it refused: the verdict failed with "invalid kappa_min = 0", an input
