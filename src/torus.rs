@@ -1442,11 +1442,17 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
     /// Whether [`precise_sample`] can take the nodes of `piece` in double-double: an end with a
     /// sharp pair, on a shape that gives the reduction in double-double there.
     fn gives_precise_nodes(&self, piece: &Piece) -> bool {
-        [&piece.left, &piece.right].iter().any(|end| {
-            end.sharp
-                .as_ref()
-                .is_some_and(|s| self.body.reduction_double_double(s.sin, s.cos).is_some())
-        })
+        [&piece.left, &piece.right]
+            .iter()
+            .any(|end| self.end_gives_precise_nodes(end))
+    }
+
+    /// Whether `end` has a sharp pair at which the shape gives the reduction in double-double
+    /// (what [`precise_sample`] measures its nodes from).
+    fn end_gives_precise_nodes(&self, end: &PieceEnd) -> bool {
+        end.sharp
+            .as_ref()
+            .is_some_and(|s| self.body.reduction_double_double(s.sin, s.cos).is_some())
     }
 
     /// A bound on the rounding of a libration's Δψ by the poles beyond that of its nodes'

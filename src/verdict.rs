@@ -600,11 +600,7 @@ fn polish_fold(
         let v = [1.0, 1e-2, 1e-3, 1e-4]
             .iter()
             .map(|&share| {
-                let (lo, hi) = if share == 1.0 {
-                    (e0, e1)
-                } else {
-                    (fold.energy - share * width, fold.energy + share * width)
-                };
+                let (lo, hi) = (fold.energy - share * width, fold.energy + share * width);
                 golden_max(at, lo, hi, 1e-10 * (1.0 + fold.energy.abs())).1
             })
             .fold(f64::NEG_INFINITY, f64::max);
@@ -649,11 +645,11 @@ fn polish_fold(
     // it, and κ_max came out 1.8e-3 low against an error of 5.8e-12, unbounded paths above
     // it; adversary pass 28.) The traced top then stands, with that step in its error.
     let below = fold.kappa_max - (16.0 * fold.kappa_error).max(1e-9 * fold.kappa_max);
-    if root < below {
-        let n = n_near_well(body, below, fold.energy, fold.well, cell)?;
-        if sign * n > cell.tol {
-            return Some((fold.kappa_max, fold.kappa_max - below + fold.kappa_error));
-        }
+    if root < below
+        && n_near_well(body, below, fold.energy, fold.well, cell)
+            .is_some_and(|n| sign * n > cell.tol)
+    {
+        return Some((fold.kappa_max, fold.kappa_max - below + fold.kappa_error));
     }
     Some((root, error))
 }

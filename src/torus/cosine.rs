@@ -16,7 +16,7 @@ use crate::dd::CompensatedSum;
 use crate::error::Result;
 use crate::quadrature::{real_fft, real_inverse_fft, IntervalNode, FINEST_COSINE_INTERVALS};
 use rustfft::num_complex::Complex;
-use std::cell::RefCell;
+use std::cell::{OnceCell, RefCell};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 use std::sync::OnceLock;
 
@@ -129,6 +129,7 @@ fn integrate_on<S: Shape>(
     // Whether the resampled nodes have their integrands in double-double too: decided where
     // the nodes are taken again.
     let mut precise = false;
+    let precise_ends = OnceCell::new();
     let Some(mut samples) = Samples::new(v, &plain, map, energy, first_intervals(tol)) else {
         // (A node of the first level outside the allowed set: at most that level spent.)
         return Ok(Err(first_intervals(tol) + 1));
@@ -184,24 +185,21 @@ fn integrate_on<S: Shape>(
         // The rounding the sums would carry with the nodes taken again (below), once: with
         // their integrands in double-double where the plain map's nodes (offsets and dθ/dφ a
         // table value times L) are on a shape that gives the reduction in double-double
-        // ([`precise_sample`]), else with every gap to a few ulps.
+        // ([`precise_sample`]), else with every gap to a few ulps. (Whether the shape gives
+        // it is asked once a libration, and only where it matters.)
         let can_resample = !resampled && piece.left.sharp.is_some();
-        let can_be_precise = can_resample
-            && matches!(map, Map::Plain { .. })
-            && piece
-                .left
-                .sharp
-                .as_ref()
-                .is_some_and(|s| v.body.reduction_double_double(s.sin, s.cos).is_some());
-        let per_node = if can_be_precise {
-            PRECISE_NODE_ROUNDING + EPS
-        } else {
-            INTEGRAND_ROUNDING + 4.0 * EPS
+        let can_be_precise = || {
+            can_resample
+                && matches!(map, Map::Plain { .. })
+                && *precise_ends.get_or_init(|| v.end_gives_precise_nodes(&piece.left))
         };
-        let floor_t = per_node * t_sums[0] + saddle_t;
-        let floor_nodes_psi = per_node * sums.psi_variation + saddle_psi;
-        let floor_psi = floor_nodes_psi + passage_error;
-        let floor_phase = (floor_t - saddle_t) / period + floor_nodes_psi;
+        // (The floors of T, of Δψ and of the drift's phases at `per_node`.)
+        let floors = |per_node: f64| {
+            let floor_t = per_node * t_sums[0] + saddle_t;
+            let floor_nodes_psi = per_node * sums.psi_variation + saddle_psi;
+            let floor_phase = (floor_t - saddle_t) / period + floor_nodes_psi;
+            (floor_t, floor_nodes_psi + passage_error, floor_phase)
+        };
         // What the drift's quadrature may keep of the tolerance: what the phases' rounding
         // leaves; where that leaves nothing but the double-double nodes' rounding would leave
         // room and steps are left, that room (the drift refined so far, the nodes then taken
@@ -211,16 +209,13 @@ fn integrate_on<S: Shape>(
         let steps_left = samples.intervals < LAST_INTERVALS;
         let drift_budget = |d: &DriftEstimate| {
             let (allowed, extra) = (tol * d.scale, drift_extra(d));
-            let floor = floor_phase * d.scale + saddle.drift;
-            if allowed - extra < 0.1 * extra
-                && can_be_precise
-                && allowed - floor > 0.1 * floor
-                && steps_left
-            {
-                allowed - floor
-            } else {
-                budget(allowed, extra)
+            if allowed - extra < 0.1 * extra && steps_left && can_be_precise() {
+                let floor = floors(PRECISE_NODE_ROUNDING + EPS).2 * d.scale + saddle.drift;
+                if allowed - floor > 0.1 * floor {
+                    return allowed - floor;
+                }
             }
+            budget(allowed, extra)
         };
         // The drift (the costly part) only once T and Δψ have converged.
         let drift = (done && with_drift).then(|| samples.drift(rate));
@@ -241,6 +236,13 @@ fn integrate_on<S: Shape>(
             || psi_error + extra_psi > tol * TAU
             || drift.is_some_and(|d| d.error > tol * d.scale);
         if (!done || over) && can_resample {
+            let can_be_precise = can_be_precise();
+            let per_node = if can_be_precise {
+                PRECISE_NODE_ROUNDING + EPS
+            } else {
+                INTEGRAND_ROUNDING + 4.0 * EPS
+            };
+            let (floor_t, floor_psi, floor_phase) = floors(per_node);
             let converged = samples.intervals >= least
                 && trusted
                 && t_error <= 0.5 * tol * period
