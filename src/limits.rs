@@ -715,28 +715,55 @@ impl HighEnergyLimit {
 
 /// The maximum of a unimodal `f` on [a, b] by golden-section search to |b − a| ≤ `xtol`:
 /// (argmax, max).
-pub fn golden_max(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64, xtol: f64) -> (f64, f64) {
+pub fn golden_max(f: impl Fn(f64) -> f64, a: f64, b: f64, xtol: f64) -> (f64, f64) {
+    let (x, v, _) = golden_max_settled(f, a, b, xtol, f64::INFINITY);
+    (x, v)
+}
+
+/// [`golden_max`], going on past |b − a| ≤ `xtol` while the values on the bracket (its ends
+/// and its two inner points) still spread by more than `ftol` (a narrow peak's top is still
+/// rising there) and the bracket is wider than 8 ulps: (argmax, max, that spread). Near a
+/// smooth maximum the spread bounds how far the max lies above the value returned (by a
+/// factor about 6 for a parabola), and each step cuts it by about 0.618².
+pub fn golden_max_settled(
+    f: impl Fn(f64) -> f64,
+    mut a: f64,
+    mut b: f64,
+    xtol: f64,
+    ftol: f64,
+) -> (f64, f64, f64) {
     let ratio = 0.5 * (5f64.sqrt() - 1.0);
     let (mut c, mut d) = (b - ratio * (b - a), a + ratio * (b - a));
     let (mut fc, mut fd) = (f(c), f(d));
-    while (b - a).abs() > xtol {
+    // f at a and b, once they are former inner points.
+    let (mut fa, mut fb) = (f64::NAN, f64::NAN);
+    let spread = |fa: f64, fb: f64, fc: f64, fd: f64| {
+        let v = [fa, fb, fc, fd];
+        if v.iter().any(|x| x.is_nan()) {
+            f64::INFINITY
+        } else {
+            v.iter().fold(f64::NEG_INFINITY, |m, &x| m.max(x))
+                - v.iter().fold(f64::INFINITY, |m, &x| m.min(x))
+        }
+    };
+    let floor = 8.0 * f64::EPSILON * a.abs().max(b.abs());
+    while (b - a).abs() > xtol || spread(fa, fb, fc, fd) > ftol && (b - a).abs() > floor {
         if fc > fd {
-            b = d;
-            d = c;
-            fd = fc;
+            (b, fb) = (d, fd);
+            (d, fd) = (c, fc);
             c = b - ratio * (b - a);
             fc = f(c);
         } else {
-            a = c;
-            c = d;
-            fc = fd;
+            (a, fa) = (c, fc);
+            (c, fc) = (d, fd);
             d = a + ratio * (b - a);
             fd = f(d);
         }
     }
+    let spread = spread(fa, fb, fc, fd);
     if fc > fd {
-        (c, fc)
+        (c, fc, spread)
     } else {
-        (d, fd)
+        (d, fd, spread)
     }
 }

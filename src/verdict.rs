@@ -28,7 +28,7 @@ mod census;
 use crate::cell::{solve_component, CellOptions, Status};
 use crate::critical::{CriticalSet, DiagramType};
 use crate::error::{check_range, AtlasError, Result};
-use crate::limits::{golden_max, HighEnergyLimit};
+use crate::limits::{golden_max, golden_max_settled, HighEnergyLimit};
 use crate::resonance::{self, bracketed_root, ResonanceOptions};
 use crate::torus::{CriticalKind, EffectivePotential, MotionKind};
 use crate::EllipsoidBody;
@@ -38,6 +38,7 @@ pub use census::{
 };
 use rayon::prelude::*;
 use serde::Serialize;
+use std::cell::RefCell;
 
 /// The smallest κ-line of case 1: below it N has its κ → 0 limits (±1/2 near one pole,
 /// O(κ) across both, and between them in a band of width ~κ √|U″| round the level of a pole
@@ -562,6 +563,31 @@ fn n_near_well(
 /// Relative error bar of a κ_max that could not be solved from N = 0, ∂N/∂ε = 0.
 const CORNER_ERROR: f64 = 1e-4;
 
+/// M(κ) of [`polish_fold`] at one κ: the best maximum of ±N over its windows, the height
+/// above the well's bottom where it lies, and the spread of N over its section's last bracket
+/// (how far M may lie above the value found).
+#[derive(Debug, Clone, Copy)]
+struct RidgePoint {
+    kappa: f64,
+    m: f64,
+    height: f64,
+    spread: f64,
+}
+
+/// The bottom of V at κ: its minimum nearest `well` (the well [`n_near_well`] takes).
+fn well_bottom(body: &EllipsoidBody, kappa: f64, well: f64) -> Option<f64> {
+    EffectivePotential::new(body, kappa)
+        .critical_points()
+        .iter()
+        .filter(|p| p.kind == CriticalKind::Minimum)
+        .min_by(|p, q| {
+            (p.site.theta - well)
+                .abs()
+                .total_cmp(&(q.site.theta - well).abs())
+        })
+        .map(|p| p.value)
+}
+
 fn polish_fold(
     body: &EllipsoidBody,
     fold: &resonance::Fold,
@@ -589,55 +615,123 @@ fn polish_fold(
     } else {
         return None;
     };
-    // M(κ) is at least the best of local maxima: the golden section over the whole window,
-    // and over windows 1e-2, 1e-3 and 1e-4 as wide round the traced top's energy (near the
-    // top the inside of the curve is a tongue far narrower than the window: adversary pass
-    // 28, below; at tol 1e-13 the traced top's energy was 5e-5 off).
+    // M(κ) is at least the best of local maxima: golden sections over the whole window and
+    // over windows 1e-2, 1e-3 and 1e-4 as wide (near the top the inside of the curve is a
+    // tongue far narrower than the window). The windows follow the ridge of the tongue: they
+    // are centred at the height above the well's bottom, ε − V_min(κ), of the maximum found
+    // at the nearest κ where it is inside the curve (M > 0), at first the traced top's. The
+    // bottom moves with κ (dV_min/dκ ≈ 14 at α = 0.0061, β = 193, where the tongue is 1e-5
+    // wide in ε): windows fixed in ε lost the ridge between two κ 1e-11 apart, M jumped from
+    // +0.03 to −6e-4 there and the root was that jump, 1.3e-3 below the fold (adversary
+    // pass 29).
+    let height_at_top = fold.energy - well_bottom(body, fold.kappa_max, fold.well)?;
+    let evaluations: RefCell<Vec<RidgePoint>> = RefCell::new(Vec::new());
     let m = |kappa: f64| -> Result<f64> {
+        let not_found = AtlasError::NotPeriodic {
+            reason: "no torus of the fold's family near it",
+        };
+        let bottom = well_bottom(body, kappa, fold.well).ok_or(not_found.clone())?;
+        let height = evaluations
+            .borrow()
+            .iter()
+            .filter(|p| p.m > 0.0)
+            .min_by(|p, q| (p.kappa - kappa).abs().total_cmp(&(q.kappa - kappa).abs()))
+            .map_or(height_at_top, |p| p.height);
+        let centre = bottom + height;
         let at = |e: f64| {
             n_near_well(body, kappa, e, fold.well, cell).map_or(f64::NEG_INFINITY, |n| sign * n)
         };
-        let v = [1.0, 1e-2, 1e-3, 1e-4]
+        // Each section goes on until the values on its bracket agree to the tolerance: at a
+        // tongue 1e-5 wide, N'' ~ 1e8 and a bracket of 1e-10 ε left M 1e-8 low.
+        let (energy, v, spread) = [1.0, 1e-2, 1e-3, 1e-4]
             .iter()
             .map(|&share| {
-                let (lo, hi) = (fold.energy - share * width, fold.energy + share * width);
-                golden_max(at, lo, hi, 1e-10 * (1.0 + fold.energy.abs())).1
+                let (lo, hi) = (centre - share * width, centre + share * width);
+                golden_max_settled(at, lo, hi, 1e-10 * (1.0 + centre.abs()), cell.tol)
             })
-            .fold(f64::NEG_INFINITY, f64::max);
-        if v.is_finite() {
-            Ok(v)
-        } else {
-            Err(AtlasError::NotPeriodic {
-                reason: "no torus of the fold's family near it",
-            })
+            .fold((f64::NAN, f64::NEG_INFINITY, f64::NAN), |best, w| {
+                if w.1 > best.1 {
+                    w
+                } else {
+                    best
+                }
+            });
+        if !v.is_finite() {
+            return Err(not_found);
         }
+        evaluations.borrow_mut().push(RidgePoint {
+            kappa,
+            m: v,
+            height: energy - bottom,
+            spread,
+        });
+        Ok(v)
     };
-    // A bracket [a, b] around the root, M(a) > 0 > M(b).
-    let mut step = 1e-6 * fold.kappa_max;
-    let (mut a, mut b) = (fold.kappa_max, fold.kappa_max);
-    let (mut fa, mut fb) = (m(a).ok()?, m(b).ok()?);
-    // Only close to the traced top: further off, M is not the fold's.
+    // A bracket [a, b] around the root, M(a) > 0 > M(b), only close to the traced top
+    // (further off, M is not the fold's): from (a, b), a stepped down while M(a) ≤ 0 and b up
+    // while M(b) ≥ 0, the steps doubling.
     let (floor, ceiling) = (fold.kappa_max * 0.99, fold.kappa_max * 1.01);
-    for _ in 0..30 {
-        if fa > 0.0 && fb < 0.0 || a < floor || b > ceiling {
+    let bracket = |(mut a, mut fa): (f64, f64), (mut b, mut fb): (f64, f64)| {
+        let mut step = 1e-6 * fold.kappa_max;
+        for _ in 0..30 {
+            if fa > 0.0 && fb < 0.0 || a < floor || b > ceiling {
+                break;
+            }
+            if fa <= 0.0 {
+                a -= step;
+                fa = m(a).ok()?;
+            }
+            if fb >= 0.0 {
+                b += step;
+                fb = m(b).ok()?;
+            }
+            step *= 2.0;
+        }
+        (fa > 0.0 && fb < 0.0 && a >= floor && b <= ceiling).then_some(((a, fa), (b, fb)))
+    };
+    let top = (fold.kappa_max, m(fold.kappa_max).ok()?);
+    let ((mut a, mut fa), (mut b, mut fb)) = bracket(top, top)?;
+    let mut root = f64::NAN;
+    // M(b) < 0 is only as good as the windows at b: where they were centred before the ridge
+    // near the root was known, M(b) can be a false negative and the root a jump of M. So the
+    // root is checked from just above it, its windows now on the ridge; M > 0 there goes on
+    // upward from that κ.
+    for _ in 0..8 {
+        // To M's own resolution, the tolerance through its slope (no finer than 4 ulps).
+        let resolution = 4.0 * cell.tol / ((fb - fa) / (b - a)).abs() / b.abs();
+        let xtol = resolution.clamp(4.0 * f64::EPSILON, 1e-12);
+        let width;
+        (root, width) = illinois(m, (a, fa), (b, fb), xtol).ok()?;
+        let above = root + 2.0 * width.max(1e-12 * root);
+        let m_above = m(above).ok()?;
+        if m_above < 0.0 {
             break;
         }
-        if fa <= 0.0 {
-            a -= step;
-            fa = m(a).ok()?;
-        }
-        if fb >= 0.0 {
-            b += step;
-            fb = m(b).ok()?;
-        }
-        step *= 2.0;
+        ((a, fa), (b, fb)) = bracket((above, m_above), (above, m_above))?;
+        root = f64::NAN;
     }
-    if !(fa > 0.0 && fb < 0.0) || a < floor || b > ceiling {
+    if !root.is_finite() {
         return None;
     }
-    let (root, width) = illinois(m, (a, fa), (b, fb), 1e-12).ok()?;
-    let slope = (fb - fa) / (b - a);
-    let error = width + cell.tol / slope.abs().max(f64::MIN_POSITIVE);
+    // The innermost evaluations on either side, M(lower) > 0 > M(upper): the root is the
+    // secant's between them, within the larger of its distances to them and M's own error
+    // (the tolerance and the sections' spread) through the slope.
+    let (lower, upper) = {
+        let all = evaluations.borrow();
+        let lower = *all
+            .iter()
+            .filter(|p| p.m > 0.0 && p.kappa <= root)
+            .max_by(|p, q| p.kappa.total_cmp(&q.kappa))?;
+        let upper = *all
+            .iter()
+            .filter(|p| p.m < 0.0 && p.kappa >= root)
+            .min_by(|p, q| p.kappa.total_cmp(&q.kappa))?;
+        (lower, upper)
+    };
+    let slope = (upper.m - lower.m) / (upper.kappa - lower.kappa);
+    let root = lower.kappa - lower.m / slope;
+    let error = (root - lower.kappa).max(upper.kappa - root)
+        + (cell.tol + lower.spread.max(upper.spread)) / slope.abs().max(f64::MIN_POSITIVE);
     // M(κ) ≥ ±N(κ, ε) at every ε: where N at the traced top's energy, a little below its κ,
     // already has the sign of the inside of the curve, the root lies above that κ, and a
     // root below it is a maximum found off the curve's tongue, not M. (α = 0.075, β = 27.84:
