@@ -722,7 +722,8 @@ pub fn golden_max(f: impl Fn(f64) -> f64, a: f64, b: f64, xtol: f64) -> (f64, f6
 
 /// [`golden_max`], going on past |b − a| ≤ `xtol` while the values on the bracket (its ends
 /// and its two inner points) still spread by more than `ftol` (a narrow peak's top is still
-/// rising there) and the bracket is wider than 8 ulps: (argmax, max, that spread). Near a
+/// rising there) and the bracket is wider than 8 ulps: (argmax, max, that spread, infinite
+/// where f is −∞ at a point of the bracket or the maximum is at an end of [a, b]). Near a
 /// smooth maximum the spread bounds how far the max lies above the value returned (by a
 /// factor about 6 for a parabola), and each step cuts it by about 0.618².
 pub fn golden_max_settled(
@@ -735,7 +736,8 @@ pub fn golden_max_settled(
     let ratio = 0.5 * (5f64.sqrt() - 1.0);
     let (mut c, mut d) = (b - ratio * (b - a), a + ratio * (b - a));
     let (mut fc, mut fd) = (f(c), f(d));
-    // f at a and b, once they are former inner points.
+    // f at a and b, once they are former inner points (a maximum at an end of the window,
+    // never an inner point, has an infinite spread).
     let (mut fa, mut fb) = (f64::NAN, f64::NAN);
     let spread = |fa: f64, fb: f64, fc: f64, fd: f64| {
         let v = [fa, fb, fc, fd];
@@ -747,7 +749,9 @@ pub fn golden_max_settled(
         }
     };
     let floor = 8.0 * f64::EPSILON * a.abs().max(b.abs());
-    while (b - a).abs() > xtol || spread(fa, fb, fc, fd) > ftol && (b - a).abs() > floor {
+    // (A spread that is not finite, an end where f failed, does not shrink: no going on.)
+    let settling = |s: f64| s.is_finite() && s > ftol;
+    while (b - a).abs() > xtol || settling(spread(fa, fb, fc, fd)) && (b - a).abs() > floor {
         if fc > fd {
             (b, fb) = (d, fd);
             (d, fd) = (c, fc);

@@ -524,13 +524,20 @@ fn kappa_max(
         drift: false,
         ..CellOptions::default()
     };
+    // The curve is traced at tol 1e-10 at most, the same at every finer tolerance: its top
+    // only starts the polish below, which solves κ_max at `tol`. (Traced at 1e-13, at
+    // α = 0.0061, β = 193 the curve ended at a corner 0.019 below the fold that 1e-10 found.)
+    let trace = CellOptions {
+        tol: tol.max(1e-10),
+        ..cell
+    };
     for (kappa, energy, grid) in fold_windows(body, set) {
         let options = ResonanceOptions {
             target: 0.0,
             kappa,
             energy,
             grid,
-            cell,
+            cell: trace,
             max_points: 20_000,
             max_point_error: 1e-6,
             natural_scales: false,
@@ -559,6 +566,11 @@ fn n_near_well(
     resonance::evaluate(&EffectivePotential::new(body, kappa), energy, well, cell)
         .map(|p| p.rotation_number)
 }
+
+/// The most evaluations of M(κ) one polish of κ_max makes (each four golden sections; at
+/// most 23 on the bodies of the tests, 109 at α = 1e-6, β = 3, ν = 0.01, η = 1000 where M
+/// jumps between features and no root holds).
+const M_EVALUATIONS: usize = 64;
 
 /// Relative error bar of a κ_max that could not be solved from N = 0, ∂N/∂ε = 0.
 const CORNER_ERROR: f64 = 1e-4;
@@ -619,7 +631,8 @@ fn polish_fold(
     // over windows 1e-2, 1e-3 and 1e-4 as wide (near the top the inside of the curve is a
     // tongue far narrower than the window). The windows follow the ridge of the tongue: they
     // are centred at the height above the well's bottom, ε − V_min(κ), of the maximum found
-    // at the nearest κ where it is inside the curve (M > 0), at first the traced top's. The
+    // at the nearest κ where it is inside the curve (M > 0, a smooth maximum: its section's
+    // spread finite), at first the traced top's. The
     // bottom moves with κ (dV_min/dκ ≈ 14 at α = 0.0061, β = 193, where the tongue is 1e-5
     // wide in ε): windows fixed in ε lost the ridge between two κ 1e-11 apart, M jumped from
     // +0.03 to −6e-4 there and the root was that jump, 1.3e-3 below the fold (adversary
@@ -630,11 +643,15 @@ fn polish_fold(
         let not_found = AtlasError::NotPeriodic {
             reason: "no torus of the fold's family near it",
         };
+        // (A budget: M jumping between features, its root never checked, is no fold.)
+        if evaluations.borrow().len() >= M_EVALUATIONS {
+            return Err(not_found);
+        }
         let bottom = well_bottom(body, kappa, fold.well).ok_or(not_found.clone())?;
         let height = evaluations
             .borrow()
             .iter()
-            .filter(|p| p.m > 0.0)
+            .filter(|p| p.m > 0.0 && p.spread.is_finite())
             .min_by(|p, q| (p.kappa - kappa).abs().total_cmp(&(q.kappa - kappa).abs()))
             .map_or(height_at_top, |p| p.height);
         let centre = bottom + height;
@@ -696,6 +713,23 @@ fn polish_fold(
     // near the root was known, M(b) can be a false negative and the root a jump of M. So the
     // root is checked from just above it, its windows now on the ridge; M > 0 there goes on
     // upward from that κ.
+    // The innermost evaluations on either side of a root, M(lower) > 0 > M(upper).
+    let innermost = |root: f64| {
+        let all = evaluations.borrow();
+        let lower = *all
+            .iter()
+            .filter(|p| p.m > 0.0 && p.kappa <= root)
+            .max_by(|p, q| p.kappa.total_cmp(&q.kappa))?;
+        let upper = *all
+            .iter()
+            .filter(|p| p.m < 0.0 && p.kappa >= root)
+            .min_by(|p, q| p.kappa.total_cmp(&q.kappa))?;
+        // M(lower) > 0 is a value of N, proof enough that the curve reaches that κ; M(upper)
+        // < 0 holds only as far as the section's spread bounds how far the maximum lies
+        // above the value found. A maximum at an end of its window or beside points where N
+        // fails (a separatrix) has no such bound: no smooth fold, the traced top stands.
+        upper.spread.is_finite().then_some((lower, upper))
+    };
     for _ in 0..8 {
         // To M's own resolution, the tolerance through its slope (no finer than 4 ulps).
         let resolution = 4.0 * cell.tol / ((fb - fa) / (b - a)).abs() / b.abs();
@@ -713,25 +747,14 @@ fn polish_fold(
     if !root.is_finite() {
         return None;
     }
-    // The innermost evaluations on either side, M(lower) > 0 > M(upper): the root is the
-    // secant's between them, within the larger of its distances to them and M's own error
-    // (the tolerance and the sections' spread) through the slope.
-    let (lower, upper) = {
-        let all = evaluations.borrow();
-        let lower = *all
-            .iter()
-            .filter(|p| p.m > 0.0 && p.kappa <= root)
-            .max_by(|p, q| p.kappa.total_cmp(&q.kappa))?;
-        let upper = *all
-            .iter()
-            .filter(|p| p.m < 0.0 && p.kappa >= root)
-            .min_by(|p, q| p.kappa.total_cmp(&q.kappa))?;
-        (lower, upper)
-    };
+    // The root is the secant's between the innermost evaluations, within the larger of its
+    // distances to them and M's own error (the tolerance and the sections' spread) through
+    // the slope.
+    let (lower, upper) = innermost(root)?;
     let slope = (upper.m - lower.m) / (upper.kappa - lower.kappa);
     let root = lower.kappa - lower.m / slope;
     let error = (root - lower.kappa).max(upper.kappa - root)
-        + (cell.tol + lower.spread.max(upper.spread)) / slope.abs().max(f64::MIN_POSITIVE);
+        + (cell.tol + upper.spread) / slope.abs().max(f64::MIN_POSITIVE);
     // M(κ) ≥ ±N(κ, ε) at every ε: where N at the traced top's energy, a little below its κ,
     // already has the sign of the inside of the curve, the root lies above that κ, and a
     // root below it is a maximum found off the curve's tongue, not M. (α = 0.075, β = 27.84:
