@@ -6,7 +6,7 @@
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressState, ProgressStyle};
 use rubber_atlas::sweep::Progress;
 use std::io::IsTerminal;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
@@ -27,6 +27,8 @@ pub struct Reporter {
     total: AtomicU64,
     resumed: AtomicU64,
     done: AtomicU64,
+    /// Whether the file is being written: the last tally was printed before that line.
+    writing: AtomicBool,
 }
 
 fn rate_and_eta(done: u64, resumed: u64, total: u64, elapsed: Duration) -> (f64, Option<Duration>) {
@@ -77,6 +79,7 @@ impl Reporter {
             total: AtomicU64::new(0),
             resumed: AtomicU64::new(0),
             done: AtomicU64::new(0),
+            writing: AtomicBool::new(false),
         }
     }
 
@@ -99,8 +102,14 @@ impl Reporter {
     pub fn finish(&self) {
         match &self.mode {
             Mode::Bar(bar) => bar.finish_and_clear(),
-            // Nothing begun (an output already up to date): nothing to report.
-            Mode::Lines { .. } if self.total.load(Ordering::Relaxed) > 0 => self.line(),
+            // Nothing begun (an output already up to date): nothing to report; the tally was
+            // printed before "writing the file".
+            Mode::Lines { .. }
+                if self.total.load(Ordering::Relaxed) > 0
+                    && !self.writing.load(Ordering::Relaxed) =>
+            {
+                self.line()
+            }
             Mode::Lines { .. } => {}
             Mode::Quiet => {}
         }
@@ -219,7 +228,13 @@ impl Progress for Reporter {
     fn writing(&self) {
         match &self.mode {
             Mode::Bar(bar) => bar.set_message("writing the file"),
-            Mode::Lines { .. } => say!("run {}: writing the file", self.name),
+            // The last tally first: every cell is done when the file is written (it came
+            // after "writing the file": an adversary pass).
+            Mode::Lines { .. } => {
+                self.writing.store(true, Ordering::Relaxed);
+                self.line();
+                say!("run {}: writing the file", self.name);
+            }
             Mode::Quiet => {}
         }
     }

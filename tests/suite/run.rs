@@ -1804,3 +1804,28 @@ fn a_shard_that_crashes_hdf5_is_refused_by_merge() {
     );
     assert!(files_named(dir.path(), "merged.h5").is_empty());
 }
+
+/// Without a terminal the progress comes as lines; the last tally (every cell done) comes
+/// before "writing the file", which is the last line (it came after it: an adversary pass).
+#[test]
+fn progress_lines_end_with_the_tally_and_then_the_writing() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = small_scene(dir.path());
+    let out = dir.path().join("o.h5");
+    let output = run(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    ok(&output);
+    let text = String::from_utf8_lossy(&output.stderr).into_owned();
+    let lines: Vec<&str> = text.lines().collect();
+    let n = lines.len();
+    assert!(n >= 2, "{text}");
+    assert_eq!(lines[n - 1], "run small: writing the file", "{text}");
+    assert!(
+        lines[n - 2].starts_with("run small: 3840/3840 cells (100.0%)"),
+        "{text}"
+    );
+}
