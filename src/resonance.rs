@@ -826,7 +826,8 @@ fn check_window(options: &ResonanceOptions) -> Result<()> {
             path: format!("invalid energy_max = {}", crate::error::show(e1)),
             reason: format!(
                 "must be above energy_min = {} (when not given, the lowest minimum of V over \
-                 the window)",
+                 the window): no motion lies below it, so raise energy_max (for β ≫ 1 the \
+                 curves lie at large ε and κ: widen kappa_max too)",
                 crate::error::show(e0)
             ),
         });

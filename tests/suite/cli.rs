@@ -2039,3 +2039,33 @@ fn boundaries_that_find_none_say_so() {
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(text.contains("no boundary found"), "{text}");
 }
+
+/// Adversary pass 30: for a body with β = 1000 the default window (ε ≤ 5) lies below V
+/// (V_min ≈ 7.07 over it); `resonance --fold` was refused naming energy_max = 5, a value the
+/// user never gave, without saying what to do. It still exits 2 with one line, which now says
+/// to raise energy_max and widen kappa_max.
+#[test]
+fn a_default_window_below_v_says_what_to_widen() {
+    let o = run(&[
+        "resonance",
+        "--alpha",
+        "0.001",
+        "--beta",
+        "1000",
+        "--nu",
+        "2",
+        "--eta",
+        "0.001",
+        "--rotation-number",
+        "0",
+        "--fold",
+        "--json",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let text = stderr(&o);
+    assert_eq!(text.trim_end().lines().count(), 1, "{text}");
+    assert!(
+        text.contains("energy_max = 5") && text.contains("raise energy_max"),
+        "{text}"
+    );
+}
