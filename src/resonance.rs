@@ -139,10 +139,7 @@ pub(crate) fn evaluate<S: Shape>(
     well: f64,
     options: &CellOptions,
 ) -> Option<CurvePoint> {
-    let minimum = potential
-        .minimum_sites()
-        .into_iter()
-        .min_by(|a, b| (a - well).abs().total_cmp(&(b - well).abs()))?;
+    let minimum = potential.minimum_nearest(well)?.site.theta;
     let components = potential.components(energy).ok()?;
     let (index, component) = components
         .iter()

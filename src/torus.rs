@@ -373,6 +373,19 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             .collect()
     }
 
+    /// The minimum of V nearest θ = `well` (a well followed from one κ to the next), if V has
+    /// one.
+    pub fn minimum_nearest(&self, well: f64) -> Option<&CriticalPoint> {
+        self.critical
+            .iter()
+            .filter(|p| p.kind == CriticalKind::Minimum)
+            .min_by(|p, q| {
+                (p.site.theta - well)
+                    .abs()
+                    .total_cmp(&(q.site.theta - well).abs())
+            })
+    }
+
     /// The levels of the maxima of V and of its shoulders (an edged body's critical point on
     /// a kink with V monotone through it), sorted: the separatrices. Between two of them N of
     /// one component is continuous in ε; it diverges only at a separatrix.

@@ -586,20 +586,6 @@ struct RidgePoint {
     spread: f64,
 }
 
-/// The bottom of V at κ: its minimum nearest `well` (the well [`n_near_well`] takes).
-fn well_bottom(body: &EllipsoidBody, kappa: f64, well: f64) -> Option<f64> {
-    EffectivePotential::new(body, kappa)
-        .critical_points()
-        .iter()
-        .filter(|p| p.kind == CriticalKind::Minimum)
-        .min_by(|p, q| {
-            (p.site.theta - well)
-                .abs()
-                .total_cmp(&(q.site.theta - well).abs())
-        })
-        .map(|p| p.value)
-}
-
 fn polish_fold(
     body: &EllipsoidBody,
     fold: &resonance::Fold,
@@ -632,12 +618,17 @@ fn polish_fold(
     // tongue far narrower than the window). The windows follow the ridge of the tongue: they
     // are centred at the height above the well's bottom, ε − V_min(κ), of the maximum found
     // at the nearest κ where it is inside the curve (M > 0, a smooth maximum: its section's
-    // spread finite), at first the traced top's. The
-    // bottom moves with κ (dV_min/dκ ≈ 14 at α = 0.0061, β = 193, where the tongue is 1e-5
-    // wide in ε): windows fixed in ε lost the ridge between two κ 1e-11 apart, M jumped from
+    // spread finite), at first the traced top's. The bottom moves with κ (dV_min/dκ ≈ 14 at
+    // α = 0.0061, β = 193, where the tongue is 1e-5 wide in ε): windows fixed in ε lost the ridge between two κ 1e-11 apart, M jumped from
     // +0.03 to −6e-4 there and the root was that jump, 1.3e-3 below the fold (adversary
     // pass 29).
-    let height_at_top = fold.energy - well_bottom(body, fold.kappa_max, fold.well)?;
+    // The bottom of V at κ: its minimum nearest the fold's well (the well n_near_well takes).
+    let well_bottom = |kappa: f64| {
+        EffectivePotential::new(body, kappa)
+            .minimum_nearest(fold.well)
+            .map(|p| p.value)
+    };
+    let height_at_top = fold.energy - well_bottom(fold.kappa_max)?;
     let evaluations: RefCell<Vec<RidgePoint>> = RefCell::new(Vec::new());
     let m = |kappa: f64| -> Result<f64> {
         let not_found = AtlasError::NotPeriodic {
@@ -647,7 +638,7 @@ fn polish_fold(
         if evaluations.borrow().len() >= M_EVALUATIONS {
             return Err(not_found);
         }
-        let bottom = well_bottom(body, kappa, fold.well).ok_or(not_found.clone())?;
+        let bottom = well_bottom(kappa).ok_or(not_found.clone())?;
         let height = evaluations
             .borrow()
             .iter()
@@ -709,10 +700,6 @@ fn polish_fold(
     let top = (fold.kappa_max, m(fold.kappa_max).ok()?);
     let ((mut a, mut fa), (mut b, mut fb)) = bracket(top, top)?;
     let mut root = f64::NAN;
-    // M(b) < 0 is only as good as the windows at b: where they were centred before the ridge
-    // near the root was known, M(b) can be a false negative and the root a jump of M. So the
-    // root is checked from just above it, its windows now on the ridge; M > 0 there goes on
-    // upward from that κ.
     // The innermost evaluations on either side of a root, M(lower) > 0 > M(upper).
     let innermost = |root: f64| {
         let all = evaluations.borrow();
@@ -730,6 +717,10 @@ fn polish_fold(
         // fails (a separatrix) has no such bound: no smooth fold, the traced top stands.
         upper.spread.is_finite().then_some((lower, upper))
     };
+    // M(b) < 0 is only as good as the windows at b: where they were centred before the ridge
+    // near the root was known, M(b) can be a false negative and the root a jump of M. So the
+    // root is checked from just above it, its windows now on the ridge; M > 0 there goes on
+    // upward from that κ.
     for _ in 0..8 {
         // To M's own resolution, the tolerance through its slope (no finer than 4 ulps).
         let resolution = 4.0 * cell.tol / ((fb - fa) / (b - a)).abs() / b.abs();
