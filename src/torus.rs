@@ -1332,7 +1332,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 self.placed_saddle_conditioning(energy, component, period, double, residual);
             let (saddle_t, saddle_psi) = (saddle.period, saddle.psi_advance);
             period_error += period_rounding + saddle_t;
-            psi_advance_error += psi_rounding + saddle_psi + self.passage_rounding(component);
+            psi_advance_error += psi_rounding + saddle_psi;
             // A turning point nearer its pole than the rule's last node (e^{−π sinh τ_max} of the
             // piece) hides the peak of ψ̇ ~ κ/sin²θ there, which turns ψ by up to ±π/2 as θ
             // passes it by a smooth pole: the sums cannot see it, so its whole size goes into the
@@ -1369,6 +1369,20 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 // (And the time spent by a saddle, at the speed there: `saddle.drift`, absolute.)
                 let phase =
                     period_rounding / period.max(1e-300) + psi_rounding + saddle_psi + psi_tail;
+                // The floor of the phases' rounding with the nodes in double-double (below).
+                // (Half the bound of each node, as `PieceSamples::rounding` counts it, and an
+                // ulp for its gap.)
+                let precise = 0.5 * (PRECISE_NODE_ROUNDING + EPS);
+                let floor_psi = precise * psi_variation + saddle_psi;
+                let floor_phase = precise + floor_psi + psi_tail;
+                let may_retake = !retaken
+                    && converged
+                    && hidden.is_empty()
+                    && period_quadrature + precise * period + saddle_t <= tol * period
+                    && psi_quadrature + floor_psi <= tol * TAU
+                    && pieces.iter().zip(&samples).all(|(piece, sample)| {
+                        sample.rule == Rule::TanhSinh && self.gives_precise_nodes(piece)
+                    });
                 let mut known = Vec::new();
                 let mut result = drift_estimate(&samples, psi_advance, double, &mut known);
                 for _ in 0..(MAX_LEVEL - START_LEVEL) {
@@ -1377,9 +1391,16 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                     // saddle of the standard slice missed 1e-13 by that rounding. Where it leaves
                     // less than a tenth of that rounding, the tolerance itself, as before: the
                     // drift misses it anyway, and refining further only cost work at 1e-14.)
+                    // (Where the nodes will be taken again in double-double, what the tolerance
+                    // leaves after their floor: by the standard slice's saddle at tol 1e-14 the
+                    // drift stopped at a tenth of the phases' rounding in double, above what
+                    // the floor left.)
                     let room = tol - phase;
+                    let precise_room = tol - floor_phase;
                     let target = if room > 0.1 * phase {
                         room
+                    } else if may_retake && precise_room > 0.1 * floor_phase {
+                        precise_room
                     } else {
                         tol.max(0.1 * phase)
                     };
@@ -1407,22 +1428,10 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 // double-double, and T and Δψ with them: the nodes again. (At tol 1e-14, 910
                 // librations of the standard slice by a pole, κ < 0.05, missed by their drift
                 // alone, all integrated by the tanh-sinh rule, its nodes in double.)
-                // (Half the bound of each node, as `PieceSamples::rounding` counts it, and an
-                // ulp for its gap.)
-                let precise = 0.5 * (PRECISE_NODE_ROUNDING + EPS);
-                let floor_psi = precise * psi_variation + saddle_psi;
-                let floor_phase = precise + floor_psi + psi_tail;
                 let room = tol * result.scale - saddle.drift;
-                let retake = !retaken
-                    && converged
-                    && hidden.is_empty()
+                let retake = may_retake
                     && result.error + phase * result.scale > room
-                    && result.error + floor_phase * result.scale <= room
-                    && period_quadrature + precise * period + saddle_t <= tol * period
-                    && psi_quadrature + floor_psi + self.passage_rounding(component) <= tol * TAU
-                    && pieces.iter().zip(&samples).all(|(piece, sample)| {
-                        sample.rule == Rule::TanhSinh && self.gives_precise_nodes(piece)
-                    });
+                    && result.error + floor_phase * result.scale <= room;
                 if retake {
                     for (piece, sample) in pieces.iter().zip(samples.iter_mut()) {
                         sample.take_again_precise(self, piece, energy)?;
@@ -1466,25 +1475,6 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         end.sharp
             .as_ref()
             .is_some_and(|s| self.body.reduction_double_double(s.sin, s.cos).is_some())
-    }
-
-    /// A bound on the rounding of a libration's Δψ by the poles beyond that of its nodes'
-    /// integrands: each end within 0.1 of a pole (κ ≠ 0) is a passage by it, which sweeps ψ
-    /// by up to π in a sliver of time, and Δψ may be the small difference of two such sweeps
-    /// (κ → 0 at high energy). The rounding of each sweep — 29 ulps of π measured against 50
-    /// digits at ε = 3e4, κ = −4e-8, α → 1 (whole-domain seed 77), where the nodes' ψ̇ spans
-    /// 20 orders of magnitude — is allowed 64 ulps of π. The plain cosine map, which places
-    /// its nodes to an ulp of their distance from the nearer end, does without it
-    /// (docs/accuracy.md, "The cell solver").
-    pub(crate) fn passage_rounding(&self, component: &Component) -> f64 {
-        if self.kappa == 0.0 || component.kind != MotionKind::Libration {
-            return 0.0;
-        }
-        let passages = [component.lower, component.upper]
-            .iter()
-            .filter(|s| s.theta.min(s.from_pi) <= 0.1)
-            .count();
-        64.0 * EPS * PI * passages as f64
     }
 
     /// The errors of T and Δψ caused by the conditioning of the energy near a saddle (inside

@@ -119,12 +119,6 @@ fn integrate_on<S: Shape>(
     // once the rounding of the gaps is all that keeps the values from the tolerance.
     let plain = piece.in_double();
     let mut resampled = false;
-    // (The plain map places its nodes by a pole to an ulp of their distance from it: its
-    // passages are in the nodes' rounding bound.)
-    let passage_error = match map {
-        Map::Plain { .. } => 0.0,
-        Map::Mercator { .. } => v.passage_rounding(component),
-    };
     let residual = super::level_residual(component, std::slice::from_ref(piece));
     // Whether the resampled nodes have their integrands in double-double too: decided where
     // the nodes are taken again.
@@ -153,8 +147,7 @@ fn integrate_on<S: Shape>(
         let saddle = v.placed_saddle_conditioning(energy, component, period, 2.0, residual);
         let (saddle_t, saddle_psi) = (saddle.period, saddle.psi_advance);
         let extra_t = 2.0 * sums.t_rounding + saddle_t;
-        let nodes_psi = 2.0 * sums.psi_rounding + saddle_psi;
-        let extra_psi = nodes_psi + passage_error;
+        let extra_psi = 2.0 * sums.psi_rounding + saddle_psi;
         let budget = |allowed: f64, extra: f64| (allowed - extra).max(0.1 * extra);
         // Where the differences may be taken as the error: the plain map's (one geometric
         // strip); the Mercator map's only where its last four levels show one rate and the
@@ -179,8 +172,7 @@ fn integrate_on<S: Shape>(
         let psi_advance_error = psi_error + extra_psi;
         // Rounding in T and Δψ enters the drift through the phases and the weights, and the
         // time spent by a saddle at the speed there (`saddle.drift`).
-        // (Not the passages' term: the drift's phases left it out before it moved here.)
-        let phase = (extra_t - saddle_t) / period + nodes_psi;
+        let phase = (extra_t - saddle_t) / period + extra_psi;
         let drift_extra = |d: &DriftEstimate| phase * d.scale + saddle.drift;
         // The rounding the sums would carry with the nodes taken again (below), once: with
         // their integrands in double-double where the plain map's nodes (offsets and dθ/dφ a
@@ -198,7 +190,7 @@ fn integrate_on<S: Shape>(
             let floor_t = per_node * t_sums[0] + saddle_t;
             let floor_nodes_psi = per_node * sums.psi_variation + saddle_psi;
             let floor_phase = (floor_t - saddle_t) / period + floor_nodes_psi;
-            (floor_t, floor_nodes_psi + passage_error, floor_phase)
+            (floor_t, floor_nodes_psi, floor_phase)
         };
         // What the drift's quadrature may keep of the tolerance: what the phases' rounding
         // leaves; where that leaves nothing but the double-double nodes' rounding would leave
