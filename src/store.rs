@@ -169,7 +169,12 @@ impl OutputLock {
                     if e.raw_os_error() == Some(libc::ELOOP) {
                         not_ours("is a symbolic link")
                     } else {
-                        output_error(&path, e)
+                        // (Named by the output asked for: in /proc the lock file cannot be
+                        // made, and its name alone left the user to guess why.)
+                        output_error(
+                            out,
+                            format!("its lock file {} cannot be created: {e}", path.display()),
+                        )
                     }
                 })?;
             if !file.metadata().is_ok_and(|m| m.is_file()) {

@@ -1526,6 +1526,32 @@ fn a_lock_file_that_is_a_symbolic_link_is_never_followed() {
     assert!(!out.exists());
 }
 
+/// Adversary pass 31: an output in a folder where no file can be made (/proc) was refused
+/// naming only its lock file ("cannot write /proc/version.h5.lock: No such file or
+/// directory"). The line names the output asked for and says that its lock file cannot be
+/// created.
+#[test]
+fn an_output_whose_lock_file_cannot_be_made_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = small_scene(dir.path(), 4);
+    let o = run(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        "/proc/version.h5",
+        "--quiet",
+    ]);
+    let said = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{said}");
+    assert_eq!(said.lines().count(), 1, "{said}");
+    assert!(
+        said.contains(
+            "cannot write /proc/version.h5: its lock file /proc/version.h5.lock cannot be created"
+        ),
+        "{said}"
+    );
+}
+
 /// Adversary pass 4: a start (θ(0), θ̇(0)) whose energy lies beyond 1e300 ran (ε = 9.8e307
 /// with T printed as NaN, or status `ok` at 5.6e306) where an energy given directly is
 /// refused; and a scene's energy of −1e301 was reported as 1e301. Each is one line, exit 2,
