@@ -333,8 +333,28 @@ POLE_TOP = [
 ]
 
 
+# Pole wells of oblate bodies (β 50 … 225, α ≈ 0, κ ~ 1e-12 … 3e-11, ε 4e-5 … 4e-4 above the
+# pole's level), integrated in Mercator's coordinate: T's level differences fell fast and then
+# crept (6.6e-7, 3.3e-10, 2.6e-16), and T was `ok` at tol 1e-12 and 1e-13 up to 1.79 times its
+# estimate off; at β = 50 the levels agreed to 2 ulps and T was 40 ulps off, the nodes' places
+# and weights rounded beyond their bound (adversary pass 31). (α, β, ν, η, κ, ε, tol)
+OBLATE_POLE_WELLS = [
+    (alpha, beta, nu, eta, kappa, energy, tol)
+    for alpha, beta, nu, eta, kappa, energy in [
+        (-3.954530629635225e-09, 224.75910815453776, 0.05064984893647105, 50.87606359794578,
+         1.1860121376077897e-12, 1.0000372719826724),
+        (-3.954530629635225e-09, 224.75910815453776, 0.05064984893647105, 50.87606359794578,
+         2.9079276124290017e-11, 1.0000999960454695),
+        (1.7170863560780994e-11, 49.96965766657239, 0.04935171160848611, 13.828262215575178,
+         -2.897900396653392e-12, 1.0004),
+    ]
+    for tol in (1e-12, 1e-13)
+]
+
+
 @pytest.mark.parametrize(
     "alpha, beta, nu, eta, kappa, energy, tol", SHAPE_ROUNDING + UNPLACED + NEEDLE + FIXED_POINTS + CUSP + POLE_TOP
+    + OBLATE_POLE_WELLS
 )
 def test_hard_cells_are_within_their_estimates(alpha, beta, nu, eta, kappa, energy, tol):
     for comp, truth in components_against_reference(alpha, beta, nu, eta, kappa, energy, tol):
@@ -425,31 +445,6 @@ def test_passages_by_a_pole_need_no_allowance_beyond_the_tails(alpha, beta, nu, 
             if alpha == 0.5:
                 assert comp["status"] == "ok" and comp["errors"]["rotation_number"] <= tol, where
     assert passing >= 1
-
-
-# Pole wells of oblate bodies (β 50 … 225, α ≈ 0, κ ~ 1e-12 … 3e-11, ε 4e-5 … 4e-4 above the
-# pole's level), integrated in Mercator's coordinate: T's level differences fell fast and then
-# crept (6.6e-7, 3.3e-10, 2.6e-16), and T was `ok` at tol 1e-12 and 1e-13 up to 1.79 times its
-# estimate off (adversary pass 31). Mercator's differences are now trusted only where the last
-# is no larger than the two before predict for one rate. (α, β, ν, η, κ, ε)
-OBLATE_POLE_WELLS = [
-    (-3.954530629635225e-09, 224.75910815453776, 0.05064984893647105, 50.87606359794578,
-     1.1860121376077897e-12, 1.0000372719826724),
-    (-3.954530629635225e-09, 224.75910815453776, 0.05064984893647105, 50.87606359794578,
-     2.9079276124290017e-11, 1.0000999960454695),
-    (1.7170863560780994e-11, 49.96965766657239, 0.04935171160848611, 13.828262215575178,
-     -2.897900396653392e-12, 1.0004),
-]
-
-
-@pytest.mark.parametrize("tol", [1e-12, 1e-13])
-@pytest.mark.parametrize("alpha, beta, nu, eta, kappa, energy", OBLATE_POLE_WELLS)
-def test_mercators_sums_that_creep_are_not_trusted(alpha, beta, nu, eta, kappa, energy, tol):
-    for comp, truth in components_against_reference(alpha, beta, nu, eta, kappa, energy, tol):
-        where = f"kappa {kappa} tol {tol}: {comp}"
-        assert abs(comp["period"] - float(truth.period)) <= comp["errors"]["period"], where
-        error = abs(comp["rotation_number"] - float(truth.rotation_number))
-        assert error <= comp["errors"]["rotation_number"], where
 
 
 def test_ode_method_is_honest_where_it_converges():
