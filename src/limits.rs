@@ -214,8 +214,8 @@ fn odd_part_integral<S: Shape>(
         }
         let rest = (m as f64 - j) * (FRAC_PI_2 / m as f64) + FRAC_PI_2_LOW * (1.0 - j / m as f64);
         let (u, from_top, sin_2phi) = if phi <= FRAC_PI_4 {
-            let u = phi - 0.25 * a * (4.0 * phi).sin();
-            (u, rest + 0.25 * a * (4.0 * phi).sin(), (2.0 * phi).sin())
+            let shift = 0.25 * a * (4.0 * phi).sin();
+            (phi - shift, rest + shift, (2.0 * phi).sin())
         } else {
             let from_top = rest - 0.25 * a * (4.0 * rest).sin();
             (FRAC_PI_2 - from_top, from_top, (2.0 * rest).sin())

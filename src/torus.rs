@@ -1375,14 +1375,17 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 let precise = 0.5 * (PRECISE_NODE_ROUNDING + EPS);
                 let floor_psi = precise * psi_variation + saddle_psi;
                 let floor_phase = precise + floor_psi + psi_tail;
-                let may_retake = !retaken
+                // (Whether the shape gives its nodes in double-double is asked only where the
+                // rest holds and it matters: this runs for every libration with a drift.)
+                let may_retake_here = !retaken
                     && converged
                     && hidden.is_empty()
                     && period_quadrature + precise * period + saddle_t <= tol * period
                     && psi_quadrature + floor_psi <= tol * TAU
-                    && pieces.iter().zip(&samples).all(|(piece, sample)| {
-                        sample.rule == Rule::TanhSinh && self.gives_precise_nodes(piece)
-                    });
+                    && samples.iter().all(|sample| sample.rule == Rule::TanhSinh);
+                let may_retake = || {
+                    may_retake_here && pieces.iter().all(|piece| self.gives_precise_nodes(piece))
+                };
                 let mut known = Vec::new();
                 let mut result = drift_estimate(&samples, psi_advance, double, &mut known);
                 for _ in 0..(MAX_LEVEL - START_LEVEL) {
@@ -1399,7 +1402,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                     let precise_room = tol - floor_phase;
                     let target = if room > 0.1 * phase {
                         room
-                    } else if may_retake && precise_room > 0.1 * floor_phase {
+                    } else if precise_room > 0.1 * floor_phase && may_retake() {
                         precise_room
                     } else {
                         tol.max(0.1 * phase)
@@ -1429,9 +1432,9 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 // librations of the standard slice by a pole, κ < 0.05, missed by their drift
                 // alone, all integrated by the tanh-sinh rule, its nodes in double.)
                 let room = tol * result.scale - saddle.drift;
-                let retake = may_retake
-                    && result.error + phase * result.scale > room
-                    && result.error + floor_phase * result.scale <= room;
+                let retake = result.error + phase * result.scale > room
+                    && result.error + floor_phase * result.scale <= room
+                    && may_retake();
                 if retake {
                     for (piece, sample) in pieces.iter().zip(samples.iter_mut()) {
                         sample.take_again_precise(self, piece, energy)?;

@@ -163,14 +163,6 @@ fn integrate_on<S: Shape>(
         // (above the 1.6e-16 the rate predicted), and the sums then crept on, 5.5e-16 from
         // the truth at 64 steps, twice the last difference: T `ok` at tol 1e-12, 1.8 times
         // its estimate off.)
-        let not_slowing = |coarsest: f64, s: [f64; 3]| {
-            let (d1, d2, d3) = (
-                (s[0] - s[1]).abs(),
-                (s[1] - s[2]).abs(),
-                (s[2] - coarsest).abs(),
-            );
-            d3 == 0.0 || d1 * d3 <= d2 * d2
-        };
         let falling = |coarsest: f64, s: [f64; 3]| {
             (settled(s) && not_slowing(coarsest, s)) || at_level_floor(s, Convergence::Unknown)
         };
@@ -250,7 +242,7 @@ fn integrate_on<S: Shape>(
             let per_node = if can_be_precise {
                 PRECISE_NODE_ROUNDING + EPS
             } else {
-                INTEGRAND_ROUNDING + 4.0 * EPS
+                INTEGRAND_ROUNDING + 4.0 * EPS + map.node_rounding()
             };
             let (floor_t, floor_psi, floor_phase) = floors(per_node);
             let converged = samples.intervals >= least
@@ -511,13 +503,26 @@ impl Samples {
 /// ratios 0.25, 0.042, 1.4e-5 were followed by 0.33 instead of a thousandth, and the error
 /// of T at n = 256 was 3.3 times its estimate). Such levels are not trusted beyond d₁.
 pub(super) fn single_rate(coarsest: f64, sums: [f64; 3]) -> bool {
-    let [i0, i1, i2] = sums;
-    let (d1, d2, d3) = ((i0 - i1).abs(), (i1 - i2).abs(), (i2 - coarsest).abs());
+    let (d1, d2, d3) = level_differences(coarsest, sums);
     if d2 == 0.0 || d3 == 0.0 {
         return true;
     }
     let (r1, r2) = (d1 / d2, d2 / d3);
     r1 >= r2 * r2 / 16.0
+}
+
+/// Whether the last level difference is no larger than one rate through the two before
+/// predicts, d₁ ≤ d₂²/d₃ (`coarsest`, then `sums` finest first, as for [`single_rate`]): the
+/// sums are not slowing down.
+fn not_slowing(coarsest: f64, sums: [f64; 3]) -> bool {
+    let (d1, d2, d3) = level_differences(coarsest, sums);
+    d3 == 0.0 || d1 * d3 <= d2 * d2
+}
+
+/// |d₁|, |d₂|, |d₃|: the differences of the sums on n and n/2, n/2 and n/4, n/4 and n/8 steps.
+fn level_differences(coarsest: f64, sums: [f64; 3]) -> (f64, f64, f64) {
+    let [i0, i1, i2] = sums;
+    ((i0 - i1).abs(), (i1 - i2).abs(), (i2 - coarsest).abs())
 }
 
 /// Whether the geometric convergence seen in `sums` (on n = `intervals`, n/2 and n/4 steps)
