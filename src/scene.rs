@@ -655,6 +655,29 @@ impl Scene {
                 format!("{} is above {MAX_ENERGY:e} in size", show(widest(&energy))),
             ));
         }
+        // On the excess plane ε = V_min(κ) + e, and V_min(κ) = κ²/2 + U at its minimum, O(1)
+        // beside κ²/2 wherever ε nears 1e300: the cells' ε stays within the range every surface
+        // takes (a wheel's scene at κ = 1e150, e = 1e300 ran its cells at ε = 1.5e300, which
+        // `cells` refuses; adversary pass 32).
+        if plane == Plane::KappaExcess {
+            let top = energy
+                .values
+                .iter()
+                .copied()
+                .fold(f64::NEG_INFINITY, f64::max);
+            let half_square = 0.5 * largest(&kappa) * largest(&kappa);
+            if top + half_square > MAX_ENERGY {
+                return Err(reader.error(
+                    "axes.excess_energy",
+                    format!(
+                        "{} at kappa = {} gives energy = V_min + excess_energy >= kappa^2/2 + excess_energy = {}, above {MAX_ENERGY:e}",
+                        show(top),
+                        show(widest(&kappa)),
+                        show(top + half_square)
+                    ),
+                ));
+            }
+        }
         if plane == Plane::Compact {
             let s_min = smallest_positive(&energy);
             if s_min < MIN_S {

@@ -985,13 +985,45 @@ pub fn verdict_until(
     stopped()?;
     let candidates = brackets(&lines, options.tol, symmetric);
     let all: Vec<&Sample> = lines.iter().flatten().collect();
-    let (n_lo, n_hi) = rotation_number_range(&sampler, &lines, &high_energy);
+    let ((n_lo, n_hi), extremes) = rotation_number_range(&sampler, &lines, &high_energy);
     let (mut found, mut refinement_failures) = if options.counterexamples {
         counterexamples(&sampler, &candidates)
     } else {
         (Vec::new(), 0)
     };
     let mut integer_brackets = candidates.len();
+    let mut path_crossings = Vec::new();
+    // An extreme of N beyond −1 or 1 that no bracket of the samples holds: the crossing on the
+    // way to it (the ellipsoid α = 1 − 1e-12, β = 10.417, ν = η = 0.5 held with N_min =
+    // −1.0000815 at κ just above κ_max, where the path runs away: adversary pass 32). Where
+    // it cannot be confirmed the body is undecided.
+    for (extreme, k) in extremes.iter().zip([-1i64, 1]) {
+        let Some(extreme) = extreme else { continue };
+        let n = k.signum() as f64 * extreme.value;
+        let beyond = (n - k as f64) * k as f64 > options.tol.max(SIGN_FLOOR);
+        if !beyond || found.iter().any(|c| c.integer == k) {
+            continue;
+        }
+        let crossing = crossing_on_path(&sampler, extreme, k);
+        if options.counterexamples {
+            let (more, failures) = counterexamples(&sampler, crossing.as_slice());
+            found.extend(more);
+            refinement_failures += failures;
+        }
+        integer_brackets += usize::from(crossing.is_some());
+        path_crossings.extend(crossing);
+        let shown = if options.counterexamples {
+            found.iter().any(|c| c.integer == k)
+        } else {
+            !path_crossings.is_empty()
+        };
+        if !shown && undecided.is_none() {
+            undecided = Some(format!(
+                "N reaches {} beyond the integer {k} (its smallest or largest over the region, refined between the samples, which do not reach it), but no crossing of {k} on the way there could be confirmed",
+                crate::error::show(n),
+            ));
+        }
+    }
 
     // The limit κ → ∞ decides what lies beyond the last line.
     let bottom_sign = lines
@@ -1020,7 +1052,7 @@ pub fn verdict_until(
     let resonant = if options.counterexamples {
         !verdict.counterexamples.is_empty()
     } else {
-        !candidates.is_empty()
+        !candidates.is_empty() || !path_crossings.is_empty()
     };
     if !resonant && limit_failure.is_none() && undecided.is_none() {
         undecided = limit_undecided(&high_energy).or_else(|| {
@@ -1037,7 +1069,8 @@ pub fn verdict_until(
                         crate::error::show(ambiguity(s, options.tol)),
                         crate::error::show(s.kappa),
                         crate::error::show(s.energy),
-                        s.n.round(),
+                        // (As a whole number: −0.0 printed "the integer -0".)
+                        s.n.round() as i64,
                         crate::error::show(options.tol),
                     )
                 })
@@ -1078,6 +1111,18 @@ pub fn verdict_until(
     Ok(verdict)
 }
 
+/// A refined extreme ([`refined_extreme`]): its value and the way the search took to it.
+struct Extreme {
+    /// `sign` · `value` at the extreme.
+    value: f64,
+    /// The sample the search started from (it gives the family).
+    start: Sample,
+    /// The points (κ, ε) the search moved through, the start's first: each step is one line
+    /// search's improvement along log ε at fixed λ = κ/√ε, log κ at fixed ε or log ε at fixed
+    /// κ, a straight segment in (ln κ, ln ε).
+    path: Vec<(f64, f64)>,
+}
+
 /// The largest `sign` · `value` over the samples that pass `eligible`, refined round the best
 /// of them by golden sections until it stops growing (below), so that it follows the true
 /// extremum rather than the grid. `value(N, κ, ε)`; None without an eligible sample.
@@ -1087,7 +1132,7 @@ fn refined_extreme<S: Shape>(
     sign: f64,
     eligible: &dyn Fn(&Sample) -> bool,
     value: &dyn Fn(f64, f64, f64) -> f64,
-) -> Option<f64> {
+) -> Option<Extreme> {
     let tol = sampler.cell.tol;
     let of = |s: &Sample| sign * value(s.n, s.kappa, s.energy);
     let (j, i, s) = lines
@@ -1189,6 +1234,7 @@ fn refined_extreme<S: Shape>(
     };
     let (mut kappa_steps, mut energy_steps) = (1, 1);
     let (mut kappa, mut energy) = (s.kappa, s.energy);
+    let mut path = vec![(kappa, energy)];
     for _ in 0..64 {
         let before = best;
         seen.set(false);
@@ -1201,16 +1247,19 @@ fn refined_extreme<S: Shape>(
             let (e, v) = log_golden(&|e| at(lambda * e.sqrt(), e), lo, hi);
             if v > best {
                 (kappa, energy, best) = (lambda * e.sqrt(), e, v);
+                path.push((kappa, energy));
             }
         }
         let (k, v) = log_golden(&|k| at(k, energy), k_lo, k_hi);
         if v > best {
             (kappa, best) = (k, v);
+            path.push((kappa, energy));
         }
         // And along ε at fixed κ: the way along the region's edge, where λ cannot be kept.
         let (e, v) = log_golden(&|e| at(kappa, e), e_lo, e_hi);
         if v > best {
             (energy, best) = (e, v);
+            path.push((kappa, energy));
         }
         if best - before <= 1e-13 * best.abs() {
             if !seen.get() {
@@ -1236,7 +1285,46 @@ fn refined_extreme<S: Shape>(
             }
         }
     }
-    Some(best)
+    Some(Extreme {
+        value: best,
+        start: *s,
+        path,
+    })
+}
+
+/// Where the refined extreme of N lies beyond the integer `k` by more than its error bar
+/// while no bracket of the samples holds k (every sample on one side: the resonance lies in
+/// a sliver of the plane that the grid steps over, as beside the N = −1 boundary in β), the
+/// crossing on the search's path from the start to the extreme: the first step of the path
+/// whose ends have N on both sides of k, as a bracket for [`counterexamples`]. None where the
+/// path's points do not show it (their N is recomputed, each within its family).
+fn crossing_on_path<S: Shape>(
+    sampler: &Sampler<'_, S>,
+    extreme: &Extreme,
+    k: i64,
+) -> Option<Candidate> {
+    let tol = sampler.cell.tol;
+    let points: Vec<Sample> = extreme
+        .path
+        .iter()
+        .map(|&(kappa, energy)| {
+            sampler
+                .solve(kappa, energy, &extreme.start, false)
+                .map(|(_, r)| Sample {
+                    kappa,
+                    energy,
+                    grid: None,
+                    n: r.rotation_number,
+                    error: r.error_estimate,
+                    ..extreme.start
+                })
+        })
+        .collect::<Option<_>>()?;
+    points.windows(2).find_map(|pair| {
+        let mut found = Vec::new();
+        integers_between(&pair[0], Some(&pair[1]), false, tol, &mut found);
+        found.into_iter().find(|c| c.k == k)
+    })
 }
 
 /// The fail margin of the verdict (see [`Verdict::fail_margin`]). The extreme ñ and N of the
@@ -1262,7 +1350,7 @@ fn fail_margin<S: Shape>(
             .map(|v| sign * v)
             .fold(f64::NEG_INFINITY, f64::max);
         let sampled = refined_extreme(sampler, lines, sign, &reliable, &normalized)
-            .unwrap_or(f64::NEG_INFINITY);
+            .map_or(f64::NEG_INFINITY, |e| e.value);
         (sampled.max(edge_best), edge_best >= sampled)
     };
     let (sup, sup_edge) = extreme(1.0);
@@ -1283,16 +1371,24 @@ fn fail_margin<S: Shape>(
 
 /// The smallest and the largest N over the samples, each refined ([`refined_extreme`]), and
 /// over the high-energy limit's N∞ (κ → ∞).
+/// Also the sampled extremes themselves (smallest, largest), with the way to them.
 fn rotation_number_range<S: Shape>(
     sampler: &Sampler<'_, S>,
     lines: &[Vec<Sample>],
     high_energy: &HighEnergyLimit,
-) -> (f64, f64) {
+) -> ((f64, f64), [Option<Extreme>; 2]) {
     let n = |n: f64, _: f64, _: f64| n;
     let any = |_: &Sample| true;
-    let hi = refined_extreme(sampler, lines, 1.0, &any, &n).unwrap_or(f64::NEG_INFINITY);
-    let lo = -refined_extreme(sampler, lines, -1.0, &any, &n).unwrap_or(f64::NEG_INFINITY);
-    (lo.min(high_energy.n_min), hi.max(high_energy.n_max))
+    let hi = refined_extreme(sampler, lines, 1.0, &any, &n);
+    let lo = refined_extreme(sampler, lines, -1.0, &any, &n);
+    let value = |e: &Option<Extreme>| e.as_ref().map_or(f64::NEG_INFINITY, |e| e.value);
+    (
+        (
+            (-value(&lo)).min(high_energy.n_min),
+            value(&hi).max(high_energy.n_max),
+        ),
+        [lo, hi],
+    )
 }
 
 /// The terms of the fail margin: each positive exactly when its resonance exists.
@@ -1537,6 +1633,20 @@ fn refine<S: Shape>(sampler: &Sampler<'_, S>, c: &Candidate) -> Option<Counterex
                 0.5 * tol,
             )?;
             (c.a.kappa, e)
+        }
+        Some(b) if c.a.grid.is_none() || b.grid != c.a.grid => {
+            // A step of a refined extreme's search ([`crossing_on_path`]): straight in
+            // (ln κ, ln ε).
+            let at = |t: f64| {
+                let between = |x: f64, y: f64| (x.ln() + t * (y.ln() - x.ln())).exp();
+                (between(c.a.kappa, b.kappa), between(c.a.energy, b.energy))
+            };
+            let f = |t: f64| {
+                let (kappa, energy) = at(t);
+                sampler.offset(kappa, energy, &c.a, k)
+            };
+            let t = bracketed_root(f, (0.0, c.a.n - k), (1.0, b.n - k), 1e-15, 0.5 * tol)?;
+            at(t)
         }
         Some(b) => {
             // Along κ at the base energy index of both: ε = V_low(κ) / (1 − q)².
@@ -1823,8 +1933,14 @@ pub fn boundaries_with(
     };
     let coarse_margin =
         |beta: f64| -> Result<Verdict> { verdict_until(&body(beta)?, &coarse_only, stop) };
+    // (The ends exactly as given: exp(ln 8) is 7.999999999999998.)
+    let last = options.scan - 1;
     let mut betas: Vec<f64> = (0..options.scan)
-        .map(|i| (b0.ln() + (b1.ln() - b0.ln()) * i as f64 / (options.scan - 1) as f64).exp())
+        .map(|i| match i {
+            0 => b0,
+            i if i == last => b1,
+            i => (b0.ln() + (b1.ln() - b0.ln()) * i as f64 / last as f64).exp(),
+        })
         .collect();
     let case_line = (1.0 + alpha).sqrt();
     if case_line > b0 && case_line < b1 {

@@ -415,8 +415,11 @@ class RubberAccessor:
             index = _api._count(f"{name}_index", index)
             if name not in ds.cell_status.dims:
                 if index not in (0, -1):
+                    hint = (" (a truncated ball's or wheel's atlas has its cuts along cut: cut_index=)"
+                            if name == "beta" and "cut" in ds.cell_status.dims else "")
                     raise ValueError(f"invalid {name}_index = {index}: the dataset has no dimension {name} "
-                                     f"(its dimensions are {list(ds.cell_status.dims)}): leave {name}_index at 0")
+                                     f"(its dimensions are {list(ds.cell_status.dims)}): leave {name}_index at 0"
+                                     f"{hint}")
                 continue
             size = ds.sizes[name]
             if not -size <= index < size:

@@ -55,6 +55,24 @@ def test_boundaries_contract():
     assert abs(one["beta"] - 0.744478) < 1e-5 and 0 < one["error"] < 1e-4
 
 
+def test_bodies_just_above_the_n_minus_one_boundary_fail_at_50_digits():
+    """Just above the N = −1 boundary in β the resonance lies in a sliver above κ_max that the
+    sampling grid steps over (adversary pass 32: these bodies held). Each now fails, and its
+    counterexample is on N = −1 by the 50-digit reference of scripts/reference.py (the Rust
+    test of the same bodies follows its path with the full model)."""
+    sys.path.insert(0, str(ROOT / "scripts"))
+    from reference import reference
+
+    for alpha, beta in [(0.5, 19.7931), (0.999999999999, 10.417)]:
+        v = verdict(f"--alpha={alpha}", f"--beta={beta}", "--nu=0.5", "--eta=0.5")
+        assert v["holds"] is False and v["fail_margin"] > 0, v
+        c = next(c for c in v["counterexamples"] if c["integer"] == -1)
+        assert c["kappa"] > v["kappa_max"]
+        comps = reference(alpha, beta, 0.5, 0.5, c["kappa"], c["energy"])
+        comp = min(comps, key=lambda x: abs(x.theta_min - c["theta_min"]) + abs(x.theta_max - c["theta_max"]))
+        assert abs(comp.rotation_number + 1) <= 1e-10 + c["error_estimate"], (alpha, beta, c, comp)
+
+
 @pytest.mark.parametrize("args", [
     ["--alpha=-inf", "--beta=1", "--nu=0.5", "--eta=0.5"],
     ["--alpha=1", "--beta=1", "--nu=0.5", "--eta=0.5"],

@@ -1604,6 +1604,38 @@ fn a_start_beyond_the_largest_energy_is_refused_like_the_energy() {
     let said = stderr(&o);
     assert_eq!(o.status.code(), Some(2), "{said}");
     assert!(said.contains("-1e301 is above 1e300 in size"), "{said}");
+    // On the excess plane the cells' ε = V_min + e: κ = 1e150 with e = 1e300 is ε = 1.5e300,
+    // refused as `cells` refuses it (adversary pass 32); e = 5e299 there is ε = 1e300, run.
+    for (excess, refused) in [("1e300", true), ("5e299", false)] {
+        std::fs::write(
+            &scene,
+            format!(
+                "name = \"e\"\n[body]\nshape = \"wheel\"\nnu = 0.5\neta = 0.5\n[axes]\nalpha = [0.3]\n\
+                 cut = [0.5]\nkappa = [-1e150, 0.0]\nexcess_energy = [0.0, {excess}]\n"
+            ),
+        )
+        .unwrap();
+        let out = dir.path().join("e.h5");
+        let o = run(&[
+            "run",
+            scene.to_str().unwrap(),
+            "--quiet",
+            "--force",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let said = stderr(&o);
+        if refused {
+            assert_eq!(o.status.code(), Some(2), "{said}");
+            assert_eq!(said.lines().count(), 1, "{said}");
+            assert!(
+                said.contains("axes.excess_energy") && said.contains("1.5e300"),
+                "{said}"
+            );
+        } else {
+            assert!(o.status.success(), "{said}");
+        }
+    }
 }
 
 /// `man --dir` writes its pages as any output is written (adversary pass 5 of issue 22: it

@@ -103,6 +103,33 @@ fn strongly_oblate_body_fails_beyond_kappa_max() {
 }
 
 #[test]
+fn bodies_just_above_the_n_minus_one_boundary_fail() {
+    // Adversary pass 32: just above the N = −1 boundary in β the resonance lies in a sliver
+    // above κ_max that the grid steps over; only the refined extreme of N passes −1. These
+    // held, with N_min = −1.0000044, −1.0000074 and −1.0000815 in their own evidence.
+    for (alpha, beta, boundary) in [
+        (0.5, 19.7931, 19.7930141),
+        (0.9, 11.4228, 11.4227164),
+        (0.999999999999, 10.417, 10.41617),
+    ] {
+        let (body, v) = judge(alpha, beta);
+        assert_eq!((v.case, v.holds), (Case::Two, Some(false)), "{v:#?}");
+        assert!(v.fail_margin > 0.0, "{v:#?}");
+        assert!(v.counterexamples.iter().any(|c| c.integer == -1), "{v:#?}");
+        check_counterexamples(&body, &v);
+        // Just below the boundary the body holds.
+        let below = boundary * (1.0 - 2e-6);
+        let (_, v) = judge(alpha, below);
+        assert_eq!(
+            (v.case, v.holds),
+            (Case::Two, Some(true)),
+            "β = {below}: {v:#?}"
+        );
+        assert!(v.fail_margin < 0.0, "β = {below}: {v:#?}");
+    }
+}
+
+#[test]
 fn symmetric_prolate_body_fails_everywhere() {
     // α = 0, β < 1 (type (d)): V is symmetric about the equator, N = 0 on every torus.
     let (body, v) = judge(0.0, 0.5);
