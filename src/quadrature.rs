@@ -65,7 +65,7 @@ impl IntervalNode {
 
     /// Scales a node of the unit interval to an interval of length `length`.
     #[inline]
-    fn scaled(self, length: f64) -> Self {
+    pub(crate) fn scaled(self, length: f64) -> Self {
         Self {
             from_left: self.from_left * length,
             from_right: self.from_right * length,

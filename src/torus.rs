@@ -1250,8 +1250,8 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             .iter()
             .zip(&kinds)
             .map(|(p, kind)| {
-                let chebyshev = kind.and_then(|(kind, least)| {
-                    PieceSamples::chebyshev(self, p, energy, kind, START_LEVEL, least)
+                let chebyshev = kind.and_then(|(kind, least, map)| {
+                    PieceSamples::chebyshev(self, p, energy, kind, map, START_LEVEL, least)
                 });
                 match chebyshev {
                     Some(s) => Ok(s),
@@ -1861,7 +1861,7 @@ impl<S: Shape> EffectivePotential<'_, S> {
         component: &Component,
         pieces: &[Piece],
         tol: f64,
-    ) -> Vec<Option<(ChebyshevPiece, u32)>> {
+    ) -> Vec<Option<(ChebyshevPiece, u32, cosine::Map)>> {
         let n = pieces.len();
         let (lower, upper) = (component.lower.theta, component.upper.theta);
         let kinks = self.kinks_inside(lower, upper);
@@ -1931,24 +1931,40 @@ impl<S: Shape> EffectivePotential<'_, S> {
             let r = Complex::from_polar(d, std::f64::consts::FRAC_PI_3);
             [Complex::new(d, 0.0), r, r.conj()]
         };
-        // ρ beyond a kink, the rule's variable there z(x) for an outward distance x.
-        let regular = |end: &PieceEnd, left: bool, z: &dyn Fn(Complex<f64>) -> Complex<f64>| {
+        // The points beyond an end that bound ρ, as outward distances in the map's variable:
+        // the gap's zeros (of its local model, without the excess at a turning point), the
+        // cubic term's (beyond a kink), and the pole (θ) or the edge of the strip |Im s| < π/2
+        // (Mercator's s = ln tan(θ/2), which sends the pole to infinity). In s an outward
+        // distance x in θ from an end at d from its pole is ln tan(d/2) − ln tan((d − x)/2).
+        let beyond = |end: &PieceEnd, left: bool, turning: bool, mercator: bool| {
             let (a, c) = local(end, left);
-            zeros(end.excess.max(0.0), a, c)
-                .into_iter()
-                .chain(cubic(end))
-                .chain(pole(end, left))
-                .map(|x| bernstein(z(x)))
-                .fold(f64::INFINITY, f64::min)
+            let excess = if turning { 0.0 } else { end.excess.max(0.0) };
+            let mut points = zeros(excess, a, c);
+            if !turning {
+                points.extend(cubic(end));
+            }
+            if !mercator {
+                points.extend(pole(end, left));
+                return points;
+            }
+            let d = Complex::new(
+                if left {
+                    end.site.theta
+                } else {
+                    end.site.from_pi
+                },
+                0.0,
+            );
+            let s = |y: Complex<f64>| (0.5 * y).tan().ln();
+            let mut points: Vec<Complex<f64>> =
+                points.into_iter().map(|x| s(d) - s(d - x)).collect();
+            points.push(s(d) + Complex::new(0.0, FRAC_PI_2));
+            points
         };
-        // ρ beyond a turning point of a piece of length L: a point at outward distance x is
-        // at u² = −x/L.
-        let turning = |end: &PieceEnd, left: bool, length: f64| {
-            let (a, c) = local(end, left);
-            zeros(0.0, a, c)
+        let rho = |points: Vec<Complex<f64>>, z: &dyn Fn(Complex<f64>) -> Complex<f64>| {
+            points
                 .into_iter()
-                .chain(pole(end, left))
-                .map(|x| bernstein((-x / length).sqrt()))
+                .map(|x| bernstein(z(x)))
                 .fold(f64::INFINITY, f64::min)
         };
         let planned = CHEBYSHEV_PLANNED_INTERVALS as f64;
@@ -1956,25 +1972,62 @@ impl<S: Shape> EffectivePotential<'_, S> {
             .iter()
             .enumerate()
             .map(|(k, p)| {
-                let length = p.length;
-                // Beside a turning point the far end is u = 1: θ − θ_t = L u², so a point x
-                // beyond it is at u = √(1 + x/L); between kinks x = 1 + 2x/L.
-                let half = |x: Complex<f64>| (1.0 + x / length).sqrt();
-                let whole = |x: Complex<f64>| 1.0 + 2.0 * x / length;
-                let (kind, rho) = if k == 0 {
-                    let rho = turning(&p.left, true, length).min(regular(&p.right, false, &half));
-                    (ChebyshevPiece::TurningLeft, rho)
-                } else if k == n - 1 {
-                    let rho = turning(&p.right, false, length).min(regular(&p.left, true, &half));
-                    (ChebyshevPiece::TurningRight, rho)
-                } else {
-                    let rho = regular(&p.left, true, &whole).min(regular(&p.right, false, &whole));
-                    (ChebyshevPiece::Regular, rho)
+                let plain = cosine::Map::Plain { length: p.length };
+                // Mercator's map where an end lies nearer its pole than the piece is long
+                // (κ ≠ 0, the piece within (0, π)).
+                let near_pole = self.kappa != 0.0
+                    && p.left.angle.sin > 0.0
+                    && p.right.angle.sin > 0.0
+                    && p.left.site.theta.min(p.right.site.from_pi) < p.length;
+                let plan = |map: cosine::Map| {
+                    let (mercator, length) = match map {
+                        cosine::Map::Plain { length } => (false, length),
+                        cosine::Map::Mercator { length, .. } => (true, length),
+                    };
+                    // Beside a turning point the far end is u = 1: x − x_t = L u², so a point
+                    // x beyond it is at u = √(1 + x/L), and beyond the turning point itself
+                    // at u² = −x/L; between kinks at 1 + 2x/L.
+                    let half = |x: Complex<f64>| (1.0 + x / length).sqrt();
+                    let whole = |x: Complex<f64>| 1.0 + 2.0 * x / length;
+                    let turning = |x: Complex<f64>| (-x / length).sqrt();
+                    let (kind, rho) = if k == 0 {
+                        let rho = rho(beyond(&p.left, true, true, mercator), &turning)
+                            .min(rho(beyond(&p.right, false, false, mercator), &half));
+                        (ChebyshevPiece::TurningLeft, rho)
+                    } else if k == n - 1 {
+                        let rho = rho(beyond(&p.right, false, true, mercator), &turning)
+                            .min(rho(beyond(&p.left, true, false, mercator), &half));
+                        (ChebyshevPiece::TurningRight, rho)
+                    } else {
+                        let rho = rho(beyond(&p.left, true, false, mercator), &whole)
+                            .min(rho(beyond(&p.right, false, false, mercator), &whole));
+                        (ChebyshevPiece::Regular, rho)
+                    };
+                    // The intervals the prediction needs; before them a level's differences
+                    // are not trusted (the coarse levels of a near-singular end may agree by
+                    // chance).
+                    let needed = -tol.ln() / rho.ln();
+                    // (Mercator's levels are trusted to d₁ only, not to the plain map's
+                    // geometric rate: a level more for the same error, so it is counted
+                    // twice.)
+                    let cost = if mercator { 2.0 * needed } else { needed };
+                    (needed <= planned).then_some((cost, needed, kind, map))
                 };
-                // The intervals the prediction needs; before them a level's differences are
-                // not trusted (the coarse levels of a near-singular end may agree by chance).
-                let needed = -tol.ln() / rho.ln();
-                (needed <= planned).then(|| (kind, needed.max(1.0).log2().ceil() as u32))
+                // (Mercator's is planned only where the plain map needs more than 64
+                // intervals: below, it could save a level at most, and its plan costs complex
+                // logarithms and tangents: planned beyond 32, the plans took 14 % of the time
+                // of the truncated ball's scene, against 5 % before.)
+                let plain = plan(plain);
+                let mercator = if near_pole && plain.is_none_or(|(_, needed, ..)| needed > 64.0) {
+                    plan(cosine::Map::mercator(p))
+                } else {
+                    None
+                };
+                [plain, mercator]
+                    .into_iter()
+                    .flatten()
+                    .min_by(|a, b| a.0.total_cmp(&b.0))
+                    .map(|(_, needed, kind, map)| (kind, needed.max(1.0).log2().ceil() as u32, map))
             })
             .collect()
     }
@@ -2690,6 +2743,9 @@ enum Rule {
 /// other node).
 struct PieceSamples {
     rule: Rule,
+    /// How a Clenshaw–Curtis piece's variable covers the piece: θ itself, or Mercator's
+    /// s = ln tan(θ/2) by a pole (the tanh-sinh rule's: θ).
+    map: cosine::Map,
     level: u32,
     /// The least level whose differences are trusted.
     least_level: u32,
@@ -2724,6 +2780,9 @@ impl PieceSamples {
             .collect::<Result<Vec<_>>>()?;
         Ok(Self {
             rule: Rule::TanhSinh,
+            map: cosine::Map::Plain {
+                length: piece.length,
+            },
             level,
             least_level: 0,
             evaluations: nodes.len(),
@@ -2741,14 +2800,16 @@ impl PieceSamples {
         piece: &Piece,
         energy: f64,
         kind: ChebyshevPiece,
+        map: cosine::Map,
         level: u32,
         least_level: u32,
     ) -> Option<Self> {
         let nodes = (0..kind.count(level))
-            .map(|i| chebyshev_sample(v, piece, energy, kind, level, i))
+            .map(|i| chebyshev_sample(v, piece, energy, kind, &map, level, i))
             .collect::<Option<Vec<_>>>()?;
         Some(Self {
             rule: Rule::Chebyshev(kind),
+            map,
             level,
             least_level,
             evaluations: nodes.len(),
@@ -2871,6 +2932,19 @@ impl PieceSamples {
             Rule::TanhSinh => {
                 level_error(sums, Convergence::Unknown) + self.tail(PART_VALUES[part])
             }
+            Rule::Chebyshev(_) if matches!(self.map, cosine::Map::Mercator { .. }) => {
+                // Mercator's levels as the cosine rule's: d₁ where they are trusted, else the
+                // integrand's whole L1 size (refined on, or to the tanh-sinh rule). (Sums on
+                // their floor are trusted whatever the rate: the last difference may be 0.)
+                if self.level >= 4
+                    && (at_level_floor(sums, Convergence::Unknown)
+                        || (cosine::single_rate(s3, sums) && cosine::mercator_falling(s3, sums)))
+                {
+                    level_error(sums, Convergence::Unknown)
+                } else {
+                    self.size(part)
+                }
+            }
             Rule::Chebyshev(_) => {
                 let settled = (s0 - s1).abs() <= GEOMETRIC_FROM * self.size(part);
                 let rate = if self.level >= 4 && cosine::single_rate(s3, sums) && settled {
@@ -2920,12 +2994,15 @@ impl PieceSamples {
 
     /// Whether the levels are a Clenshaw–Curtis rule's in one geometric regime.
     fn geometric(&self) -> bool {
-        matches!(self.rule, Rule::Chebyshev(_)) && self.one_rate()
+        matches!(self.rule, Rule::Chebyshev(_))
+            && matches!(self.map, cosine::Map::Plain { .. })
+            && self.one_rate()
     }
 
     /// Σ ½ (relative gap error) |f| weight: the gap enters t′ as (ε − V)^{−1/2}.
     fn rounding(&self, f: impl Fn(&NodeSample) -> f64) -> f64 {
-        self.sum(0, |n| 0.5 * n.rounding * f(n).abs())
+        let node_rounding = self.map.node_rounding();
+        self.sum(0, |n| 0.5 * (n.rounding + node_rounding) * f(n).abs())
     }
 
     /// Take a tanh-sinh piece's nodes again with their integrands in double-double
@@ -2973,8 +3050,9 @@ impl PieceSamples {
             Rule::Chebyshev(kind) => {
                 // The new (odd) nodes first: where one is not in the allowed set the samples
                 // stay as they were.
+                let map = self.map;
                 let odd = (1..self.nodes.len())
-                    .map(|j| chebyshev_sample(v, piece, energy, kind, level, 2 * j - 1))
+                    .map(|j| chebyshev_sample(v, piece, energy, kind, &map, level, 2 * j - 1))
                     .collect::<Option<Vec<_>>>();
                 let Some(odd) = odd else {
                     self.level -= 1;
@@ -3133,14 +3211,22 @@ fn chebyshev_sample<S: Shape>(
     piece: &Piece,
     energy: f64,
     kind: ChebyshevPiece,
+    map: &cosine::Map,
     level: u32,
     i: usize,
 ) -> Option<NodeSample> {
     if kind.turning_node(level) == Some(i) {
         let left = kind == ChebyshevPiece::TurningLeft;
-        return cosine::end_sample_with_length(v, piece, 4.0 * piece.length, left);
+        return cosine::end_sample_with_length(v, piece, 4.0 * map.end_length(piece, left), left);
     }
-    let node = IntervalNode::chebyshev_tabulated(kind, level, i, piece.length);
+    let node = match map {
+        cosine::Map::Plain { .. } => {
+            IntervalNode::chebyshev_tabulated(kind, level, i, piece.length)
+        }
+        cosine::Map::Mercator { .. } => {
+            map.place(IntervalNode::chebyshev_tabulated(kind, level, i, 1.0))
+        }
+    };
     sample(v, piece, energy, node).ok()
 }
 

@@ -302,6 +302,34 @@ def test_ordinary_librations_across_kinks_are_cheap():
     assert works[len(works) // 2] <= 160, works
 
 
+# Tori of cut balls with a turning point near a pole (κ ≤ 0.1) that cross the kink: their
+# pieces take the Clenshaw–Curtis rule in Mercator's s = ln tan(θ/2) (docs/accuracy.md).
+NEAR_POLE = [
+    ("truncated_ball", 0.2, 0.4, 0.7, 1.3, 0.0413385826771654, 1.1739624371995567),
+    ("truncated_ball", 0.2, 0.4, 0.7, 1.3, 0.0413385826771654, 1.4),
+    ("truncated_ball", 0.2, 0.4, 0.7, 1.3, 0.01, 1.0),
+    ("truncated_ball", -0.3, -0.5, 1.0, 2.5, 0.08, 2.0),
+    ("wheel", 0.25, 0.7, 0.7, 1.3, 0.03, 1.5),
+    ("wheel", 0.0, 0.3, 0.5, 3.0, 0.1, 2.0),
+]
+
+
+@pytest.mark.parametrize("case", NEAR_POLE, ids=lambda c: f"{c[0]}-{c[1]}-{c[5]:.3f}-{c[6]}")
+def test_pieces_by_a_pole_keep_within_their_estimates_and_are_cheap(case):
+    """Against 50 digits at tol 1e-10 and 1e-13: every `ok` value within its estimate and the
+    rest honest; at 1e-10 every component `ok` and at most 320 evaluations (the first, by the
+    tanh-sinh rule, took 548)."""
+    shape, alpha, cut, nu, eta, kappa, energy = case
+    c = whole_domain.Case(alpha, 1.0, nu, eta, kappa, energy, "near pole", None, shape, cut)
+    for tol in (1e-10, 1e-13):
+        outcome = whole_domain.check(c, tol=tol)
+        assert not outcome.problems, (case, tol, outcome.problems)
+        if tol == 1e-10:
+            assert outcome.ok_components == outcome.components, (case, outcome)
+    works = [x["work"] for x in whole_domain.run_cell(c, tol=1e-10)["components"]]
+    assert max(works) <= 320, works
+
+
 def test_a_level_within_rounding_of_a_kink_holds_both_sides():
     """A centred truncated ball (α = 0: its sphere neutral, V′ = 2e-11 on both sides of the
     kink at κ = 7.8e-6) at a level within an ulp of V at the kink: rounding decides on which

@@ -74,7 +74,12 @@ fn least_intervals<S: Shape>(v: &EffectivePotential<'_, S>, piece: &Piece, map: 
 
 /// φ-steps on [0, π] beyond which the tanh-sinh rule is cheaper.
 const LAST_INTERVALS: usize = 256;
-const _: () = assert!(LAST_INTERVALS <= FINEST_COSINE_INTERVALS);
+/// The same where T and Δψ have converged and only the drift misses: one level more costs
+/// half the nodes the tanh-sinh rule would start again with. (A disk's libration 0.008 from
+/// both poles at κ = 0.01 had its drift 1.05e-10 of its scale at 256 steps, tol 1e-10: the
+/// Mercator map and then the tanh-sinh rule took it again, 1,316 evaluations in all.)
+const DRIFT_LAST_INTERVALS: usize = 512;
+const _: () = assert!(DRIFT_LAST_INTERVALS <= FINEST_COSINE_INTERVALS);
 
 /// T, Δψ and (if `with_drift`) Δζ of a libration that is one piece (see the parent's
 /// `integrate`), or, when the trapezoid rule would need more than [`LAST_INTERVALS`] steps
@@ -151,25 +156,11 @@ fn integrate_on<S: Shape>(
         let budget = |allowed: f64, extra: f64| (allowed - extra).max(0.1 * extra);
         // Where the differences may be taken as the error: the plain map's (one geometric
         // strip); the Mercator map's only where its last four levels show one rate and the
-        // last two differences fall tenfold (`settled`) or sit on the floor. A disk at
-        // ν = 9e-4, κ = −7e-4 (turning points 1e-4 from its faces) had Δψ's 1.1e-4, 4.5e-5,
-        // 1.1e-5, then 2.3e-8, its error 12 times that last one; one at ν = 7e-4 had 1.2e-4,
-        // 2.9e-5, 1.4e-5, slowing down, its error 2.7 times the last (adversary pass of
-        // 2026-11-27).
-        let settled = |s: [f64; 3]| (s[0] - s[1]).abs() <= 0.1 * (s[1] - s[2]).abs();
-        // (And not slowing: the last difference at most what the two before predict for one
-        // rate, d₂²/d₃. In a pole well of an oblate body (β = 225, κ = 1.2e-12, ε 3.7e-5 above
-        // the pole's level; adversary pass 31) T's differences were 6.6e-7, 3.3e-10, 2.6e-16
-        // (above the 1.6e-16 the rate predicted), and the sums then crept on, 5.5e-16 from
-        // the truth at 64 steps, twice the last difference: T `ok` at tol 1e-12, 1.8 times
-        // its estimate off.)
-        let falling = |coarsest: f64, s: [f64; 3]| {
-            (settled(s) && not_slowing(coarsest, s)) || at_level_floor(s, Convergence::Unknown)
-        };
+        // last differences fall as [`mercator_falling`] asks.
         let trusted = map.convergence() == Convergence::Geometric
             || (one_rate
-                && falling(sums.t_coarsest, t_sums)
-                && falling(sums.psi_coarsest, psi_sums));
+                && mercator_falling(sums.t_coarsest, t_sums)
+                && mercator_falling(sums.psi_coarsest, psi_sums));
         // A sum at the floor of `level_error` has nothing left for refinement to gain: where
         // that floor with the rounding misses the tolerance (tol ≲ 1e-14), refining on to
         // LAST_INTERVALS steps and then by the tanh-sinh rule only bought the same estimate
@@ -287,7 +278,14 @@ fn integrate_on<S: Shape>(
                 continue;
             }
         }
-        let hopeless = samples.intervals >= LAST_INTERVALS
+        // (T and Δψ done, the drift not: `drift` is made only once they are.)
+        let drift_alone_misses = drift.is_some() && !done;
+        let last = if drift_alone_misses {
+            DRIFT_LAST_INTERVALS
+        } else {
+            LAST_INTERVALS
+        };
+        let hopeless = samples.intervals >= last
             || !reaches(samples.intervals, t_sums, 0.5 * tol * period)
             || !reaches(samples.intervals, psi_sums, 0.5 * tol * TAU);
         // With a turning point beyond the tanh-sinh rule's last node (which would hide the ψ̇
@@ -511,6 +509,27 @@ pub(super) fn single_rate(coarsest: f64, sums: [f64; 3]) -> bool {
     r1 >= r2 * r2 / 16.0
 }
 
+/// Whether the Mercator map's last level difference, d₁, may be taken as the error of the
+/// finest sum (`coarsest`, then `sums` finest first): it falls tenfold from the one before and
+/// is not slowing ([`not_slowing`]), or the sums sit on their floor. A disk at ν = 9e-4,
+/// κ = −7e-4 (turning points 1e-4 from its faces) had Δψ's 1.1e-4, 4.5e-5, 1.1e-5, then
+/// 2.3e-8, its error 12 times that last one; one at ν = 7e-4 had 1.2e-4, 2.9e-5, 1.4e-5,
+/// slowing down, its error 2.7 times the last (adversary pass of 2026-11-27). In a pole well
+/// of an oblate body (β = 225, κ = 1.2e-12, ε 3.7e-5 above the pole's level; adversary pass
+/// 31) T's differences were 6.6e-7, 3.3e-10, 2.6e-16 (above the 1.6e-16 the rate predicted),
+/// and the sums then crept on, 5.5e-16 from the truth at 64 steps, twice the last
+/// difference: T `ok` at tol 1e-12, 1.8 times its estimate off.
+pub(super) fn mercator_falling(coarsest: f64, sums: [f64; 3]) -> bool {
+    (settled(sums) && not_slowing(coarsest, sums)) || at_level_floor(sums, Convergence::Unknown)
+}
+
+/// Whether the last level difference of `sums` (finest first) is a tenth of the one before
+/// or less.
+fn settled(sums: [f64; 3]) -> bool {
+    let [i0, i1, i2] = sums;
+    (i0 - i1).abs() <= 0.1 * (i1 - i2).abs()
+}
+
 /// Whether the last level difference is no larger than one rate through the two before
 /// predicts, d₁ ≤ d₂²/d₃ (`coarsest`, then `sums` finest first, as for [`single_rate`]): the
 /// sums are not slowing down.
@@ -546,8 +565,10 @@ fn reaches(intervals: usize, sums: [f64; 3], target: f64) -> bool {
 /// [`Map::node_rounding`] of Mercator's map: 2 × 20 ulps.
 const MERCATOR_NODE_ROUNDING: f64 = 40.0 * EPS;
 
-/// How φ ∈ [0, π] covers a libration [θ_min, θ_max].
-enum Map {
+/// How φ ∈ [0, π] covers a libration [θ_min, θ_max] (and how a Clenshaw–Curtis piece's
+/// variable covers the piece).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Map {
     /// θ = θ_min + L (1 − cos φ)/2.
     Plain { length: f64 },
     /// The same in the Mercator coordinate s = ln tan(θ/2) (dθ/ds = sin θ): it sends the
@@ -593,7 +614,7 @@ impl Map {
         plain.into_iter().chain(mercator)
     }
 
-    fn mercator(piece: &Piece) -> Self {
+    pub(super) fn mercator(piece: &Piece) -> Self {
         // tan(θ/2) = sin θ / (1 + cos θ) = (1 − cos θ) / sin θ, whichever has no cancellation.
         let tan_half = |a: Angle| {
             if a.cos >= 0.0 {
@@ -632,7 +653,7 @@ impl Map {
     /// table's weight in dθ/dφ (about 8 ulps). Without it a pole well of an oblate body
     /// (β = 50, κ = −2.9e-12, ε 4e-4 above the pole's level) had T `ok` at tol 1e-12, 40 ulps
     /// off, 1.07 times its estimate (adversary pass 31).
-    fn node_rounding(&self) -> f64 {
+    pub(super) fn node_rounding(&self) -> f64 {
         match self {
             Map::Plain { .. } => 0.0,
             Map::Mercator { .. } => MERCATOR_NODE_ROUNDING,
@@ -643,8 +664,17 @@ impl Map {
     fn node(&self, intervals: usize, j: usize) -> IntervalNode {
         match *self {
             Map::Plain { length } => IntervalNode::cosine_tabulated(intervals, j, length),
+            Map::Mercator { .. } => self.place(IntervalNode::cosine_tabulated(intervals, j, 1.0)),
+        }
+    }
+
+    /// A node of a rule on the unit interval (its distances to the ends, and dx/dv for the
+    /// rule's variable v) placed on the piece: x = θ for the plain map (scaled by L), and
+    /// x = (s − s_min)/L_s for Mercator's, which makes dθ/dv = sin θ L_s dx/dv.
+    pub(super) fn place(&self, unit: IntervalNode) -> IntervalNode {
+        match *self {
+            Map::Plain { length } => unit.scaled(length),
             Map::Mercator { tan_half, length } => {
-                let unit = IntervalNode::cosine_tabulated(intervals, j, 1.0);
                 // From each end, in its own pole's coordinate: s − s_end = L_s u with u the
                 // unit distance to that end; with q = e^{L_s u} and t = tan(θ_end/2) (for the
                 // right end, of π − θ_end): |θ − θ_end| = 2 atan(t (q − 1) / (1 + t² q)) and
@@ -665,7 +695,6 @@ impl Map {
                 } else {
                     sin_right
                 };
-                // dθ/dφ = sin θ ds/dφ = sin θ L_s sin(φ/2) cos(φ/2).
                 IntervalNode {
                     from_left,
                     from_right,
@@ -676,7 +705,7 @@ impl Map {
     }
 
     /// ℓ with θ − θ_end ≈ ℓ φ²/4 near an end (φ measured from that end): L, or sin θ_end L_s.
-    fn end_length(&self, piece: &Piece, left: bool) -> f64 {
+    pub(super) fn end_length(&self, piece: &Piece, left: bool) -> f64 {
         match *self {
             Map::Plain { length } => length,
             Map::Mercator { length, .. } => {
@@ -811,10 +840,10 @@ fn antiderivative(
     nu
 }
 
-/// 1/k for k = 0 … [`LAST_INTERVALS`] (k = 0 unused), made once.
+/// 1/k for k = 0 … [`DRIFT_LAST_INTERVALS`] (k = 0 unused), made once.
 fn reciprocals() -> &'static [f64] {
     static TABLE: OnceLock<Vec<f64>> = OnceLock::new();
-    TABLE.get_or_init(|| (0..=LAST_INTERVALS).map(|k| 1.0 / k as f64).collect())
+    TABLE.get_or_init(|| (0..=DRIFT_LAST_INTERVALS).map(|k| 1.0 / k as f64).collect())
 }
 
 /// Per-thread buffers of [`fourier_drift`]: ψ̃, the transform's input and its spectrum.
