@@ -1010,12 +1010,13 @@ pub fn verdict_until(
             found.extend(more);
             refinement_failures += failures;
         }
-        integer_brackets += usize::from(crossing.is_some());
+        let crossed = crossing.is_some();
+        integer_brackets += usize::from(crossed);
         path_crossings.extend(crossing);
         let shown = if options.counterexamples {
             found.iter().any(|c| c.integer == k)
         } else {
-            !path_crossings.is_empty()
+            crossed
         };
         if !shown && undecided.is_none() {
             undecided = Some(format!(
