@@ -63,12 +63,15 @@ def test_bodies_just_above_the_n_minus_one_boundary_fail_at_50_digits():
     sys.path.insert(0, str(ROOT / "scripts"))
     from reference import reference
 
-    for alpha, beta in [(0.5, 19.7931), (0.999999999999, 10.417)]:
-        v = verdict(f"--alpha={alpha}", f"--beta={beta}", "--nu=0.5", "--eta=0.5")
+    # (α = 0.9, β = 1.6773, ν = 1.5, η = 5: N at the bottom dips below −1 between two κ-lines,
+    # adversary pass 33.)
+    for alpha, beta, nu, eta in [(0.5, 19.7931, 0.5, 0.5), (0.999999999999, 10.417, 0.5, 0.5),
+                                 (0.9, 1.6773, 1.5, 5.0)]:
+        v = verdict(f"--alpha={alpha}", f"--beta={beta}", f"--nu={nu}", f"--eta={eta}")
         assert v["holds"] is False and v["fail_margin"] > 0, v
         c = next(c for c in v["counterexamples"] if c["integer"] == -1)
         assert c["kappa"] > v["kappa_max"]
-        comps = reference(alpha, beta, 0.5, 0.5, c["kappa"], c["energy"])
+        comps = reference(alpha, beta, nu, eta, c["kappa"], c["energy"])
         comp = min(comps, key=lambda x: abs(x.theta_min - c["theta_min"]) + abs(x.theta_max - c["theta_max"]))
         assert abs(comp.rotation_number + 1) <= 1e-10 + c["error_estimate"], (alpha, beta, c, comp)
 

@@ -378,6 +378,7 @@ pub fn census<S: Shape>(
         energies: options.resolution,
         offset_energies: true,
         n_alone: true,
+        sharpen: false,
         stop,
     };
     let symmetric = body.shape.symmetric_about_equator();

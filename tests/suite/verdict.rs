@@ -130,6 +130,56 @@ fn bodies_just_above_the_n_minus_one_boundary_fail() {
 }
 
 #[test]
+fn a_dip_of_n_at_the_bottom_between_kappa_lines_fails() {
+    // Adversary pass 33: N at the bottom of the well, N_b(κ), dips below −1 between two
+    // κ-lines (to −1.00009 at κ = 0.35 for α = 0.9, β = 1.6773, ν = 1.5, η = 5, where the
+    // lines' bottoms had −0.9994 and above); the verdict held with N_min = −0.99997. Its
+    // counterexample lies in the sliver between the bottom and N = −1 above it.
+    for (alpha, beta) in [(0.9, 1.6773), (0.867, 1.74)] {
+        let body = EllipsoidBody::ellipsoid(alpha, beta, 1.5, 5.0).unwrap();
+        let v = verdict(&body, &VerdictOptions::default()).unwrap();
+        assert_eq!((v.case, v.holds), (Case::Two, Some(false)), "{v:#?}");
+        assert!(v.fail_margin > 0.0, "{v:#?}");
+        assert!(v.counterexamples.iter().any(|c| c.integer == -1), "{v:#?}");
+        check_counterexamples(&body, &v);
+        // The bottom itself: some κ between the lines has N_b < −1 (closed form).
+        let dip = v
+            .counterexamples
+            .iter()
+            .find(|c| c.integer == -1)
+            .unwrap()
+            .kappa;
+        let potential = EffectivePotential::new(&body, dip);
+        let n_b = potential
+            .critical_points()
+            .iter()
+            .filter_map(|c| rubber_atlas::limits::bottom_rotation_number(&potential, c))
+            .fold(f64::INFINITY, f64::min);
+        assert!(n_b < -1.0, "N_b({dip}) = {n_b}");
+    }
+    // Below the boundary, β = 1.6771381 at α = 0.9 (where min N_b = −1), the body holds.
+    let body = EllipsoidBody::ellipsoid(0.9, 1.6771, 1.5, 5.0).unwrap();
+    let v = verdict(&body, &VerdictOptions::default()).unwrap();
+    assert_eq!((v.case, v.holds), (Case::Two, Some(true)), "{v:#?}");
+}
+
+#[test]
+fn bodies_just_above_the_n_zero_boundary_hold() {
+    // Adversary pass 33: just above the lower (N = 0) boundary N at small κ and high energy
+    // is a limit's value of 1e-11 (N ~ κ/√ε), within tol 1e-10 of 0: the verdict was
+    // undecided over 1.3e-3 of β (relative) at α = 0.5 and 3.7e-3 at α = 0.2, while the cells'
+    // own estimates were 2e-14. Such samples are solved again to 1e-13.
+    for (alpha, beta) in [(0.5, 0.7446), (0.5, 0.745), (0.2, 0.7795), (0.9, 0.6662)] {
+        let (_, v) = judge(alpha, beta);
+        assert_eq!(
+            (v.case, v.holds),
+            (Case::One, Some(true)),
+            "α = {alpha}, β = {beta}: {v:#?}"
+        );
+    }
+}
+
+#[test]
 fn symmetric_prolate_body_fails_everywhere() {
     // α = 0, β < 1 (type (d)): V is symmetric about the equator, N = 0 on every torus.
     let (body, v) = judge(0.0, 0.5);
