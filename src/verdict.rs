@@ -414,12 +414,14 @@ impl<S: Shape> Sampler<'_, S> {
                     continue;
                 }
                 let Some(m) = c.minimum() else { continue };
-                let Ok(mut r) = solve_component(&potential, energy, c, &self.cell) else {
+                let solved = |options: &CellOptions| {
+                    solve_component(&potential, energy, c, options)
+                        .ok()
+                        .filter(|r| r.status != Status::Separatrix && r.rotation_number.is_finite())
+                };
+                let Some(mut r) = solved(&self.cell) else {
                     continue;
                 };
-                if r.status == Status::Separatrix || !r.rotation_number.is_finite() {
-                    continue;
-                }
                 // N within the tolerance of an integer on the open plane: solved again to
                 // SHARP_TOL, so that its sign is told where the cell's own estimate allows.
                 // Beside the N = 0 boundary in β, N of 1e-11 at small κ and high energy (a
@@ -439,10 +441,8 @@ impl<S: Shape> Sampler<'_, S> {
                         tol: SHARP_TOL,
                         ..self.cell
                     };
-                    if let Ok(s) = solve_component(&potential, energy, c, &sharp) {
-                        if s.status != Status::Separatrix && s.rotation_number.is_finite() {
-                            (r, tol) = (s, SHARP_TOL);
-                        }
+                    if let Some(s) = solved(&sharp) {
+                        (r, tol) = (s, SHARP_TOL);
                     }
                 }
                 let well = minima.iter().position(|&t| t == m.site.theta).unwrap_or(0);
@@ -540,19 +540,13 @@ fn on_integer(s: &Sample) -> bool {
 /// sample, the integer it is on within its error bar (a body whose symmetry makes N an
 /// integer on a whole family, such as N ≡ 0 at α = 0). Only interior samples count alone: at
 /// the bottom and at ε → ∞ N reaches 0 as a limit.
-fn integers_between(
-    a: &Sample,
-    b: Option<&Sample>,
-    interior: bool,
-    tol: f64,
-    out: &mut Vec<Candidate>,
-) {
+fn integers_between(a: &Sample, b: Option<&Sample>, interior: bool, out: &mut Vec<Candidate>) {
     match b {
         None => {
             let k = a.n.round();
             if interior
                 && a.kappa >= ON_INTEGER_KAPPA
-                && a.error <= tol
+                && a.error <= a.tol
                 && (a.n - k).abs() <= a.error
             {
                 out.push(Candidate {
@@ -1077,7 +1071,7 @@ pub fn verdict_until(
         // (Before the brackets: over the lines sampled up to Ctrl-C they took up to 1.6 s at
         // resolution 4096.)
         stopped()?;
-        if !counterexamples(&sampler, &brackets(&lines, options.tol, symmetric))
+        if !counterexamples(&sampler, &brackets(&lines, symmetric))
             .0
             .is_empty()
         {
@@ -1101,7 +1095,7 @@ pub fn verdict_until(
         (kappas, lines)
     });
     stopped()?;
-    let candidates = brackets(&lines, options.tol, symmetric);
+    let candidates = brackets(&lines, symmetric);
     let all: Vec<&Sample> = lines.iter().flatten().collect();
     let ((n_lo, n_hi), extremes) = rotation_number_range(&sampler, &lines, &high_energy);
     let (mut found, mut refinement_failures) = if options.counterexamples {
@@ -1421,7 +1415,6 @@ fn crossing_on_path<S: Shape>(
     extreme: &Extreme,
     k: i64,
 ) -> Option<Candidate> {
-    let tol = sampler.cell.tol;
     let points: Vec<Sample> = extreme
         .path
         .iter()
@@ -1440,7 +1433,7 @@ fn crossing_on_path<S: Shape>(
         .collect::<Option<_>>()?;
     points.windows(2).find_map(|pair| {
         let mut found = Vec::new();
-        integers_between(&pair[0], Some(&pair[1]), false, tol, &mut found);
+        integers_between(&pair[0], Some(&pair[1]), false, &mut found);
         found.into_iter().find(|c| c.k == k)
     })
 }
@@ -1647,7 +1640,7 @@ fn search_beyond<S: Shape>(
         .collect();
     let mut joined = vec![last.to_vec()];
     joined.extend(extra.iter().cloned());
-    let more = brackets(&joined, sampler.cell.tol, symmetric);
+    let more = brackets(&joined, symmetric);
     let (extra_found, failures) = counterexamples(sampler, &more);
     for c in extra_found {
         if !found
@@ -1666,17 +1659,17 @@ fn search_beyond<S: Shape>(
 /// lands on a crossing does not hide it. Single samples on an integer count only for a body
 /// whose symmetry makes N an integer on whole families (`symmetric`, α = 0: N ≡ 0); elsewhere
 /// N near an integer is a value, not a resonance, until a bracket proves one.
-fn brackets(lines: &[Vec<Sample>], tol: f64, symmetric: bool) -> Vec<Candidate> {
+fn brackets(lines: &[Vec<Sample>], symmetric: bool) -> Vec<Candidate> {
     let mut candidates = Vec::new();
     let interior = |s: &Sample| symmetric && s.grid.is_some_and(|i| i > 0);
     for line in lines {
         for (i, a) in line.iter().enumerate() {
-            integers_between(a, None, interior(a), tol, &mut candidates);
+            integers_between(a, None, interior(a), &mut candidates);
             if let Some(b) = line[i + 1..]
                 .iter()
                 .find(|b| b.gap == a.gap && b.well == a.well && !on_integer(b))
             {
-                integers_between(a, Some(b), false, tol, &mut candidates);
+                integers_between(a, Some(b), false, &mut candidates);
             }
         }
     }
@@ -1685,7 +1678,7 @@ fn brackets(lines: &[Vec<Sample>], tol: f64, symmetric: bool) -> Vec<Candidate> 
             if let Some(b) = pair[1].iter().find(|b| {
                 b.grid == a.grid && b.gap == a.gap && b.well == a.well && b.shape == a.shape
             }) {
-                integers_between(a, Some(b), false, tol, &mut candidates);
+                integers_between(a, Some(b), false, &mut candidates);
             }
         }
     }

@@ -385,7 +385,7 @@ pub fn census<S: Shape>(
     let kappas = kappa_lines(KAPPA_FLOOR, 4.0, options.resolution);
     let mut lines: Vec<Vec<Sample>> = kappas.par_iter().map(|&k| sampler.line(k)).collect();
     stopped()?;
-    let mut candidates = brackets(&lines, options.tol, symmetric);
+    let mut candidates = brackets(&lines, symmetric);
     let (mut found, mut failures) = counterexamples(&sampler, &candidates);
     stopped()?;
     let from_limits = limit_resonances(&high_energy);
