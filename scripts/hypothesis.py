@@ -51,10 +51,10 @@ def verdict(alpha: float, beta: float, nu: float, eta: float, resolution: int) -
 
 
 def label(holds, case="1") -> str:
-    """holds / fails; for a null verdict, `not covered`, or `undecided` in case 2 (κ_max not
-    found and nothing beyond it fails)."""
+    """holds / fails; for a null verdict, `not covered` where the hypothesis says nothing
+    (α = 0, β ≥ 1), else `undecided` (the verdict's reason says why)."""
     if holds is None:
-        return "undecided" if case == "2" else "not covered"
+        return "not covered" if case == "not_covered" else "undecided"
     return "holds" if holds else "fails"
 
 
@@ -89,15 +89,18 @@ def boundary_rows(results, nu, eta) -> list[dict]:
 
 
 def curve_kind(row: dict) -> str | None:
-    """Boundaries of one mechanism join into one curve β(α) (whether the sampled plane or the
-    high-energy limit decided it at that α); the hair-thin band of undecided case-2 bodies
-    just above β² = 1 + α is not a curve of its own."""
+    """Boundaries of one mechanism and one side of failure join into one curve β(α) (whether
+    the sampled plane or the high-energy limit decided it at that α, and whether a hair-thin
+    undecided band lies beside it there); the edges of those bands (found by bisection on the
+    verdict) are not curves of their own."""
     if row["quantity"].startswith("case"):
         return "case line beta^2 = 1 + alpha"
-    if "undecided" in row["below"] or "undecided" in row["above"]:
+    below, above = row["below"], row["above"]
+    if row["quantity"] == "verdict" and ("undecided" in below or "undecided" in above):
         return None
     mechanism = row["quantity"].replace("fail_margin: ", "").split(" (sampled")[0].split(" (high-energy")[0]
-    return f"{row['below']} | {row['above']}: {mechanism}"
+    side = "fails above" if "fails" in above else "fails below" if "fails" in below else f"{below} | {above}"
+    return f"case {row['below'].split()[1]}, {side}: {mechanism}"
 
 
 def curves_of(brows: list[dict]) -> dict[tuple, dict[str, list]]:

@@ -1888,6 +1888,13 @@ impl Default for BoundaryOptions {
 /// Relative width to which a boundary is located on the sampled plane.
 const BOUNDARY_XTOL: f64 = 1e-5;
 
+/// Least relative distance from a boundary at which its sides are judged (the labels
+/// `holds_below`, `holds_above`); at least four times the boundary's error bar.
+const SIDE_REACH: f64 = 1e-6;
+
+/// Changes beyond one per scan step that [`boundaries`] locates (where a step holds several).
+const MORE_CHANGES: usize = 64;
+
 /// Illinois regula falsi on a bracket, to a relative width `xtol`: the root and the final
 /// bracket's width (a bound on its error).
 fn illinois(
@@ -1955,9 +1962,10 @@ fn key(v: &Verdict) -> (Case, Option<bool>) {
 
 /// The β in (β_min, β_max) at which the verdict (case and holds) changes at this α. The
 /// scan solves the full verdict at log-spaced β; each change is then located by root-finding
-/// (Illinois regula falsi) on the high-energy quantity that changes sign across it, and
-/// checked by the verdict on both sides of the root; a change no limit explains is located
-/// by bisection on the verdict itself.
+/// (Illinois regula falsi) on the fail-margin term that changes sign across it, or by bisection
+/// on the verdict itself where none does. Its labels are the verdicts a few error bars (at
+/// least [`SIDE_REACH`] relative) on either side of the root; where one differs from the step's
+/// end on that side, the step holds another change, located in turn.
 pub fn boundaries(alpha: f64, nu: f64, eta: f64, options: &BoundaryOptions) -> Result<Boundaries> {
     boundaries_until(alpha, nu, eta, options, &|| false)
 }
@@ -2089,38 +2097,15 @@ pub fn boundaries_with(
             v
         })
         .collect::<Result<_>>()?;
-    let changes = verdicts
-        .windows(2)
-        .filter(|p| key(&p[0]) != key(&p[1]))
-        .count();
-    let mut found = Vec::new();
-    for pair in verdicts.windows(2) {
-        let (lo, hi) = (&pair[0], &pair[1]);
-        if key(lo) == key(hi) {
-            continue;
-        }
-        progress(BoundarySearch::Locating {
-            index: found.len() + 1,
-            of: changes,
-        });
-        let boundary = |beta: f64, error: f64, quantity: String| Boundary {
-            beta,
-            error,
-            quantity,
-            case_below: lo.case,
-            holds_below: lo.holds,
-            case_above: hi.case,
-            holds_above: hi.holds,
-        };
+    // Where in (lo.β, hi.β) the verdict changes, to what error, and what decides it.
+    let locate_change = |lo: &Verdict, hi: &Verdict| -> Result<(f64, f64, String)> {
         if lo.case != hi.case {
-            found.push(boundary(
+            return Ok((
                 case_line,
                 4.0 * f64::EPSILON * case_line,
                 "case: beta^2 = 1 + alpha".into(),
             ));
-            continue;
         }
-        let mut located = None;
         if let (Some(ml), Some(mh)) = (lo.margins, hi.margins) {
             let (tl, th) = (ml.terms(), mh.terms());
             // The term that changes sign across the pair decides; where the high-energy limit
@@ -2154,29 +2139,84 @@ pub fn boundaries_with(
                         let moved = resolution_term(coarse, lo.beta, hi.beta, root, xtol)?;
                         ("sampled plane", width + moved)
                     };
-                    located = Some(boundary(
-                        root,
-                        error,
-                        format!("fail_margin: {} ({source})", Margins::NAMES[t]),
-                    ));
+                    let quantity = format!("fail_margin: {} ({source})", Margins::NAMES[t]);
+                    return Ok((root, error, quantity));
                 }
             }
         }
-        if located.is_none() {
-            // Bisection on the verdict itself, to the same relative width.
-            let (mut a, mut b) = (lo.beta, hi.beta);
-            while b - a > BOUNDARY_XTOL * b {
-                let m = (a * b).sqrt();
-                if key(&margin(m)?) == key(lo) {
-                    a = m;
-                } else {
-                    b = m;
-                }
+        // Bisection on the verdict itself, to the same relative width.
+        let (mut a, mut b) = (lo.beta, hi.beta);
+        while b - a > BOUNDARY_XTOL * b {
+            let m = (a * b).sqrt();
+            if key(&margin(m)?) == key(lo) {
+                a = m;
+            } else {
+                b = m;
             }
-            located = Some(boundary((a * b).sqrt(), 0.5 * (b - a), "verdict".into()));
         }
-        found.extend(located);
+        Ok(((a * b).sqrt(), 0.5 * (b - a), "verdict".into()))
+    };
+    // The pairs of neighbouring verdicts that differ, each holding at least one change; a
+    // pair whose located change is not the whole story (the verdict a few error bars from the
+    // root differs from the pair's end on that side) gives the pair between them back here.
+    let mut pairs: std::collections::VecDeque<(Verdict, Verdict)> = verdicts
+        .windows(2)
+        .filter(|p| key(&p[0]) != key(&p[1]))
+        .map(|p| (p[0].clone(), p[1].clone()))
+        .collect();
+    let mut of = pairs.len();
+    let mut found = Vec::new();
+    let mut index = 0;
+    while let Some((lo, hi)) = pairs.pop_front() {
+        index += 1;
+        progress(BoundarySearch::Locating { index, of });
+        let (beta, error, quantity) = locate_change(&lo, &hi)?;
+        if lo.case != hi.case {
+            // The scan's own β at (1 ∓ 1e-9) of the case line are its sides.
+            found.push(Boundary {
+                beta,
+                error,
+                quantity,
+                case_below: lo.case,
+                holds_below: lo.holds,
+                case_above: hi.case,
+                holds_above: hi.holds,
+            });
+            continue;
+        }
+        // The labels are the verdicts a few error bars away on either side, not the pair's
+        // ends: one scan step may hold two changes (at ν = 1.5, η = 5, α = 0.867 the
+        // undecided band just above the case line and the N = −1 boundary at 1.7399).
+        let reach = (4.0 * error).max(SIDE_REACH * beta);
+        let side = |b: f64, end: &Verdict| -> Result<Verdict> {
+            if (b - end.beta) * (beta - end.beta) > 0.0
+                && (b - beta).abs() < (end.beta - beta).abs()
+            {
+                margin(b)
+            } else {
+                Ok(end.clone())
+            }
+        };
+        let (below, above) = (side(beta - reach, &lo)?, side(beta + reach, &hi)?);
+        for (a, b) in [(&lo, &below), (&above, &hi)] {
+            if key(a) != key(b) && of < options.scan + MORE_CHANGES {
+                of += 1;
+                pairs.push_back((a.clone(), b.clone()));
+            }
+        }
+        if key(&below) != key(&above) {
+            found.push(Boundary {
+                beta,
+                error,
+                quantity,
+                case_below: below.case,
+                holds_below: below.holds,
+                case_above: above.case,
+                holds_above: above.holds,
+            });
+        }
     }
+    found.sort_by(|a, b| a.beta.total_cmp(&b.beta));
     Ok(Boundaries {
         alpha,
         nu,

@@ -116,3 +116,26 @@ def test_map_boundaries_and_evidence(tmp_path):
     with h5py.File(out.with_suffix(".h5")) as f:
         assert set(f) == {"map", "boundaries", "evidence"} and f.attrs["nu"] == 0.5 and f.attrs["resolution"] == 32
     assert out.with_suffix(".png").stat().st_size > 10_000
+
+
+def test_curves_join_one_mechanism_whatever_band_lies_beside_it():
+    """A boundary beside a hair-thin undecided band (its side judged undecided) stays on its
+    curve; the band's own edge (bisection on the verdict) is no curve; a case-1 body without a
+    verdict is `undecided`, and only α = 0, β ≥ 1 is `not covered`."""
+    sys.path.insert(0, str(ROOT / "scripts"))
+    import hypothesis
+
+    def row(quantity, below, above):
+        return dict(quantity=quantity, below=below, above=above)
+
+    n0 = "fail_margin: N takes both signs (N = 0) (sampled plane)"
+    n1 = "fail_margin: N reaches -1 (sampled plane)"
+    assert hypothesis.curve_kind(row(n0, "case 1 fails", "case 1 holds")) == hypothesis.curve_kind(
+        row(n0, "case 1 fails", "case 1 undecided"))
+    assert hypothesis.curve_kind(row(n1, "case 2 holds", "case 2 fails")) == hypothesis.curve_kind(
+        row(n1.replace("sampled plane", "high-energy limit"), "case 2 undecided", "case 2 fails"))
+    assert hypothesis.curve_kind(row(n1, "case 2 holds", "case 2 fails")) != hypothesis.curve_kind(
+        row(n1, "case 2 fails", "case 2 holds"))
+    assert hypothesis.curve_kind(row("verdict", "case 2 undecided", "case 2 holds")) is None
+    assert hypothesis.label(None, "1") == hypothesis.label(None, "2") == "undecided"
+    assert hypothesis.label(None, "not_covered") == "not covered"

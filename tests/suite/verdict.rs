@@ -456,3 +456,63 @@ fn bad_options_are_refused() {
     };
     assert!(boundaries(0.5, 0.5, 0.5, &bad).is_err());
 }
+
+/// Issue 22 (G3): one scan step may hold two changes. At ν = 1.5, η = 5, α = 0.867 the step
+/// from just above the case line (undecided there) to β = 1.78 (fails) holds the end of the
+/// undecided band and the N = −1 boundary at 1.7399071; the boundary took its labels from the
+/// step's ends ("case 2 undecided below") while the bodies just below it hold, and the
+/// undecided → holds change was not reported. Every label must be the verdict of the bodies
+/// between two neighbouring boundaries, judged here at their geometric midpoints.
+#[test]
+fn a_scan_step_that_holds_two_changes_reports_both_with_the_labels_of_its_sides() {
+    let (alpha, nu, eta) = (0.8666666666666667, 1.5, 5.0);
+    let options = BoundaryOptions {
+        beta_min: 0.9,
+        beta_max: 2.5,
+        scan: 4,
+        verdict: VerdictOptions::default(),
+    };
+    let found = boundaries(alpha, nu, eta, &options).unwrap();
+    let b = &found.boundaries;
+    let summary: Vec<_> = b
+        .iter()
+        .map(|x| (x.beta, x.holds_below, x.holds_above, x.quantity.as_str()))
+        .collect();
+    assert_eq!(b.len(), 3, "{summary:#?}");
+    let case_line = (1.0 + alpha).sqrt();
+    assert!(b[0].quantity.starts_with("case"), "{summary:#?}");
+    assert!(
+        (b[1].beta / case_line - 1.0) < 1e-4 && b[1].holds_below.is_none(),
+        "{summary:#?}"
+    );
+    assert_eq!(
+        (b[1].holds_above, b[2].holds_above),
+        (Some(true), Some(false))
+    );
+    assert!(
+        (b[2].beta - 1.7399071).abs() < 2e-7 + b[2].error,
+        "{summary:#?}"
+    );
+    // The labels against the verdicts between the boundaries and beyond the outer ones.
+    let judge = |beta: f64| {
+        let body = EllipsoidBody::ellipsoid(alpha, beta, nu, eta).unwrap();
+        let v = verdict(&body, &VerdictOptions::default()).unwrap();
+        (v.case, v.holds)
+    };
+    let mut edges = vec![options.beta_min];
+    edges.extend(b.iter().map(|x| x.beta));
+    edges.push(options.beta_max);
+    for (i, w) in edges.windows(2).enumerate() {
+        let between = judge((w[0] * w[1]).sqrt());
+        if i > 0 {
+            assert_eq!(
+                between,
+                (b[i - 1].case_above, b[i - 1].holds_above),
+                "{summary:#?}"
+            );
+        }
+        if i < b.len() {
+            assert_eq!(between, (b[i].case_below, b[i].holds_below), "{summary:#?}");
+        }
+    }
+}
