@@ -2,13 +2,20 @@
 //! the memory the kernel could give now, the free disk under a folder, and bytes shown as a
 //! person reads them.
 
-/// Bytes as a person reads them, one format throughout: 1.5 GB, 310.0 MB.
+/// Bytes as a person reads them, one format throughout: 1.5 GB, 310.0 MB, 1.4 PB.
 pub fn show_bytes(bytes: f64) -> String {
-    // (Beyond a thousand TB, in powers of ten: 1e24 cells made "932000000000000.0 TB".)
-    if bytes >= 1e15 {
+    // (Beyond a thousand EB, in powers of ten: 1e24 cells made "932000000000000.0 TB".)
+    if bytes >= 1e21 {
         return format!("{bytes:.1e} B");
     }
-    let units = [("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("kB", 1e3)];
+    let units = [
+        ("EB", 1e18),
+        ("PB", 1e15),
+        ("TB", 1e12),
+        ("GB", 1e9),
+        ("MB", 1e6),
+        ("kB", 1e3),
+    ];
     match units.iter().find(|(_, size)| bytes >= *size) {
         Some((name, size)) => format!("{:.1} {name}", bytes / size),
         None => format!("{bytes:.0} B"),
@@ -133,5 +140,45 @@ pub fn check_memory(bytes: f64, allow_large: bool, remedy: &str) -> crate::Resul
             reason: format!("needs {short}: {remedy}"),
         }),
         _ => Ok(()),
+    }
+}
+
+/// The thread count `RAYON_NUM_THREADS` asks for, read as rayon reads it: unset, empty or 0 is
+/// every core (`None`); anything but a whole number is refused in one line, not ignored as
+/// rayon ignores it.
+pub fn threads_from_env() -> crate::Result<Option<usize>> {
+    match std::env::var("RAYON_NUM_THREADS") {
+        Ok(v) if !v.trim().is_empty() => match v.trim().parse::<usize>() {
+            Ok(n) => Ok(Some(n).filter(|&n| n > 0)),
+            Err(_) => Err(crate::AtlasError::Atlas {
+                path: format!("RAYON_NUM_THREADS = {v:?}"),
+                reason: format!(
+                    "must be a whole number of threads, at most {} (0 or unset: every core)",
+                    usize::MAX
+                ),
+            }),
+        },
+        _ => Ok(None),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::show_bytes;
+
+    /// One format from bytes to exabytes (refusals showed "1.4e15 B" beside "14.4 TB":
+    /// adversary pass 34), powers of ten only beyond.
+    #[test]
+    fn bytes_read_as_a_person_reads_them() {
+        for (bytes, shown) in [
+            (12.0, "12 B"),
+            (310e6, "310.0 MB"),
+            (932e12, "932.0 TB"),
+            (1.44e15, "1.4 PB"),
+            (2.5e18, "2.5 EB"),
+            (4.6e21, "4.6e21 B"),
+        ] {
+            assert_eq!(show_bytes(bytes), shown);
+        }
     }
 }

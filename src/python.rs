@@ -110,6 +110,9 @@ fn resolution_between(value: i64, lowest: i64, what: &str) -> PyResult<usize> {
 /// them (None: rayon's global pool, which honours RAYON_NUM_THREADS).
 fn pool(threads: Option<i64>) -> PyResult<Option<rayon::ThreadPool>> {
     let Some(n) = threads else {
+        // (rayon's pool ignores a RAYON_NUM_THREADS that is not a number; the program refuses
+        // it, and so does the package: adversary pass 34.)
+        crate::machine::threads_from_env().map_err(value_error)?;
         return Ok(None);
     };
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
@@ -152,6 +155,9 @@ fn interruptible<T: Send>(
     work: impl FnOnce(&(dyn Fn() -> bool + Sync)) -> T + Send,
 ) -> PyResult<T> {
     use std::sync::atomic::{AtomicBool, Ordering};
+    if pool.is_none() {
+        crate::machine::threads_from_env().map_err(value_error)?;
+    }
     let stop = AtomicBool::new(false);
     let done = AtomicBool::new(false);
     let asked_to_stop = || stop.load(Ordering::Relaxed);

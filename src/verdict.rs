@@ -151,6 +151,10 @@ pub struct Counterexample {
     /// Its index among the cell's components in increasing θ_min (as `cell --json` lists
     /// them and `trajectory --component` takes it).
     pub component: usize,
+    /// The cell's status there, as `cell` reports it: `ok` for a verdict; a census also takes
+    /// a point whose N is within the tolerance while another output is not (T beside a
+    /// separatrix), `tolerance_not_reached`.
+    pub status: Status,
 }
 
 /// What a verdict rests on.
@@ -264,7 +268,14 @@ const BOTTOM_SCAN: usize = 16;
 /// dip of N_b between two lines puts N beyond an integer in a sliver above the bottom that no
 /// sample sees (α = 0.9, β = 1.6773, ν = 1.5, η = 5: N_b = −1.00009 at κ = 0.35 between
 /// lines whose bottoms have −0.99 and −0.9994, and the verdict held: adversary pass 33).
-fn bottom_extreme_kappas<S: Shape>(body: &Body<S>, kappas: &[f64]) -> Vec<f64> {
+///
+/// Asked to `stop`, it scans no further and finds nothing (the caller then stops): at
+/// resolution 1024 the scan takes seconds (Ctrl-C waited 1–5 s for it: adversary pass 34).
+fn bottom_extreme_kappas<S: Shape>(
+    body: &Body<S>,
+    kappas: &[f64],
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Vec<f64> {
     // (smallest, largest) N_b over the wells at κ; ±∞ where V has no minimum with N_b.
     let bottoms = |kappa: f64| -> [f64; 2] {
         let potential = EffectivePotential::new(body, kappa);
@@ -285,7 +296,13 @@ fn bottom_extreme_kappas<S: Shape>(body: &Body<S>, kappas: &[f64]) -> Vec<f64> {
         })
         .collect();
     scan.extend(kappas.last());
-    let values: Vec<[f64; 2]> = scan.par_iter().map(|&k| bottoms(k)).collect();
+    let values: Option<Vec<[f64; 2]>> = scan
+        .par_iter()
+        .map(|&k| (!stop()).then(|| bottoms(k)))
+        .collect();
+    let Some(values) = values else {
+        return Vec::new();
+    };
     let mut found = Vec::new();
     for (slot, sign) in [(0, -1.0), (1, 1.0)] {
         let f = |k: f64| sign * bottoms(k)[slot];
@@ -317,9 +334,10 @@ fn lines_with_bottom_extremes<S: Shape>(
     lo: f64,
     linear_top: f64,
     resolution: usize,
+    stop: &(dyn Fn() -> bool + Sync),
 ) -> Vec<f64> {
     let mut k = kappa_lines(lo, linear_top, resolution);
-    let extra = bottom_extreme_kappas(body, &k);
+    let extra = bottom_extreme_kappas(body, &k, stop);
     k.extend(extra);
     k.sort_by(f64::total_cmp);
     k.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs());
@@ -1057,7 +1075,7 @@ pub fn verdict_until(
     let mut coarse = None;
     if options.coarse_first && options.counterexamples && resolution >= 16 {
         let half = resolution / 2;
-        let kappas = lines_with_bottom_extremes(body, lo, linear_top, half);
+        let kappas = lines_with_bottom_extremes(body, lo, linear_top, half, stop);
         let sampler = Sampler {
             body,
             cell,
@@ -1090,7 +1108,7 @@ pub fn verdict_until(
         stop,
     };
     let (kappas, lines) = coarse.unwrap_or_else(|| {
-        let kappas = lines_with_bottom_extremes(body, lo, linear_top, resolution);
+        let kappas = lines_with_bottom_extremes(body, lo, linear_top, resolution, stop);
         let lines: Vec<Vec<Sample>> = kappas.par_iter().map(|&k| sampler.line(k)).collect();
         (kappas, lines)
     });
@@ -1818,6 +1836,7 @@ fn refine<S: Shape>(sampler: &Sampler<'_, S>, c: &Candidate) -> Option<Counterex
         drift_error: r.errors.drift,
         family: r.family,
         component,
+        status: r.status,
     })
 }
 
@@ -2235,4 +2254,29 @@ pub fn boundaries_with(
             })
             .collect(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{bottom_extreme_kappas, kappa_lines};
+    use crate::EllipsoidBody;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    /// The scan for N's extremes at the bottom hears a stop: at resolution 1024 it is 16,000
+    /// bottoms and took seconds, during which Ctrl-C waited (1–5 s, adversary pass 34). Asked
+    /// to stop at its 100th point, it looks at few more and finds nothing; not asked, it
+    /// finds the dip of α = 0.9, β = 1.6773, ν = 1.5, η = 5 (N_b = −1.00009 near κ = 0.35).
+    #[test]
+    fn the_bottom_scan_stops_when_asked() {
+        let body = EllipsoidBody::ellipsoid(0.9, 1.6773, 1.5, 5.0).unwrap();
+        let kappas = kappa_lines(0.2, 4.0, 1024);
+        let polls = AtomicUsize::new(0);
+        let stop = || polls.fetch_add(1, Ordering::Relaxed) >= 100;
+        assert!(bottom_extreme_kappas(&body, &kappas, &stop).is_empty());
+        let polled = polls.load(Ordering::Relaxed);
+        assert!(polled < 1_000, "{polled} points after the stop");
+        let coarse = kappa_lines(0.2, 4.0, 64);
+        let found = bottom_extreme_kappas(&body, &coarse, &|| false);
+        assert!(found.iter().any(|k| (k - 0.3475).abs() < 0.01), "{found:?}");
+    }
 }

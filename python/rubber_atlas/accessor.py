@@ -4,6 +4,7 @@ of a session, one call each."""
 from __future__ import annotations
 
 import functools
+import math
 from fractions import Fraction
 
 import numpy as np
@@ -16,6 +17,8 @@ _LABELS = {"kappa": "κ", "energy": "ε", "excess_energy": "ε − V_min", "lamb
            "s": "s = 1/√ε", "alpha": "α", "beta": "β", "cut": "h", "nu": "ν", "eta": "η"}
 # At most this many resonance contours per panel: fewer denominators beyond.
 _MAX_LEVELS = 60
+# The largest max_q of plot_slice: beyond it the contours would be lowered to fewer anyway.
+_MAX_Q = 100
 # A trajectory's plane is drawn with equal scales only while the path's extents differ by at
 # most this factor: a drifting path, long and thin, would otherwise shrink to a flat line.
 _EQUAL_ASPECT_UP_TO = 4.0
@@ -48,6 +51,26 @@ def resonances(lo: float, hi: float, max_q: int = 7) -> list[float]:
         for p in range(int(np.floor(lo * q)), int(np.ceil(hi * q)) + 1)
     }
     return sorted(float(f) for f in found if lo <= f <= hi)
+
+
+def _contour_levels(lo: float, hi: float, max_q: int) -> tuple[int, list[float]]:
+    """The largest q ≤ `max_q` whose values p/q in [lo, hi] number at most `_MAX_LEVELS`, with
+    those values; where even the integers are more, q = 1 and the first `_MAX_LEVELS` of them.
+    The count only grows with q, so q is found by bisection, and a q whose p/q (repeats
+    counted, from the ends alone) are too many to list is not listed: N's range reaches 1e12
+    beside a separatrix, and `max_q` 1000 took minutes one q at a time (adversary pass 34)."""
+    def fits(q: int) -> bool:
+        listed = sum(max(0, math.floor(hi * k) - math.ceil(lo * k) + 1) for k in range(1, q + 1))
+        return listed <= _MAX_LEVELS or (listed <= 400 * _MAX_LEVELS and len(resonances(lo, hi, q)) <= _MAX_LEVELS)
+
+    if not fits(1):
+        first = math.ceil(lo)
+        return 1, [float(i) for i in range(first, first + _MAX_LEVELS) if i <= hi]
+    good, bad = 1, max_q + 1
+    while bad - good > 1:
+        mid = (good + bad) // 2
+        good, bad = (mid, bad) if fits(mid) else (good, mid)
+    return good, resonances(lo, hi, good)
 
 
 def _family_codes(ds: xr.Dataset) -> dict[str, int]:
@@ -365,8 +388,8 @@ class RubberAccessor:
             has those dimensions; a negative index counts from the end, as in numpy (−1 is
             the last).
         max_q : int, default 7
-            The largest denominator q of the contours N = p/q, ≥ 1; lowered where a panel
-            would have more than 60 contours.
+            The largest denominator q of the contours N = p/q, from 1 to 100; lowered where a
+            panel would have more than 60 contours.
         cut_index : int, default 0
             The cut of a truncated ball or wheel atlas (index along ``cut``, negative from
             the end; the disk's atlas has no second dimension).
@@ -383,7 +406,7 @@ class RubberAccessor:
         ValueError
             The dataset is not an atlas or a `cells` result over two dimensions (besides
             α and β, or α and the cut); an index beyond ``alpha``, ``beta`` or ``cut`` (a dataset without that
-            dimension has index 0 only); `max_q` < 1; a slice that is empty or whose axes
+            dimension has index 0 only); `max_q` outside 1 … 100; a slice that is empty or whose axes
             are not finite; nothing to draw: neither rotation_number nor drift_radius (the
             fields left them out), or no finite value of them (the message counts the
             cells by ``cell_status``, e.g. "12 no_motion"); a damaged file.
@@ -408,8 +431,8 @@ class RubberAccessor:
         ds = self._ds
         _api._cells_dataset(ds, "plot_slice")
         max_q = _api._count("max_q", max_q)
-        if max_q < 1:
-            raise ValueError(f"invalid max_q = {max_q}: must be >= 1")
+        if not 1 <= max_q <= _MAX_Q:
+            raise ValueError(f"invalid max_q = {max_q}: must be between 1 and {_MAX_Q}")
         cut = ds
         for name, index in (("alpha", alpha_index), ("beta", beta_index), ("cut", cut_index)):
             index = _api._count(f"{name}_index", index)
@@ -494,10 +517,7 @@ class RubberAccessor:
             mesh = ax.pcolormesh(x, y, np.ma.masked_invalid(values), shading="auto", cmap="RdBu_r", norm=norm)
             fig.colorbar(mesh, ax=ax, label="N", extend=extend)
             lo, hi = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 0.0)
-            q = max_q
-            while q > 1 and len(resonances(lo, hi, q)) > _MAX_LEVELS:
-                q -= 1
-            levels = resonances(lo, hi, q)
+            q, levels = _contour_levels(lo, hi, max_q)
             integers = [v for v in levels if float(v).is_integer()]
             fractions = [v for v in levels if not float(v).is_integer()]
             contoured = np.ma.masked_invalid(values)

@@ -272,6 +272,9 @@ def test_plot_slice_refuses_indices_it_does_not_have(slice_atlas):
         refused(ValueError, lambda: atlas.rubber.plot_slice(beta_index=-2), "beta_index = -2", "from the end")
         refused(TypeError, lambda: atlas.rubber.plot_slice(alpha_index="x"), "alpha_index")
         refused(ValueError, lambda: atlas.rubber.plot_slice(max_q=0), "max_q")
+        # A max_q of 1000 ran for minutes, 10**6 grew without end (adversary pass 34).
+        for big in (101, 1000, 10**6):
+            refused(ValueError, lambda: atlas.rubber.plot_slice(max_q=big), f"max_q = {big}", "100")
     cells = ra.cells(*BODY, kappa=np.linspace(0.1, 1.0, 4), energy=np.linspace(1.5, 3.5, 3))
     refused(ValueError, lambda: cells.rubber.plot_slice(alpha_index=1), "alpha_index = 1")
 
@@ -789,3 +792,30 @@ def test_components_of_a_dataset_that_lost_its_attributes_or_its_component_dimen
                  lambda: one.rubber.families(), lambda: ra.components(one, kappa=0.8, energy=4.0)):
         with pytest.raises(ValueError, match="component dimension"):
             call()
+
+
+def test_contour_levels_are_the_largest_q_that_fits_and_cheap_on_any_range():
+    """The contours' q, found by bisection, is the one the linear search down from max_q
+    finds; over N's range beside a separatrix (to 1e12) it lists 60 integers at once."""
+    from fractions import Fraction
+
+    from rubber_atlas import accessor
+
+    def linear(lo, hi, max_q):
+        q = max_q
+        while q > 1 and len(accessor.resonances(lo, hi, q)) > accessor._MAX_LEVELS:
+            q -= 1
+        return q, accessor.resonances(lo, hi, q)
+
+    rng = np.random.default_rng(34)
+    for _ in range(40):
+        lo = float(rng.uniform(-3, 1))
+        hi = lo + float(10 ** rng.uniform(-4, 0.3))
+        max_q = int(rng.integers(1, 101))
+        q, levels = accessor._contour_levels(lo, hi, max_q)
+        if len(accessor.resonances(lo, hi, 1)) <= accessor._MAX_LEVELS:
+            assert (q, levels) == linear(lo, hi, max_q), (lo, hi, max_q)
+    q, levels = accessor._contour_levels(-1e12, 1e12, 100)
+    assert q == 1 and levels == [float(i) for i in range(-10**12, -10**12 + 60)]
+    assert accessor._contour_levels(0.25, 0.25, 100) == (100, [0.25])
+    assert Fraction(1, 3) in {Fraction(x).limit_denominator(10) for x in accessor._contour_levels(0, 1, 7)[1]}

@@ -452,6 +452,14 @@ def test_rayon_num_threads_is_honoured_when_threads_is_absent(tmp_path):
         assert after.returncode == 0, after.stderr
         threads[n] = int(after.stdout)
     assert threads[3] - threads[1] == 2, threads
+    # One that is not a whole number is refused, as the program refuses it (it was ignored:
+    # adversary pass 34), by every function that would run on rayon's global pool.
+    for call in ("ra.cells(0.5, 3.0, 0.5, 0.5, 0.8, 2.5)", "ra.verdict(0.5, 3.0, 0.5, 0.5)",
+                 "ra.diagram(0.5, 3.0)"):
+        refused = subprocess.run([sys.executable, "-c", f"import rubber_atlas as ra; {call}"], cwd=tmp_path,
+                                 env=dict(os.environ, RAYON_NUM_THREADS="abc"), capture_output=True, text=True)
+        last = refused.stderr.strip().splitlines()[-1]
+        assert refused.returncode == 1 and last.startswith('ValueError: RAYON_NUM_THREADS = "abc"'), refused.stderr
 
 
 def test_boundaries_equal_the_command():

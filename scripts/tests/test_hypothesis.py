@@ -38,6 +38,7 @@ def test_contract_keys_and_the_issue_bodies():
          f"--energy={c['energy']!r}", "--json"], check=True, capture_output=True, text=True).stdout)
     comp = min(cell["components"], key=lambda x: abs(x["theta_min"] - c["theta_min"]))
     assert abs(comp["rotation_number"] - c["integer"]) < 1e-9 and comp["bounded"] is False
+    assert c["status"] == comp["status"] == "ok"
     v = verdict("--alpha=0.9", "--beta=20", "--nu=0.5", "--eta=0.5")
     assert v["case"] == "2" and v["holds"] is False and abs(v["kappa_max"] - 3.919) < 1e-3
     assert all(c["kappa"] > v["kappa_max"] for c in v["counterexamples"])

@@ -222,21 +222,7 @@ pub(super) fn run_scene(args: RunArgs) -> Result<()> {
     }
     // --threads, else RAYON_NUM_THREADS (as rayon itself reads it), else every core.
     // (0, as for rayon, is every core; anything but a whole number is refused, not ignored.)
-    let from_env = match std::env::var("RAYON_NUM_THREADS") {
-        Ok(v) if !v.trim().is_empty() => match v.trim().parse::<usize>() {
-            Ok(n) => Some(n).filter(|&n| n > 0),
-            Err(_) => {
-                return Err(AtlasError::Atlas {
-                    path: format!("RAYON_NUM_THREADS = {v:?}"),
-                    reason: "must be a whole number of threads, at most 18446744073709551615 \
-                             (0 or unset: every core)"
-                        .into(),
-                }
-                .into())
-            }
-        },
-        _ => None,
-    };
+    let from_env = rubber_atlas::machine::threads_from_env()?;
     let threads = match args.threads.or(from_env) {
         Some(0) => {
             return Err(AtlasError::Atlas {

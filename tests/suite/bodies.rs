@@ -1436,6 +1436,17 @@ fn a_census_finds_the_resonances_and_its_points_run_away_in_the_full_equations()
                 (comp.rotation_number - p.integer as f64).abs() <= 1e-9,
                 "{ctx}: {p:?} re-solved {comp:?}"
             );
+            // Its status is the one `cell` reports there at the census's tolerance.
+            let at_tol = CellOptions {
+                tol: options.tol,
+                drift: true,
+                ..CellOptions::default()
+            };
+            let again = solve_cell(&body, p.kappa, p.energy, &at_tol).unwrap();
+            assert_eq!(
+                again.components[p.component].status, p.status,
+                "{ctx}: {p:?}"
+            );
             let start = Start {
                 kappa: p.kappa,
                 theta0: comp.theta_min,

@@ -516,3 +516,30 @@ fn a_scan_step_that_holds_two_changes_reports_both_with_the_labels_of_its_sides(
         }
     }
 }
+
+/// The verdict asks whether N equals an integer; `bounded` whether |N − k| is within the
+/// resonance tolerance (adversary pass 34 read the two as contradicting each other). A body
+/// that holds has a cell flagged unbounded at the default 1e-9 where N → 0 (κ → 0) without
+/// reaching it, bounded at 1e-12 (docs/hypothesis.md).
+#[test]
+fn a_body_that_holds_may_have_cells_within_the_resonance_tolerance() {
+    let body = EllipsoidBody::ellipsoid(0.5, 1.2, 0.5, 0.5).unwrap();
+    let v = verdict(&body, &VerdictOptions::default()).unwrap();
+    assert_eq!((v.case, v.holds), (Case::One, Some(true)));
+    let at = |resonance_tol: f64| {
+        let options = CellOptions {
+            resonance_tol,
+            drift: true,
+            ..CellOptions::default()
+        };
+        let cell = solve_cell(&body, 1e-9, 3.0, &options).unwrap();
+        assert_eq!(cell.components.len(), 1);
+        cell.components[0].clone()
+    };
+    let (loose, tight) = (at(1e-9), at(1e-12));
+    assert!(
+        loose.rotation_number < 0.0 && loose.rotation_number.abs() > 100.0 * loose.error_estimate,
+        "{loose:?}"
+    );
+    assert_eq!((loose.bounded, tight.bounded), (Some(false), Some(true)));
+}
