@@ -100,7 +100,7 @@ def curve_kind(row: dict) -> str | None:
         return None
     mechanism = row["quantity"].replace("fail_margin: ", "").split(" (sampled")[0].split(" (high-energy")[0]
     side = "fails above" if "fails" in above else "fails below" if "fails" in below else f"{below} | {above}"
-    return f"case {row['below'].split()[1]}, {side}: {mechanism}"
+    return f"case {below.split()[1]}, {side}: {mechanism}"
 
 
 def curves_of(brows: list[dict]) -> dict[tuple, dict[str, list]]:

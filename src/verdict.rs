@@ -2190,22 +2190,10 @@ pub fn boundaries_with(
         index += 1;
         progress(BoundarySearch::Locating { index, of });
         let (beta, error, quantity) = locate_change(&lo, &hi)?;
-        if lo.case != hi.case {
-            // The scan's own β at (1 ∓ 1e-9) of the case line are its sides.
-            found.push(Boundary {
-                beta,
-                error,
-                quantity,
-                case_below: lo.case,
-                holds_below: lo.holds,
-                case_above: hi.case,
-                holds_above: hi.holds,
-            });
-            continue;
-        }
         // The labels are the verdicts a few error bars away on either side, not the pair's
         // ends: one scan step may hold two changes (at ν = 1.5, η = 5, α = 0.867 the
-        // undecided band just above the case line and the N = −1 boundary at 1.7399).
+        // undecided band just above the case line and the N = −1 boundary at 1.7399). (The
+        // case line's sides are the scan's own β at (1 ∓ 1e-9) of it, nearer than the reach.)
         let reach = (4.0 * error).max(SIDE_REACH * beta);
         let side = |b: f64, end: &Verdict| -> Result<Verdict> {
             if (b - end.beta) * (beta - end.beta) > 0.0
