@@ -10,7 +10,7 @@ use crate::cf::{self, Units};
 use crate::error::{AtlasError, Result};
 use crate::family::{Census, ComponentAxis, Family};
 use crate::scene::{Field, Plane, Scene};
-use crate::torus::{EffectivePotential, MotionKind};
+use crate::torus::{EffectivePotential, MotionKind, ScanTable};
 use rayon::prelude::*;
 use std::f64::consts::{PI, TAU};
 use std::ops::Range;
@@ -828,6 +828,7 @@ fn visit_row<S: Shape>(
         }
         Plane::Compact => {
             // κ = λ/s, ε = 1/s²: every cell has its own κ; s = 0 is ε = ∞.
+            let table = ScanTable::new(body);
             for (j, &s) in columns.iter().enumerate() {
                 if s == 0.0 {
                     // λ = 0 keeps κ = 0 at ε = ∞ (rolling over the top), as at every s > 0.
@@ -835,7 +836,7 @@ fn visit_row<S: Shape>(
                     visit(j, (kappa, f64::INFINITY), CellLevel::HighEnergy(row_value));
                 } else {
                     let (kappa, energy) = (row_value / s, 1.0 / (s * s));
-                    let potential = EffectivePotential::new(body, kappa);
+                    let potential = EffectivePotential::with_scan(body, kappa, &table);
                     visit(j, (kappa, energy), CellLevel::Level(&potential, energy));
                 }
             }
@@ -1050,10 +1051,17 @@ fn visit_with_potentials<S: Shape>(
     mut visit: impl FnMut(usize, &CellPoint, &EffectivePotential<'_, S>) -> bool,
 ) {
     let key = |q: &CellPoint| [q.alpha, q.beta, q.nu, q.eta, q.kappa].map(f64::to_bits);
+    // The body's part of the scan, kept while the body stays (κ alone varying along a path).
+    let mut table: Option<([u64; 4], ScanTable)> = None;
     let mut row: Option<([u64; 5], EffectivePotential<'_, S>)> = None;
     for (j, (p, body)) in points.iter().zip(bodies).enumerate() {
         if row.as_ref().is_none_or(|(k, _)| *k != key(p)) {
-            row = Some((key(p), EffectivePotential::new(body, p.kappa)));
+            let body_key = [p.alpha, p.beta, p.nu, p.eta].map(f64::to_bits);
+            if table.as_ref().is_none_or(|(k, _)| *k != body_key) {
+                table = Some((body_key, ScanTable::new(body)));
+            }
+            let scan = &table.as_ref().expect("set above").1;
+            row = Some((key(p), EffectivePotential::with_scan(body, p.kappa, scan)));
         }
         if !visit(j, p, &row.as_ref().expect("set above").1) {
             return;

@@ -7,7 +7,7 @@
 use crate::body::Shape;
 use crate::cell::{solve_component, within_rounding_of_separatrix, CellOptions, Status};
 use crate::error::{check_range, AtlasError, Result, MAX_ENERGY, MAX_KAPPA};
-use crate::torus::{CriticalKind, EffectivePotential, MotionKind};
+use crate::torus::{CriticalKind, EffectivePotential, MotionKind, ScanTable};
 use crate::Body;
 use serde::Serialize;
 
@@ -326,6 +326,8 @@ fn nearest_root(
 
 struct Tracer<'a, S: Shape> {
     body: &'a Body<S>,
+    /// The body's part of V's critical-point scan, made once for every κ of the trace.
+    scan: ScanTable,
     options: &'a ResonanceOptions,
     /// The window's widths in κ and ε: the largest scales of [`Tracer::scale_at`].
     window: (f64, f64),
@@ -341,6 +343,7 @@ impl<'a, S: Shape> Tracer<'a, S> {
     ) -> Self {
         Self {
             body,
+            scan: ScanTable::new(body),
             options,
             window: (
                 options.kappa.1 - options.kappa.0,
@@ -371,7 +374,7 @@ impl<'a, S: Shape> Tracer<'a, S> {
     }
 
     fn at(&self, kappa: f64, energy: f64, well: f64) -> Option<CurvePoint> {
-        let potential = EffectivePotential::new(self.body, kappa);
+        let potential = EffectivePotential::with_scan(self.body, kappa, &self.scan);
         evaluate(&potential, energy, well, &self.options.cell)
     }
 
@@ -390,7 +393,7 @@ impl<'a, S: Shape> Tracer<'a, S> {
     /// ∇N = (∂N/∂κ, ∂N/∂ε), by central differences with steps (in `p`'s scaled units)
     /// that stay well inside the point's gap between separatrices.
     fn gradient(&self, p: &CurvePoint) -> Option<(f64, f64)> {
-        let potential = EffectivePotential::new(self.body, p.kappa);
+        let potential = EffectivePotential::with_scan(self.body, p.kappa, &self.scan);
         let scale = self.scale(p);
         let distance = side_of(&potential.separatrix_levels(), p.energy)
             .map_or(f64::INFINITY, |s| (p.energy - s.level).abs());
@@ -423,7 +426,7 @@ impl<'a, S: Shape> Tracer<'a, S> {
         let tol = self.tol();
         let scale = self.scale(from);
         let side = side_of(
-            &EffectivePotential::new(self.body, from.kappa).separatrix_levels(),
+            &EffectivePotential::with_scan(self.body, from.kappa, &self.scan).separatrix_levels(),
             from.energy,
         );
         let in_gap = |levels: &[f64], x: f64| {
@@ -434,7 +437,7 @@ impl<'a, S: Shape> Tracer<'a, S> {
             if kappa < k.0 || kappa > k.1 {
                 return None;
             }
-            let potential = EffectivePotential::new(self.body, kappa);
+            let potential = EffectivePotential::with_scan(self.body, kappa, &self.scan);
             let (lo, hi) = gap_for(&potential.separatrix_levels(), side);
             let (lo, hi) = (lo.max(e.0), hi.min(e.1));
             if lo >= hi {
@@ -458,7 +461,7 @@ impl<'a, S: Shape> Tracer<'a, S> {
                 return None;
             }
             let f = |x: f64| {
-                let potential = EffectivePotential::new(self.body, x);
+                let potential = EffectivePotential::with_scan(self.body, x, &self.scan);
                 if !in_gap(&potential.separatrix_levels(), energy) {
                     return None;
                 }
@@ -469,7 +472,7 @@ impl<'a, S: Shape> Tracer<'a, S> {
             let root = nearest_root(f, k.0, k.1, around, step * scale.0 * 0.05, tol)?;
             self.at(root, energy, from.well)?
         };
-        let potential = EffectivePotential::new(self.body, point.kappa);
+        let potential = EffectivePotential::with_scan(self.body, point.kappa, &self.scan);
         (self.on_curve(&point) && in_gap(&potential.separatrix_levels(), point.energy))
             .then_some(point)
     }
@@ -572,7 +575,7 @@ impl<'a, S: Shape> Tracer<'a, S> {
         let (k0, k1) = self.options.kappa;
         let step = (k1 - k0) / n as f64;
         let count = |k: f64| {
-            EffectivePotential::new(self.body, k)
+            EffectivePotential::with_scan(self.body, k, &self.scan)
                 .critical_points()
                 .len()
         };
@@ -627,7 +630,7 @@ impl<'a, S: Shape> Tracer<'a, S> {
                 if (self.stop)() {
                     return Vec::new();
                 }
-                let potential = EffectivePotential::new(self.body, kappa);
+                let potential = EffectivePotential::with_scan(self.body, kappa, &self.scan);
                 let levels = potential.separatrix_levels();
                 let bottom = potential.lowest_minimum().unwrap_or(e0);
                 let wells: Vec<f64> = potential

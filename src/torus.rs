@@ -258,10 +258,65 @@ pub struct EffectivePotential<'a, S: Shape> {
 /// sin³θ V′ is monotone unless its own derivative changes sign, and those roots are scanned too.
 const SCAN_CELLS: usize = 1024;
 
+/// The body's part of the critical-point scan, the same at every κ: the [`SCAN_CELLS`]
+/// uniform sites in (0, π) with sinθ, cosθ, U′ and U″ at each, the largest |U′| (at least 1)
+/// on every eighth cell's middle and the largest |U″| (at least 1) at the poles. Built once
+/// per body and handed to [`EffectivePotential::with_scan`] when V is wanted at many κ (a
+/// verdict, a resonance curve, a plane with κ per cell): it is most of the scan's work.
+#[derive(Debug, Clone)]
+pub struct ScanTable {
+    sites: Vec<Site>,
+    angles: Vec<Angle>,
+    slopes: Vec<f64>,
+    seconds: Vec<f64>,
+    steepest: f64,
+    pole_curvature: f64,
+}
+
+impl ScanTable {
+    /// The table of a body.
+    pub fn new<S: Shape>(body: &Body<S>) -> Self {
+        let shape = &body.shape;
+        let cell = PI / SCAN_CELLS as f64;
+        let half = SCAN_CELLS / 2;
+        let sites: Vec<Site> = (1..=half)
+            .map(|i| Site::at(cell * i as f64))
+            .chain((half + 1..SCAN_CELLS).map(|i| Site::from_pi(cell * (SCAN_CELLS - i) as f64)))
+            .collect();
+        let angles: Vec<Angle> = sites.iter().map(Site::angle).collect();
+        Self {
+            slopes: angles
+                .iter()
+                .map(|&a| shape.potential_prime_at(a))
+                .collect(),
+            seconds: angles
+                .iter()
+                .map(|&a| shape.potential_second_at(a))
+                .collect(),
+            sites,
+            angles,
+            steepest: (1..=SCAN_CELLS / 8)
+                .map(|i| shape.potential_prime_at(Angle::new(8.0 * cell * i as f64 - 0.5 * cell)))
+                .map(f64::abs)
+                .fold(1.0, f64::max),
+            pole_curvature: [Site::at(0.0), Site::from_pi(0.0)]
+                .iter()
+                .map(|s| shape.potential_second_at(s.angle()).abs())
+                .fold(1.0, f64::max),
+        }
+    }
+}
+
 impl<'a, S: Shape> EffectivePotential<'a, S> {
     /// V of `body` at F2 = `kappa`, with its critical points in (0, π) (κ ≠ 0) or on the
     /// circle [0, 2π) (κ = 0).
     pub fn new(body: &'a Body<S>, kappa: f64) -> Self {
+        Self::with_scan(body, kappa, &ScanTable::new(body))
+    }
+
+    /// [`Self::new`] with the body's part of the critical-point scan made beforehand
+    /// (`table` must be the same body's).
+    pub fn with_scan(body: &'a Body<S>, kappa: f64, table: &ScanTable) -> Self {
         let mut v = Self {
             body,
             kappa,
@@ -271,7 +326,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             inverse_eta: DoubleDouble::from_f64(1.0).div(DoubleDouble::from_f64(body.eta)),
             shoulders: Vec::new(),
         };
-        (v.critical, v.shoulders) = v.find_critical_points();
+        (v.critical, v.shoulders) = v.find_critical_points(table);
         v.dips = body
             .shape
             .slope_zeros()
@@ -533,12 +588,13 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
     }
 
     /// Where to look for critical points of V, in increasing θ over [0, π] (κ = 0: the
-    /// uniform cells alone): [`SCAN_CELLS`]
-    /// uniform cells, each pole's end cell again on a logarithmic scale (8 points a decade)
-    /// down to 10⁻³ √|κ|, below which V′ < 0 near θ = 0 (> 0 near π) whatever U (the wall
-    /// κ²/sin³θ beats any U′ there), so that a small well at a pole is not lost inside the
-    /// first cell. Sites beyond π/2 are held as π − θ.
-    fn scan_sites(&self) -> Vec<Site> {
+    /// uniform cells alone), with g′/sin²θ ([`Self::find_critical_points`]) at each site:
+    /// [`SCAN_CELLS`] uniform cells (their body's part from `table`), each pole's end cell
+    /// again on a logarithmic scale (8 points a decade) down to 10⁻³ √|κ|, below which V′ < 0
+    /// near θ = 0 (> 0 near π) whatever U (the wall κ²/sin³θ beats any U′ there), so that a
+    /// small well at a pole is not lost inside the first cell. Sites beyond π/2 are held as
+    /// π − θ.
+    fn scan_sites(&self, table: &ScanTable, dg: &impl Fn(Angle) -> f64) -> (Vec<Site>, Vec<f64>) {
         let cell = PI / SCAN_CELLS as f64;
         // κ = 0: the poles are critical points themselves, no well hides at them. Else the
         // well nearest a pole sits where κ²/sin³θ meets U′: at sinθ ~ (κ²/U″)^¼ by a smooth
@@ -550,21 +606,12 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         let innermost = if self.kappa == 0.0 {
             cell
         } else {
-            let shape = &self.body.shape;
             let k = self.kappa.abs();
-            let curvature = [Site::at(0.0), Site::from_pi(0.0)]
-                .iter()
-                .map(|s| shape.potential_second_at(s.angle()).abs())
-                .fold(1.0, f64::max);
-            let slope = (1..=SCAN_CELLS / 8)
-                .map(|i| shape.potential_prime_at(Angle::new(8.0 * cell * i as f64 - 0.5 * cell)))
-                .map(f64::abs)
-                .fold(1.0, f64::max);
             // (Each bound in powers of κ itself: κ² underflows below 1e-154.)
-            let smooth = k.sqrt() / curvature.sqrt().sqrt();
-            let steep = k.powf(2.0 / 3.0) / slope.cbrt();
-            let faces = shape.faces() != [false, false];
-            1e-3 * if faces || slope > 1.0 {
+            let smooth = k.sqrt() / table.pole_curvature.sqrt().sqrt();
+            let steep = k.powf(2.0 / 3.0) / table.steepest.cbrt();
+            let faces = self.body.shape.faces() != [false, false];
+            1e-3 * if faces || table.steepest > 1.0 {
                 smooth.min(steep)
             } else {
                 smooth
@@ -577,30 +624,35 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             logs.push(x);
             x *= 10f64.powf(0.125);
         }
-        let half = SCAN_CELLS / 2;
         let mut sites: Vec<Site> = logs.iter().map(|&x| Site::at(x)).collect();
-        sites.extend((1..=half).map(|i| Site::at(cell * i as f64)));
-        sites.extend((half + 1..SCAN_CELLS).map(|i| Site::from_pi(cell * (SCAN_CELLS - i) as f64)));
-        sites.extend(logs.iter().rev().map(|&x| Site::from_pi(x)));
-        sites
+        let mut values: Vec<f64> = sites.iter().map(|s| dg(s.angle())).collect();
+        sites.extend(&table.sites);
+        // g′/sin²θ = κ² / sinθ + 3 cosθ U′ + sinθ U″, as `dg` evaluates it.
+        values.extend(table.sites.iter().enumerate().map(|(i, _)| {
+            let a = table.angles[i];
+            let w = self.kappa / a.sin;
+            w * w * a.sin + 3.0 * a.cos * table.slopes[i] + a.sin * table.seconds[i]
+        }));
+        let far: Vec<Site> = logs.iter().rev().map(|&x| Site::from_pi(x)).collect();
+        values.extend(far.iter().map(|s| dg(s.angle())));
+        sites.extend(far);
+        (sites, values)
     }
 
-    /// The zeros of `f` on a sequence of sites, one per neighbouring pair with a sign change
-    /// (bisected) or an exact zero at a site.
-    fn sign_changes(&self, f: &impl Fn(Angle) -> f64, sites: &[Site]) -> Vec<Site> {
+    /// The zeros of `f` on a sequence of sites, `values` of `f` there, one per neighbouring
+    /// pair with a sign change (bisected) or an exact zero at a site.
+    fn sign_changes(&self, f: &impl Fn(Angle) -> f64, sites: &[Site], values: &[f64]) -> Vec<Site> {
         let mut zeros = Vec::new();
-        for w in sites.windows(2) {
-            let (fa, fb) = (f(w[0].angle()), f(w[1].angle()));
+        for (i, w) in sites.windows(2).enumerate() {
+            let (fa, fb) = (values[i], values[i + 1]);
             if fa == 0.0 {
                 zeros.push(w[0]);
             } else if fb != 0.0 && (fa < 0.0) != (fb < 0.0) {
                 zeros.push(self.bisect_sites(f, w[0], w[1]));
             }
         }
-        if let Some(&last) = sites.last() {
-            if f(last.angle()) == 0.0 {
-                zeros.push(last);
-            }
+        if values.last() == Some(&0.0) {
+            zeros.push(sites[sites.len() - 1]);
         }
         zeros
     }
@@ -671,7 +723,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
     }
 
     /// The critical points, and the shoulders ([`Self::shoulders`]).
-    fn find_critical_points(&self) -> (Vec<CriticalPoint>, Vec<Site>) {
+    fn find_critical_points(&self, table: &ScanTable) -> (Vec<CriticalPoint>, Vec<Site>) {
         let shape = &self.body.shape;
         // Roots of g = sin³θ V′ = −κ² cosθ + sin³θ U′ (no pole; U′'s roots in (0, π) for
         // κ = 0), bracketed between the roots of g′ = κ² sinθ + 3 sin²θ cosθ U′ + sin³θ U″
@@ -695,11 +747,11 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
                 + 3.0 * a.cos * shape.potential_prime_at(a)
                 + a.sin * shape.potential_second_at(a)
         };
-        let scan = self.scan_sites();
+        let (scan, dg_values) = self.scan_sites(table, &dg);
         // A flat U at κ = 0 (the homogeneous sphere) has no isolated critical points: every
         // energy above U is uniform rolling; only θ = 0 and π are kept as reference points.
         let flat = self.kappa == 0.0 && scan.iter().all(|s| g(s.angle()) == 0.0);
-        let extrema = self.sign_changes(&dg, &scan);
+        let extrema = self.sign_changes(&dg, &scan, &dg_values);
         let mut cuts = vec![scan[0]];
         cuts.extend(&extrema);
         cuts.push(scan[scan.len() - 1]);
@@ -707,7 +759,8 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         let mut roots = if flat {
             Vec::new()
         } else {
-            self.sign_changes(&g, &cuts)
+            let values: Vec<f64> = cuts.iter().map(|s| g(s.angle())).collect();
+            self.sign_changes(&g, &cuts, &values)
         };
         roots.dedup();
         // A critical point on a kink: V′ there may round to either sign on both sides (V

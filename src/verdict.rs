@@ -22,7 +22,7 @@
 //! β² > 1 + α and α > 0: bounded for κ > κ_max, the top (fold) of the N = 0 curve that hugs
 //! σ_u. Other bodies (α = 0 with β ≥ 1, and β² = 1 + α exactly) are not covered.
 
-use crate::body::{Body, Shape};
+use crate::body::{Body, Ellipsoid, Shape};
 
 mod census;
 use crate::cell::{solve_component, CellOptions, Status};
@@ -30,7 +30,7 @@ use crate::critical::{CriticalSet, DiagramType};
 use crate::error::{check_range, AtlasError, Result};
 use crate::limits::{golden_max, golden_max_settled, HighEnergyLimit};
 use crate::resonance::{self, bracketed_root, ResonanceOptions};
-use crate::torus::{CriticalKind, EffectivePotential, MotionKind};
+use crate::torus::{CriticalKind, EffectivePotential, MotionKind, ScanTable};
 use crate::EllipsoidBody;
 pub use census::{
     census, census_report, high_energy_scan, Census, CensusOptions, CensusReport, HighEnergyScan,
@@ -277,8 +277,9 @@ fn bottom_extreme_kappas<S: Shape>(
     stop: &(dyn Fn() -> bool + Sync),
 ) -> Vec<f64> {
     // (smallest, largest) N_b over the wells at κ; ±∞ where V has no minimum with N_b.
+    let table = ScanTable::new(body);
     let bottoms = |kappa: f64| -> [f64; 2] {
-        let potential = EffectivePotential::new(body, kappa);
+        let potential = EffectivePotential::with_scan(body, kappa, &table);
         potential
             .critical_points()
             .iter()
@@ -351,6 +352,8 @@ fn grid_energy(low: f64, q: f64) -> f64 {
 
 struct Sampler<'a, S: Shape> {
     body: &'a Body<S>,
+    /// The body's part of V's critical-point scan, made once for all lines.
+    scan: ScanTable,
     cell: CellOptions,
     energies: usize,
     /// Base energies ε = V_low/(1 − q)² (the ellipsoid, whose V_low > 0), or, for any body,
@@ -388,7 +391,7 @@ impl<S: Shape> Sampler<'_, S> {
         if (self.stop)() {
             return Vec::new();
         }
-        let potential = EffectivePotential::new(self.body, kappa);
+        let potential = EffectivePotential::with_scan(self.body, kappa, &self.scan);
         let minima = potential.minimum_sites();
         let levels = potential.separatrix_levels();
         let Some(low) = potential.lowest_minimum() else {
@@ -498,7 +501,7 @@ impl<S: Shape> Sampler<'_, S> {
         if (self.stop)() {
             return None;
         }
-        let potential = EffectivePotential::new(self.body, kappa);
+        let potential = EffectivePotential::with_scan(self.body, kappa, &self.scan);
         let minima = potential.minimum_sites();
         let levels = potential.separatrix_levels();
         if (minima.len(), levels.len()) != of.shape {
@@ -683,16 +686,15 @@ fn kappa_max(
     Ok(None)
 }
 
-/// N of the component around the minimum of V nearest `well` at (κ, ε).
+/// N of the component around the minimum of V nearest `well` at ε, on V at one κ (built
+/// once per κ: its critical-point scan costs more than one cell).
 fn n_near_well(
-    body: &EllipsoidBody,
-    kappa: f64,
+    potential: &EffectivePotential<'_, Ellipsoid>,
     energy: f64,
     well: f64,
     cell: &CellOptions,
 ) -> Option<f64> {
-    resonance::evaluate(&EffectivePotential::new(body, kappa), energy, well, cell)
-        .map(|p| p.rotation_number)
+    resonance::evaluate(potential, energy, well, cell).map(|p| p.rotation_number)
 }
 
 /// The most evaluations of M(κ) one polish of κ_max makes (each four golden sections; at
@@ -721,18 +723,12 @@ fn polish_fold(
 ) -> Option<(f64, f64)> {
     let width = 1e-3 * (1.0 + fold.energy.abs());
     let (e0, e1) = (fold.energy - width, fold.energy + width);
+    let table = ScanTable::new(body);
+    let potential_at = |kappa: f64| EffectivePotential::with_scan(body, kappa, &table);
     // The sign of the extremum: N just above the fold stays on one side of 0.
-    let probe = fold.kappa_max * (1.0 + 1e-4);
+    let probe = potential_at(fold.kappa_max * (1.0 + 1e-4));
     let side: Vec<f64> = (0..=8)
-        .filter_map(|i| {
-            n_near_well(
-                body,
-                probe,
-                e0 + (e1 - e0) * i as f64 / 8.0,
-                fold.well,
-                cell,
-            )
-        })
+        .filter_map(|i| n_near_well(&probe, e0 + (e1 - e0) * i as f64 / 8.0, fold.well, cell))
         .collect();
     let sign = if side.iter().all(|&n| n < 0.0) {
         1.0
@@ -751,12 +747,10 @@ fn polish_fold(
     // +0.03 to −6e-4 there and the root was that jump, 1.3e-3 below the fold (adversary
     // pass 29).
     // The bottom of V at κ: its minimum nearest the fold's well (the well n_near_well takes).
-    let well_bottom = |kappa: f64| {
-        EffectivePotential::new(body, kappa)
-            .minimum_nearest(fold.well)
-            .map(|p| p.value)
+    let well_bottom = |potential: &EffectivePotential<'_, Ellipsoid>| {
+        potential.minimum_nearest(fold.well).map(|p| p.value)
     };
-    let height_at_top = fold.energy - well_bottom(fold.kappa_max)?;
+    let height_at_top = fold.energy - well_bottom(&potential_at(fold.kappa_max))?;
     let evaluations: RefCell<Vec<RidgePoint>> = RefCell::new(Vec::new());
     let m = |kappa: f64| -> Result<f64> {
         let not_found = AtlasError::NotPeriodic {
@@ -766,7 +760,8 @@ fn polish_fold(
         if evaluations.borrow().len() >= M_EVALUATIONS {
             return Err(not_found);
         }
-        let bottom = well_bottom(kappa).ok_or(not_found.clone())?;
+        let potential = potential_at(kappa);
+        let bottom = well_bottom(&potential).ok_or(not_found.clone())?;
         let height = evaluations
             .borrow()
             .iter()
@@ -775,7 +770,7 @@ fn polish_fold(
             .map_or(height_at_top, |p| p.height);
         let centre = bottom + height;
         let at = |e: f64| {
-            n_near_well(body, kappa, e, fold.well, cell).map_or(f64::NEG_INFINITY, |n| sign * n)
+            n_near_well(&potential, e, fold.well, cell).map_or(f64::NEG_INFINITY, |n| sign * n)
         };
         // Each section goes on until the values on its bracket agree to the tolerance: at a
         // tongue 1e-5 wide, N'' ~ 1e8 and a bracket of 1e-10 ε left M 1e-8 low.
@@ -882,7 +877,7 @@ fn polish_fold(
     // it; adversary pass 28.) The traced top then stands, with that step in its error.
     let below = fold.kappa_max - (16.0 * fold.kappa_error).max(1e-9 * fold.kappa_max);
     if root < below
-        && n_near_well(body, below, fold.energy, fold.well, cell)
+        && n_near_well(&potential_at(below), fold.energy, fold.well, cell)
             .is_some_and(|n| sign * n > cell.tol)
     {
         return Some((fold.kappa_max, fold.kappa_max - below + fold.kappa_error));
@@ -1078,6 +1073,7 @@ pub fn verdict_until(
         let kappas = lines_with_bottom_extremes(body, lo, linear_top, half, stop);
         let sampler = Sampler {
             body,
+            scan: ScanTable::new(body),
             cell,
             energies: half,
             offset_energies: false,
@@ -1100,6 +1096,7 @@ pub fn verdict_until(
     stopped()?;
     let sampler = Sampler {
         body,
+        scan: ScanTable::new(body),
         cell,
         energies: resolution,
         offset_energies: false,
@@ -1786,7 +1783,8 @@ fn refine<S: Shape>(sampler: &Sampler<'_, S>, c: &Candidate) -> Option<Counterex
             let q = grid_q(c.a.grid?, sampler.energies);
             let at = |t: f64| -> Option<(f64, f64)> {
                 let kappa = c.a.kappa + t * (b.kappa - c.a.kappa);
-                let low = EffectivePotential::new(sampler.body, kappa).lowest_minimum()?;
+                let low = EffectivePotential::with_scan(sampler.body, kappa, &sampler.scan)
+                    .lowest_minimum()?;
                 Some((kappa, sampler.energy(low, q)))
             };
             let f = |t: f64| {
@@ -1908,8 +1906,12 @@ impl Default for BoundaryOptions {
 const BOUNDARY_XTOL: f64 = 1e-5;
 
 /// Least relative distance from a boundary at which its sides are judged (the labels
-/// `holds_below`, `holds_above`); at least four times the boundary's error bar.
+/// `holds_below`, `holds_above`); at least [`SIDE_BARS`] times the boundary's error bar.
 const SIDE_REACH: f64 = 1e-6;
+
+/// Error bars from a boundary at which its sides are judged (at least [`SIDE_REACH`]): just
+/// beyond the bar, so that a band beside the boundary a few bars wide is not stepped over.
+const SIDE_BARS: f64 = 1.5;
 
 /// Changes beyond one per scan step that [`boundaries`] locates (where a step holds several).
 const MORE_CHANGES: usize = 64;
@@ -2071,23 +2073,40 @@ pub fn boundaries_with(
     }
     // Validates α, ν, η once.
     EllipsoidBody::ellipsoid(alpha, 1.0, nu, eta)?;
+    let verdict_at = |beta: f64, verdict: &VerdictOptions| -> Result<Verdict> {
+        verdict_until(
+            &EllipsoidBody::ellipsoid(alpha, beta, nu, eta)?,
+            verdict,
+            stop,
+        )
+    };
+    boundaries_by((alpha, nu, eta), options, &verdict_at, progress)
+}
+
+/// [`boundaries_with`] on checked input, with the verdict of the body at a β from
+/// `verdict_at` (a stand-in in the tests of the search itself).
+fn boundaries_by(
+    (alpha, nu, eta): (f64, f64, f64),
+    options: &BoundaryOptions,
+    verdict_at: &(dyn Fn(f64, &VerdictOptions) -> Result<Verdict> + Sync),
+    progress: &(dyn Fn(BoundarySearch) + Sync),
+) -> Result<Boundaries> {
+    let (b0, b1) = (options.beta_min, options.beta_max);
     let body = |beta: f64| EllipsoidBody::ellipsoid(alpha, beta, nu, eta);
-    let run =
-        |beta: f64| -> Result<Verdict> { verdict_until(&body(beta)?, &options.verdict, stop) };
+    let run = |beta: f64| -> Result<Verdict> { verdict_at(beta, &options.verdict) };
     // Inside the root-finding only the margin is needed.
     let margin_only = VerdictOptions {
         counterexamples: false,
         ..options.verdict
     };
-    let margin = |beta: f64| -> Result<Verdict> { verdict_until(&body(beta)?, &margin_only, stop) };
+    let margin = |beta: f64| -> Result<Verdict> { verdict_at(beta, &margin_only) };
     // The same at half the resolution: how far a boundary on the sampled plane moves with
     // the sampling is part of its error bar.
     let coarse_only = VerdictOptions {
         resolution: (options.verdict.resolution / 2).max(8),
         ..margin_only
     };
-    let coarse_margin =
-        |beta: f64| -> Result<Verdict> { verdict_until(&body(beta)?, &coarse_only, stop) };
+    let coarse_margin = |beta: f64| -> Result<Verdict> { verdict_at(beta, &coarse_only) };
     // (The ends exactly as given: exp(ln 8) is 7.999999999999998.)
     let last = options.scan - 1;
     let mut betas: Vec<f64> = (0..options.scan)
@@ -2103,6 +2122,8 @@ pub fn boundaries_with(
         betas.push(case_line * (1.0 + 1e-9));
     }
     betas.sort_by(f64::total_cmp);
+    // (A range a few ulps wide spaced the same β several times: adversary pass 35.)
+    betas.dedup();
     let scanned = std::sync::atomic::AtomicUsize::new(0);
     let verdicts: Vec<Verdict> = betas
         .par_iter()
@@ -2116,6 +2137,20 @@ pub fn boundaries_with(
             v
         })
         .collect::<Result<_>>()?;
+    // A change of the verdict in (lo.β, hi.β) by bisection on the verdict itself, to
+    // [`BOUNDARY_XTOL`].
+    let bisect_verdict = |lo: &Verdict, hi: &Verdict| -> Result<(f64, f64, String)> {
+        let (mut a, mut b) = (lo.beta, hi.beta);
+        while b - a > BOUNDARY_XTOL * b {
+            let m = (a * b).sqrt();
+            if key(&margin(m)?) == key(lo) {
+                a = m;
+            } else {
+                b = m;
+            }
+        }
+        Ok(((a * b).sqrt(), 0.5 * (b - a), "verdict".into()))
+    };
     // Where in (lo.β, hi.β) the verdict changes, to what error, and what decides it.
     let locate_change = |lo: &Verdict, hi: &Verdict| -> Result<(f64, f64, String)> {
         if lo.case != hi.case {
@@ -2163,17 +2198,7 @@ pub fn boundaries_with(
                 }
             }
         }
-        // Bisection on the verdict itself, to the same relative width.
-        let (mut a, mut b) = (lo.beta, hi.beta);
-        while b - a > BOUNDARY_XTOL * b {
-            let m = (a * b).sqrt();
-            if key(&margin(m)?) == key(lo) {
-                a = m;
-            } else {
-                b = m;
-            }
-        }
-        Ok(((a * b).sqrt(), 0.5 * (b - a), "verdict".into()))
+        bisect_verdict(lo, hi)
     };
     // The pairs of neighbouring verdicts that differ, each holding at least one change; a
     // pair whose located change is not the whole story (the verdict a few error bars from the
@@ -2189,22 +2214,41 @@ pub fn boundaries_with(
     while let Some((lo, hi)) = pairs.pop_front() {
         index += 1;
         progress(BoundarySearch::Locating { index, of });
-        let (beta, error, quantity) = locate_change(&lo, &hi)?;
-        // The labels are the verdicts a few error bars away on either side, not the pair's
-        // ends: one scan step may hold two changes (at ν = 1.5, η = 5, α = 0.867 the
-        // undecided band just above the case line and the N = −1 boundary at 1.7399). (The
-        // case line's sides are the scan's own β at (1 ∓ 1e-9) of it, nearer than the reach.)
-        let reach = (4.0 * error).max(SIDE_REACH * beta);
-        let side = |b: f64, end: &Verdict| -> Result<Verdict> {
-            if (b - end.beta) * (beta - end.beta) > 0.0
-                && (b - beta).abs() < (end.beta - beta).abs()
-            {
-                margin(b)
-            } else {
-                Ok(end.clone())
-            }
+        let (mut beta, mut error, mut quantity) = locate_change(&lo, &hi)?;
+        // The labels are the verdicts just beyond the error bar on either side, not the
+        // pair's ends: one scan step may hold two changes (at ν = 1.5, η = 5, α = 0.867 the
+        // undecided band just above the case line and the N = −1 boundary at 1.7399), and a
+        // band beside a boundary may be narrower than a few bars (at α = 0.1, ν = η = 0.5 an
+        // undecided band 5e-6 wide just above the N = 0 boundary, whose bar is 2.4e-6; judged
+        // at four bars it read "holds", adversary pass 35). (The case line's sides are the
+        // scan's own β at (1 ∓ 1e-9) of it, nearer than the reach.)
+        let reach_of = |beta: f64, error: f64| (SIDE_BARS * error).max(SIDE_REACH * beta);
+        let sides = |beta: f64, error: f64| -> Result<(Verdict, Verdict)> {
+            let reach = reach_of(beta, error);
+            let side = |b: f64, end: &Verdict| -> Result<Verdict> {
+                if (b - end.beta) * (beta - end.beta) > 0.0
+                    && (b - beta).abs() < (end.beta - beta).abs()
+                {
+                    margin(b)
+                } else {
+                    Ok(end.clone())
+                }
+            };
+            Ok((side(beta - reach, &lo)?, side(beta + reach, &hi)?))
         };
-        let (below, above) = (side(beta - reach, &lo)?, side(beta + reach, &hi)?);
+        let (mut below, mut above) = sides(beta, error)?;
+        // A root of a fail margin that the verdict does not change across is no boundary:
+        // the margin of a pair that is not holds/fails (an undecided end) need not change
+        // sign where the verdict does (at α = 0.5, ν = 1e-300, η = 1e-3 a root at 1.41 ±
+        // 0.045 between bodies that all fail, with the real N = −1 boundary at 1.2442 in
+        // the same step; adversary pass 35). The change is then found on the verdict itself.
+        // So is one whose bar reaches past an end of its step (at tol 1e-6, resolution 32
+        // the same step gave 1.378 ± 0.2, "undecided below", over the band that holds).
+        let unplaced = reach_of(beta, error) >= (beta - lo.beta).min(hi.beta - beta);
+        if (key(&below) == key(&above) || unplaced) && quantity != "verdict" && lo.case == hi.case {
+            (beta, error, quantity) = bisect_verdict(&lo, &hi)?;
+            (below, above) = sides(beta, error)?;
+        }
         for (a, b) in [(&lo, &below), (&above, &hi)] {
             if key(a) != key(b) && of < options.scan + MORE_CHANGES {
                 of += 1;
@@ -2246,9 +2290,70 @@ pub fn boundaries_with(
 
 #[cfg(test)]
 mod tests {
-    use super::{bottom_extreme_kappas, kappa_lines};
+    use super::{
+        bottom_extreme_kappas, boundaries_by, kappa_lines, verdict, BoundaryOptions, Margins,
+        Verdict, VerdictOptions,
+    };
     use crate::EllipsoidBody;
     use std::sync::atomic::{AtomicUsize, Ordering};
+
+    /// The search for boundaries on a stand-in verdict along β, shaped as adversary pass 35
+    /// found it at α = 0.5, ν = 1e-300, η = 1e-3 (there 1.2247, 1.2442 and 1.41): undecided
+    /// below β = 0.5, holds up to 0.6, fails above (N reaches −1: to_minus_one = β − 0.6),
+    /// while the term "N takes both signs" changes sign at 0.75 (0.7 at half the
+    /// resolution), where every body fails already. Root-finding on that term gave a boundary
+    /// at 0.75 ± 0.05 judged at four bars, on the step's ends 0.587 (holds) and 0.766
+    /// (fails): "holds below" over bodies that fail from 0.6. The search must report exactly
+    /// the changes at 0.5 and 0.6, each with the verdicts beside it. (The range keeps the case
+    /// line β² = 1 + α, which the scan adds, outside.)
+    #[test]
+    fn a_root_of_a_margin_term_the_verdict_does_not_change_across_is_no_boundary() {
+        let options = BoundaryOptions {
+            beta_min: 0.45,
+            beta_max: 1.0,
+            scan: 4,
+            verdict: VerdictOptions::default(),
+        };
+        let body = EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 0.5).unwrap();
+        let template = verdict(
+            &body,
+            &VerdictOptions {
+                resolution: 8,
+                ..VerdictOptions::default()
+            },
+        )
+        .unwrap();
+        let stand_in = |beta: f64, o: &VerdictOptions| -> crate::error::Result<Verdict> {
+            let coarse = o.resolution < options.verdict.resolution;
+            let margins = Margins {
+                both_signs: beta - if coarse { 0.7 } else { 0.75 },
+                to_plus_one: -1.0,
+                to_minus_one: beta - 0.6,
+                from_limit: [false; 3],
+            };
+            let holds = (beta >= 0.5).then_some(margins.terms().iter().all(|&t| t <= 0.0));
+            Ok(Verdict {
+                beta,
+                holds,
+                margins: Some(margins),
+                ..template.clone()
+            })
+        };
+        let found = boundaries_by((0.5, 0.5, 0.5), &options, &stand_in, &|_| {}).unwrap();
+        let b: Vec<_> = found
+            .boundaries
+            .iter()
+            .map(|x| (x.beta, x.error, x.holds_below, x.holds_above))
+            .collect();
+        assert_eq!(b.len(), 2, "{b:?}");
+        for (x, at, labels) in [
+            (b[0], 0.5, (None, Some(true))),
+            (b[1], 0.6, (Some(true), Some(false))),
+        ] {
+            assert!((x.0 - at).abs() <= x.1 && x.1 < 1e-4, "{b:?}");
+            assert_eq!((x.2, x.3), labels, "{b:?}");
+        }
+    }
 
     /// The scan for N's extremes at the bottom hears a stop: at resolution 1024 it is 16,000
     /// bottoms and took seconds, during which Ctrl-C waited (1–5 s, adversary pass 34). Asked

@@ -2413,11 +2413,11 @@ def boundaries(alpha: float, nu: float, eta: float, *, beta_min: float = 0.05, b
     beta_min, beta_max : float, default 0.05 and 50.0
         The β range, 0 < beta_min < beta_max.
     scan : int, default 48
-        Number of log-spaced bodies scanned first, ≥ 2.
+        Number of log-spaced bodies scanned first, 4 … 10000.
     tol : float, default 1e-10
-        Solver tolerance (1e-15 … 0.1).
+        Solver tolerance (1e-13 … 1e-4).
     resolution : int, default 64
-        Sampling of each body's (κ, ε) plane, as in `verdict`.
+        Sampling of each body's (κ, ε) plane, as in `verdict` (32 … 4096).
     threads : int, optional
         Number of threads (≥ 1); by default rayon's pool.
 
@@ -2426,8 +2426,9 @@ def boundaries(alpha: float, nu: float, eta: float, *, beta_min: float = 0.05, b
     xarray.Dataset
         Along ``boundary``: ``boundary_beta`` and its error bound ``boundary_error``,
         ``quantity`` (bytes: what changes sign), and the case and verdict below and above
-        (``case_below``, ``holds_below``, ``case_above``, ``holds_above``: uint8 flags; those
-        of the scanned β next to the boundary on each side, see docs/files.md).
+        (``case_below``, ``holds_below``, ``case_above``, ``holds_above``: uint8 flags; the
+        verdicts judged just beyond the boundary's error bar on each side, see
+        docs/files.md).
         Along ``scan``: ``scan_beta``, ``scan_case``, ``scan_holds``. The whole ``--json``
         object is ``attrs["boundaries_json"]``.
 

@@ -11,6 +11,7 @@ use crate::body::{Body, Shape};
 use crate::cell::CellOptions;
 use crate::error::{AtlasError, Result};
 use crate::limits::{golden_max, high_energy_rotation_number};
+use crate::torus::ScanTable;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::f64::consts::SQRT_2;
@@ -370,6 +371,7 @@ pub fn census<S: Shape>(
     }
     let sampler = Sampler {
         body,
+        scan: ScanTable::new(body),
         cell: CellOptions {
             tol: options.tol,
             drift: false,

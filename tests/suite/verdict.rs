@@ -466,14 +466,8 @@ fn bad_options_are_refused() {
 #[test]
 fn a_scan_step_that_holds_two_changes_reports_both_with_the_labels_of_its_sides() {
     let (alpha, nu, eta) = (0.8666666666666667, 1.5, 5.0);
-    let options = BoundaryOptions {
-        beta_min: 0.9,
-        beta_max: 2.5,
-        scan: 4,
-        verdict: VerdictOptions::default(),
-    };
-    let found = boundaries(alpha, nu, eta, &options).unwrap();
-    let b = &found.boundaries;
+    let (options, b) = four_step_scan((alpha, nu, eta), (0.9, 2.5));
+    let b = &b;
     let summary: Vec<_> = b
         .iter()
         .map(|x| (x.beta, x.holds_below, x.holds_above, x.quantity.as_str()))
@@ -493,10 +487,38 @@ fn a_scan_step_that_holds_two_changes_reports_both_with_the_labels_of_its_sides(
         (b[2].beta - 1.7399071).abs() < 2e-7 + b[2].error,
         "{summary:#?}"
     );
-    // The labels against the verdicts between the boundaries and beyond the outer ones.
+    labels_are_the_verdicts_between((alpha, nu, eta), &options, b);
+}
+
+/// The boundaries over (β_min, β_max) from a scan of 4 β, at the verdict's defaults.
+fn four_step_scan(
+    (alpha, nu, eta): (f64, f64, f64),
+    (beta_min, beta_max): (f64, f64),
+) -> (BoundaryOptions, Vec<rubber_atlas::verdict::Boundary>) {
+    let options = BoundaryOptions {
+        beta_min,
+        beta_max,
+        scan: 4,
+        verdict: VerdictOptions::default(),
+    };
+    let found = boundaries(alpha, nu, eta, &options).unwrap();
+    (options, found.boundaries)
+}
+
+/// Every boundary's labels against the verdicts of the bodies between it and its neighbours
+/// (and the range's ends), judged at their geometric midpoints.
+fn labels_are_the_verdicts_between(
+    (alpha, nu, eta): (f64, f64, f64),
+    options: &BoundaryOptions,
+    b: &[rubber_atlas::verdict::Boundary],
+) {
+    let summary: Vec<_> = b
+        .iter()
+        .map(|x| (x.beta, x.holds_below, x.holds_above, x.quantity.as_str()))
+        .collect();
     let judge = |beta: f64| {
         let body = EllipsoidBody::ellipsoid(alpha, beta, nu, eta).unwrap();
-        let v = verdict(&body, &VerdictOptions::default()).unwrap();
+        let v = verdict(&body, &options.verdict).unwrap();
         (v.case, v.holds)
     };
     let mut edges = vec![options.beta_min];
@@ -515,6 +537,31 @@ fn a_scan_step_that_holds_two_changes_reports_both_with_the_labels_of_its_sides(
             assert_eq!(between, (b[i].case_below, b[i].holds_below), "{summary:#?}");
         }
     }
+}
+
+/// Adversary pass 35: at α = 0.1, ν = η = 0.5 an undecided band about 5e-6 wide lies just
+/// above the N = 0 boundary (0.7843961 ± 3.2e-6), where N = −6e-14 ± 1e-13 cannot be told
+/// from 0 even at tol 1e-13. The sides were judged four bars away, beyond the band: the
+/// boundary read "holds above" and the band's end was not listed. Judged just beyond the bar,
+/// both changes are reported, each with the verdicts of the bodies beside it.
+#[test]
+fn a_band_narrower_than_a_few_error_bars_beside_a_boundary_is_reported() {
+    let (alpha, nu, eta) = (0.1, 0.5, 0.5);
+    let (options, b) = four_step_scan((alpha, nu, eta), (0.7843, 0.7845));
+    let b = &b;
+    let summary: Vec<_> = b
+        .iter()
+        .map(|x| (x.beta, x.error, x.holds_below, x.holds_above))
+        .collect();
+    assert_eq!(b.len(), 2, "{summary:#?}");
+    assert_eq!(
+        (b[0].holds_below, b[0].holds_above, b[1].holds_above),
+        (Some(false), None, Some(true)),
+        "{summary:#?}"
+    );
+    // The band between them is narrower than four of the first boundary's bars.
+    assert!(b[1].beta - b[0].beta < 4.0 * b[0].error, "{summary:#?}");
+    labels_are_the_verdicts_between((alpha, nu, eta), &options, b);
 }
 
 /// The verdict asks whether N equals an integer; `bounded` whether |N − k| is within the
