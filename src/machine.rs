@@ -161,24 +161,3 @@ pub fn threads_from_env() -> crate::Result<Option<usize>> {
         _ => Ok(None),
     }
 }
-
-#[cfg(test)]
-mod tests {
-    use super::show_bytes;
-
-    /// One format from bytes to exabytes (refusals showed "1.4e15 B" beside "14.4 TB":
-    /// adversary pass 34), powers of ten only beyond.
-    #[test]
-    fn bytes_read_as_a_person_reads_them() {
-        for (bytes, shown) in [
-            (12.0, "12 B"),
-            (310e6, "310.0 MB"),
-            (932e12, "932.0 TB"),
-            (1.44e15, "1.4 PB"),
-            (2.5e18, "2.5 EB"),
-            (4.6e21, "4.6e21 B"),
-        ] {
-            assert_eq!(show_bytes(bytes), shown);
-        }
-    }
-}

@@ -687,4 +687,144 @@ mod double_double {
             assert!(on_cos.sub(cos_exact).to_f64().abs() < 1e-31, "θ = {theta}");
         }
     }
+    /// sin and cos of doubles against 40-digit values (mpmath), to 1e-31.
+    #[test]
+    fn sin_cos_of_a_double_holds_its_digits() {
+        // (x, sin x, cos x), each as hi + lo.
+        let cases: [(f64, [f64; 2], [f64; 2]); 4] = [
+            (
+                1.0,
+                [0.8414709848078965, 1.776845092935536e-18],
+                [0.5403023058681398, -4.760954612604417e-17],
+            ),
+            (
+                -std::f64::consts::PI,
+                [-1.2246467991473532e-16, 2.99476980971834e-33],
+                [-1.0, 7.498798913309288e-33],
+            ),
+            (
+                2.5656578167457247,
+                [0.5446190608189255, -5.304878061573401e-18],
+                [-0.8386835390018762, 5.4813596513289424e-17],
+            ),
+            (
+                1.31778543583325e-5,
+                [1.3177854357951098e-5, 8.877086029606173e-23],
+                [0.9999999999131721, -4.45227805214575e-17],
+            ),
+        ];
+        for (x, sin, cos) in cases {
+            let (s, c) = DoubleDouble::sin_cos(x);
+            let off = |v: DoubleDouble, t: [f64; 2]| ((v.hi - t[0]) + (v.lo - t[1])).abs();
+            assert!(
+                off(s, sin) < 1e-31 && off(c, cos) < 1e-31,
+                "x = {x}: {s:?} {c:?}"
+            );
+        }
+    }
+}
+
+mod machine {
+    use rubber_atlas::machine::show_bytes;
+
+    /// One format from bytes to exabytes (refusals showed "1.4e15 B" beside "14.4 TB":
+    /// adversary pass 34), powers of ten only beyond.
+    #[test]
+    fn bytes_read_as_a_person_reads_them() {
+        for (bytes, shown) in [
+            (12.0, "12 B"),
+            (310e6, "310.0 MB"),
+            (932e12, "932.0 TB"),
+            (1.44e15, "1.4 PB"),
+            (2.5e18, "2.5 EB"),
+            (4.6e21, "4.6e21 B"),
+        ] {
+            assert_eq!(show_bytes(bytes), shown);
+        }
+    }
+}
+
+mod verdict {
+    use rubber_atlas::verdict::{
+        bottom_extreme_kappas, boundaries_by, kappa_lines, verdict, BoundaryOptions, Margins,
+        Verdict, VerdictOptions,
+    };
+    use rubber_atlas::EllipsoidBody;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    /// The search for boundaries on a stand-in verdict along β, shaped as adversary pass 35
+    /// found it at α = 0.5, ν = 1e-300, η = 1e-3 (there 1.2247, 1.2442 and 1.41): undecided
+    /// below β = 0.5, holds up to 0.6, fails above (N reaches −1: to_minus_one = β − 0.6),
+    /// while the term "N takes both signs" changes sign at 0.75 (0.7 at half the
+    /// resolution), where every body fails already. Root-finding on that term gave a boundary
+    /// at 0.75 ± 0.05 judged at four bars, on the step's ends 0.587 (holds) and 0.766
+    /// (fails): "holds below" over bodies that fail from 0.6. The search must report exactly
+    /// the changes at 0.5 and 0.6, each with the verdicts beside it. (The range keeps the case
+    /// line β² = 1 + α, which the scan adds, outside.)
+    #[test]
+    fn a_root_of_a_margin_term_the_verdict_does_not_change_across_is_no_boundary() {
+        let options = BoundaryOptions {
+            beta_min: 0.45,
+            beta_max: 1.0,
+            scan: 4,
+            verdict: VerdictOptions::default(),
+        };
+        let body = EllipsoidBody::ellipsoid(0.5, 3.0, 0.5, 0.5).unwrap();
+        let template = verdict(
+            &body,
+            &VerdictOptions {
+                resolution: 8,
+                ..VerdictOptions::default()
+            },
+        )
+        .unwrap();
+        let stand_in = |beta: f64, o: &VerdictOptions| -> rubber_atlas::error::Result<Verdict> {
+            let coarse = o.resolution < options.verdict.resolution;
+            let margins = Margins {
+                both_signs: beta - if coarse { 0.7 } else { 0.75 },
+                to_plus_one: -1.0,
+                to_minus_one: beta - 0.6,
+                from_limit: [false; 3],
+            };
+            let holds = (beta >= 0.5).then_some(margins.terms().iter().all(|&t| t <= 0.0));
+            Ok(Verdict {
+                beta,
+                holds,
+                margins: Some(margins),
+                ..template.clone()
+            })
+        };
+        let found = boundaries_by((0.5, 0.5, 0.5), &options, &stand_in, &|_| {}).unwrap();
+        let b: Vec<_> = found
+            .boundaries
+            .iter()
+            .map(|x| (x.beta, x.error, x.holds_below, x.holds_above))
+            .collect();
+        assert_eq!(b.len(), 2, "{b:?}");
+        for (x, at, labels) in [
+            (b[0], 0.5, (None, Some(true))),
+            (b[1], 0.6, (Some(true), Some(false))),
+        ] {
+            assert!((x.0 - at).abs() <= x.1 && x.1 < 1e-4, "{b:?}");
+            assert_eq!((x.2, x.3), labels, "{b:?}");
+        }
+    }
+
+    /// The scan for N's extremes at the bottom hears a stop: at resolution 1024 it is 16,000
+    /// bottoms and took seconds, during which Ctrl-C waited (1–5 s, adversary pass 34). Asked
+    /// to stop at its 100th point, it looks at few more and finds nothing; not asked, it
+    /// finds the dip of α = 0.9, β = 1.6773, ν = 1.5, η = 5 (N_b = −1.00009 near κ = 0.35).
+    #[test]
+    fn the_bottom_scan_stops_when_asked() {
+        let body = EllipsoidBody::ellipsoid(0.9, 1.6773, 1.5, 5.0).unwrap();
+        let kappas = kappa_lines(0.2, 4.0, 1024);
+        let polls = AtomicUsize::new(0);
+        let stop = || polls.fetch_add(1, Ordering::Relaxed) >= 100;
+        assert!(bottom_extreme_kappas(&body, &kappas, &stop).is_empty());
+        let polled = polls.load(Ordering::Relaxed);
+        assert!(polled < 1_000, "{polled} points after the stop");
+        let coarse = kappa_lines(0.2, 4.0, 64);
+        let found = bottom_extreme_kappas(&body, &coarse, &|| false);
+        assert!(found.iter().any(|k| (k - 0.3475).abs() < 0.01), "{found:?}");
+    }
 }

@@ -213,6 +213,33 @@ fn kappa_max_at(body: &EllipsoidBody, tol: f64) -> (f64, f64) {
     (v.kappa_max.unwrap(), v.kappa_max_error.unwrap())
 }
 
+/// Nearly symmetric bodies (α = 1e-9), where N ~ 1e-11 near the fold: at `--tol 1e-8` the
+/// curve was traced and κ_max polished at 1e-8, below N's resolution, and κ_max came out
+/// 2.1115 ± 2.1e-4 (tol 1e-9: 2.1027) against 1.6329617 ± 1.6e-4 at 1e-10 … 1e-13, and
+/// 1.10759 against 0.46704 for the second body (adversary pass 36). κ_max is now solved at
+/// 1e-10 at the coarsest: at every tolerance it agrees within the bars with the finest, and
+/// with the body at α = 1e-7 (κ_max moves by 1e-5 between them).
+#[test]
+fn kappa_max_of_a_nearly_symmetric_body_does_not_depend_on_a_coarse_tolerance() {
+    for (beta, nu, eta) in [(3.0, 0.5, 0.5), (1.115, 2.0, 1000.0)] {
+        let body = EllipsoidBody::ellipsoid(1e-9, beta, nu, eta).unwrap();
+        let (fine, fine_err) = kappa_max_at(&body, 1e-12);
+        let near = EllipsoidBody::ellipsoid(1e-7, beta, nu, eta).unwrap();
+        let (k7, k7_err) = kappa_max_at(&near, 1e-10);
+        assert!(
+            (fine - k7).abs() <= fine_err + k7_err,
+            "{fine} against {k7}"
+        );
+        for tol in [1e-8, 1e-9] {
+            let (k, err) = kappa_max_at(&body, tol);
+            assert!(
+                (k - fine).abs() <= err + fine_err && err < 1e-3 * k,
+                "β = {beta}, tol {tol}: {k} ± {err} against {fine} ± {fine_err}"
+            );
+        }
+    }
+}
+
 /// Small α, large β: the inside of the N = 0 curve by its fold is a tongue about 1e-3 wide
 /// in ε (N > 0 at κ = 5.1779, ε = 41.254: 5.85e-3 here and against 50 digits). The fold was
 /// traced right, 5.1789099, but its polish took the maximum of N over ε ± 0.04 by one golden
