@@ -264,10 +264,16 @@ def _count(name: str, value) -> int:
     number it holds, as it does for the other parameters."""
     if isinstance(value, np.ndarray) and value.ndim == 0:
         value = value[()]
+    # (np.timedelta64 is an Integral whose int() fails with a message naming no input; a
+    # long double 1e-400 is not whole though float() rounds it to 0: adversary pass 37.)
     whole = isinstance(value, numbers.Integral) or (
-        isinstance(value, (float, np.floating)) and float(value).is_integer())
-    if isinstance(value, (bool, np.bool_)) or not whole:
-        raise TypeError(f"{name} must be a whole number, not {value!r}")
+        isinstance(value, (float, np.floating)) and np.isfinite(value)
+        and value == np.floor(value))
+    if isinstance(value, (bool, np.bool_, np.timedelta64, np.datetime64)) or not whole:
+        shown = repr(value)
+        if "\n" in shown:
+            shown = f"a {type(value).__name__}"
+        raise TypeError(f"{name} must be a whole number, not {shown}")
     if abs(int(value)) >= 2**63:
         # Near the limit every digit matters (2**63 is one past it); far beyond, 3 do.
         shown = str(int(value)) if abs(int(value)) < 10**20 else _shown(int(value))

@@ -819,3 +819,16 @@ def test_contour_levels_are_the_largest_q_that_fits_and_cheap_on_any_range():
     assert q == 1 and levels == [float(i) for i in range(-10**12, -10**12 + 60)]
     assert accessor._contour_levels(0.25, 0.25, 100) == (100, [0.25])
     assert Fraction(1, 3) in {Fraction(x).limit_denominator(10) for x in accessor._contour_levels(0, 1, 7)[1]}
+
+
+@pytest.mark.parametrize("count", ["resolution", "threads"])
+def test_a_count_given_as_a_duration_a_masked_value_or_a_tiny_long_double_is_refused_by_name(count):
+    # Adversary pass 37: np.timedelta64 (an Integral to numpy) raised int()'s TypeError, which
+    # names no input; a masked array ended the message with its multi-line repr; a long
+    # double 1e-400 was taken for 0.
+    import xarray as xr
+    for value in (np.timedelta64(32, "s"), np.ma.masked_array([0.5], mask=[True]),
+                  xr.DataArray(0.5), np.longdouble("1e-400")):
+        with pytest.raises(TypeError, match=f"^{count} must be a whole number") as caught:
+            ra.verdict(0.5, 3.0, 0.5, 0.5, **{count: value})
+        assert "\n" not in str(caught.value), str(caught.value)
