@@ -627,12 +627,10 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         let mut sites: Vec<Site> = logs.iter().map(|&x| Site::at(x)).collect();
         let mut values: Vec<f64> = sites.iter().map(|s| dg(s.angle())).collect();
         sites.extend(&table.sites);
-        // g′/sin²θ = κ² / sinθ + 3 cosθ U′ + sinθ U″, as `dg` evaluates it.
-        values.extend(table.sites.iter().enumerate().map(|(i, _)| {
-            let a = table.angles[i];
-            let w = self.kappa / a.sin;
-            w * w * a.sin + 3.0 * a.cos * table.slopes[i] + a.sin * table.seconds[i]
-        }));
+        values.extend(
+            (0..table.sites.len())
+                .map(|i| self.dg_over_sin2(table.angles[i], table.slopes[i], table.seconds[i])),
+        );
         let far: Vec<Site> = logs.iter().rev().map(|&x| Site::from_pi(x)).collect();
         values.extend(far.iter().map(|s| dg(s.angle())));
         sites.extend(far);
@@ -723,6 +721,13 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
     }
 
     /// The critical points, and the shoulders ([`Self::shoulders`]).
+    /// g′/sin²θ = κ²/sinθ + 3 cosθ U′ + sinθ U″ at `a`, from U′ and U″ there (the
+    /// derivative of g = sin³θ V′ that brackets the critical points; see
+    /// [`Self::find_critical_points`]).
+    fn dg_over_sin2(&self, a: Angle, slope: f64, second: f64) -> f64 {
+        let w = self.kappa / a.sin;
+        w * w * a.sin + 3.0 * a.cos * slope + a.sin * second
+    }
     fn find_critical_points(&self, table: &ScanTable) -> (Vec<CriticalPoint>, Vec<Site>) {
         let shape = &self.body.shape;
         // Roots of g = sin³θ V′ = −κ² cosθ + sin³θ U′ (no pole; U′'s roots in (0, π) for
@@ -742,10 +747,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             slope => slope,
         };
         let dg = |a: Angle| {
-            let w = self.kappa / a.sin;
-            w * w * a.sin
-                + 3.0 * a.cos * shape.potential_prime_at(a)
-                + a.sin * shape.potential_second_at(a)
+            self.dg_over_sin2(a, shape.potential_prime_at(a), shape.potential_second_at(a))
         };
         let (scan, dg_values) = self.scan_sites(table, &dg);
         // A flat U at κ = 0 (the homogeneous sphere) has no isolated critical points: every
