@@ -2028,14 +2028,9 @@ pub fn boundaries_with(
             reason: "must be a finite number > 0",
         });
     }
-    if !(b1.is_finite() && b1 > b0) {
-        return Err(AtlasError::InvalidParameter {
-            name: "beta-max",
-            value: b1,
-            reason: "must be finite and above beta-min",
-        });
-    }
     // Only bodies the verdict decides: a boundary is a change between two decided verdicts.
+    // Each end is checked on its own before their order, so that the end out of range is the
+    // one named (beta-min = 2⁵³ + 1 was blamed on the default beta-max).
     for (name, value) in [("beta-min", b0), ("beta-max", b1)] {
         if !(BETA_RANGE[0]..=BETA_RANGE[1]).contains(&value) {
             return Err(AtlasError::InvalidParameter {
@@ -2045,6 +2040,13 @@ pub fn boundaries_with(
                     "must lie in 1e-3 ... 1e3, the bodies the verdict decides (docs/hypothesis.md)",
             });
         }
+    }
+    if b1 <= b0 {
+        return Err(AtlasError::InvalidParameter {
+            name: "beta-max",
+            value: b1,
+            reason: "must be above beta-min",
+        });
     }
     if !(ETA_RANGE[0]..=ETA_RANGE[1]).contains(&eta) {
         return Err(AtlasError::InvalidParameter {

@@ -214,6 +214,8 @@ def test_a_request_beyond_memory_is_refused_before_its_inputs_are_materialised(c
     # the command line's beta-max: adversary pass of 2026-11-27.)
     (lambda: ra.boundaries(0.5, 0.5, 0.5, scan=0), ValueError, ["scan = 0", "between 4 and 10000"]),
     (lambda: ra.boundaries(0.5, 0.5, 0.5, beta_min=0.8, beta_max=0.7), ValueError, ["beta_max"]),
+    # (An end out of range was blamed on the other when their order was wrong too: pass 37.)
+    (lambda: ra.boundaries(0.5, 0.5, 0.5, beta_min=2**53 + 1), ValueError, ["beta_min = 9"]),
     (lambda: ra.boundaries(0.5, 0.5, 0.5, resolution=0), ValueError, ["resolution = 0", "32 and 4096"]),
     (lambda: ra.boundaries(0.5, 0.5, 0.5, resolution=10**8), ValueError, ["resolution", "32 and 4096"]),
     (lambda: ra.verdict(0.5, 3, 0.5, 0.5, resolution=0), ValueError, ["resolution = 0", "8 and 4096"]),

@@ -348,6 +348,21 @@ fn extreme_bodies_are_undecided_with_the_reason() {
     };
     let refused = verdict::boundaries(0.5, 0.5, 0.5, &beyond).unwrap_err();
     assert!(refused.to_string().contains("beta-min"), "{refused}");
+    // The end out of range is the one named, whatever the order of the two (beta-min =
+    // 2⁵³ + 1 with the default beta-max 50 was blamed on beta-max: adversary pass 37).
+    for (beta_min, beta_max, named) in [
+        (9007199254740993.0, 50.0, "beta-min = 9007199254740992"),
+        (0.05, 1e-4, "beta-max = 0.0001"),
+        (2.0, 1.0, "beta-max = 1: must be above beta-min"),
+    ] {
+        let options = BoundaryOptions {
+            beta_min,
+            beta_max,
+            ..BoundaryOptions::default()
+        };
+        let refused = verdict::boundaries(0.5, 0.5, 0.5, &options).unwrap_err();
+        assert!(refused.to_string().contains(named), "{refused}");
+    }
 }
 
 /// Nearly symmetric bodies (α → 0): N is of the order of α everywhere, so a sample within
