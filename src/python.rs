@@ -28,7 +28,8 @@ fn value_error(e: AtlasError) -> PyErr {
     PyValueError::new_err(
         e.to_string()
             .replace("beta-min", "beta_min")
-            .replace("beta-max", "beta_max"),
+            .replace("beta-max", "beta_max")
+            .replace("kappa-max", "kappa_max"),
     )
 }
 
@@ -808,15 +809,19 @@ fn verdicts(
     if [beta.len(), nu.len(), eta.len()].iter().any(|&m| m != n) {
         return Err(bad("alpha, beta, nu and eta must have one length".into()));
     }
-    // A bad body is named by its position, as `cells` names a bad cell.
+    // A bad body is named by its position, as `cells` names a bad cell, before any is
+    // computed (an α < 0 was refused, with no position, after the others' verdicts:
+    // adversary pass 38).
     let bodies = (0..n)
         .map(|i| {
-            EllipsoidBody::ellipsoid(alpha[i], beta[i], nu[i], eta[i]).map_err(|e| {
-                value_error(AtlasError::Atlas {
-                    path: format!("cell {i}"),
-                    reason: e.to_string(),
+            verdict::check_alpha(alpha[i])
+                .and_then(|()| EllipsoidBody::ellipsoid(alpha[i], beta[i], nu[i], eta[i]))
+                .map_err(|e| {
+                    value_error(AtlasError::Atlas {
+                        path: format!("cell {i}"),
+                        reason: e.to_string(),
+                    })
                 })
-            })
         })
         .collect::<PyResult<Vec<_>>>()?;
     let options = VerdictOptions {

@@ -322,12 +322,24 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
     // (An interrupted run over an existing output, `--force` or a stale `--update`, left
     // its journal beside it: `--resume` continues that run, which replaces the output as
     // the run itself would have.)
-    let interrupted_over_it = request.resume && Journal::looks_like_one(&Journal::dir_for(out));
-    if out.exists() && !request.force && !request.update && !interrupted_over_it {
-        return Err(AtlasError::atlas(
-            out,
-            "exists; use --force to overwrite it (a finished run has nothing to resume)",
-        ));
+    // Only the file that run was allowed to replace, unchanged since: a file put at the path
+    // after it started is not (it was replaced without a word: adversary pass 38).
+    let interrupted = request.resume && Journal::looks_like_one(&Journal::dir_for(out));
+    if out.exists() && !request.force && !request.update {
+        if interrupted && !Journal::output_unchanged(&Journal::dir_for(out), out) {
+            return Err(AtlasError::atlas(
+                out,
+                "exists, and is not what was at this path when the interrupted run started: \
+                 --resume replaces only the file that run was allowed to replace; move it away, \
+                 or use --force to replace it",
+            ));
+        }
+        if !interrupted {
+            return Err(AtlasError::atlas(
+                out,
+                "exists; use --force to overwrite it (a finished run has nothing to resume)",
+            ));
+        }
     }
     // The component axis, from the whole grid's critical points: the same for every shard.
     // (A census cut short by a signal lays out nothing: the run stops before any work.)
@@ -414,7 +426,7 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
         if request.force || (request.update && matching().is_err()) {
             std::fs::remove_dir_all(&journal_dir)
                 .map_err(|e| AtlasError::atlas(&journal_dir, e))?;
-            Journal::create(&journal_dir, fingerprint, &scene.text)?
+            Journal::create(&journal_dir, fingerprint, &scene.text, out)?
         } else if request.resume || request.update {
             matching()?
         } else if matching().is_ok() {
@@ -439,7 +451,7 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
             return Err(AtlasError::atlas(&journal_dir, reason));
         }
     } else {
-        Journal::create(&journal_dir, fingerprint, &scene.text)?
+        Journal::create(&journal_dir, fingerprint, &scene.text, out)?
     };
 
     let variables = atlas::scene_variables(scene);

@@ -939,6 +939,18 @@ pub fn verdict(body: &EllipsoidBody, options: &VerdictOptions) -> Result<Verdict
     verdict_until(body, options, &|| false)
 }
 
+/// Refuses α < 0: the verdict is computed for α ≥ 0 (α < 0 is the mirror image θ → π − θ).
+pub fn check_alpha(alpha: f64) -> Result<()> {
+    if alpha < 0.0 {
+        return Err(AtlasError::InvalidParameter {
+            name: "alpha",
+            value: alpha,
+            reason: "the verdict is computed for alpha >= 0; alpha < 0 is its mirror image theta -> pi - theta",
+        });
+    }
+    Ok(())
+}
+
 /// [`verdict`], given up when `stop` says so (polled between components and phases): then
 /// [`AtlasError::Stopped`].
 pub fn verdict_until(
@@ -954,13 +966,7 @@ pub fn verdict_until(
         }
     };
     let (alpha, beta) = (body.shape.alpha, body.shape.beta);
-    if alpha < 0.0 {
-        return Err(AtlasError::InvalidParameter {
-            name: "alpha",
-            value: alpha,
-            reason: "the verdict is computed for alpha >= 0; alpha < 0 is its mirror image theta -> pi - theta",
-        });
-    }
+    check_alpha(alpha)?;
     check_sampling(options.tol, options.resolution)?;
     let case = Case::of(alpha, beta);
     // Beyond the checked bodies even the limit is not computed (at β = 1e10 its quadrature

@@ -200,6 +200,8 @@ def test_a_request_beyond_memory_is_refused_before_its_inputs_are_materialised(c
     (lambda: ra.trajectory(0.5, 3, 0.5, 0.5, 0.8, 2.5, periods="1"), TypeError, ["periods"]),
     (lambda: ra.diagram(0.5, 3, samples=2.5), TypeError, ["samples"]),
     (lambda: ra.diagram(0.5, 3, kappa_max=2**1100), ValueError, ["kappa_max"]),
+    # (Named as the command line's kappa-max: adversary pass 38.)
+    (lambda: ra.diagram(0.5, 3, kappa_max=-1), ValueError, ["invalid kappa_max = -1"]),
     (lambda: ra.resonance(0.5, 3, 0.5, 0.5, "1/0"), ValueError, ["rotation_number", "1/0"]),
     # (An empty name was refused as the folder ".".)
     (lambda: ra.read_table(""), ValueError, ["path is empty"]),
@@ -236,6 +238,12 @@ def test_inputs_that_do_not_broadcast_are_named_not_numbered():
              ["kappa", "energy", "'x'"])):
         message = refused(ValueError, call, *words)
         assert "arg " not in message, message
+
+
+def test_a_negative_alpha_in_a_verdict_array_is_named_by_its_index():
+    # (Adversary pass 38: refused with no index, after the other bodies' verdicts.)
+    alpha = np.array([[0.5, 0.3], [0.2, -0.1]])
+    refused(ValueError, lambda: ra.verdict(alpha, 3.0, 0.5, 0.5, resolution=8), "alpha[1, 1] = -0.1", "alpha >= 0")
 
 
 def test_a_bad_value_in_a_2d_input_is_named_by_its_index_in_that_input():

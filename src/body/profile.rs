@@ -219,19 +219,20 @@ impl Profile {
     /// before from the same table is returned again. Refused, with the point and the reason
     /// in one line, where the table is not a convex meridian the arc spline can follow.
     pub fn from_points(points: &[Vec<f64>]) -> Result<&'static Profile> {
-        let rows = Self::checked_rows(points)?;
+        let (rows, reversed) = Self::checked_rows(points)?;
         let mut made = PROFILES.lock().unwrap_or_else(|e| e.into_inner());
         if let Some(p) = made.iter().find(|p| p.points == rows) {
             return Ok(p);
         }
-        let profile = Self::fit(rows)?;
+        let profile = Self::fit(rows, reversed)?;
         let leaked: &'static Profile = Box::leak(Box::new(profile));
         made.push(leaked);
         Ok(leaked)
     }
 
-    /// The rows as (ρ, z, edge), bottom pole first, each value checked.
-    fn checked_rows(points: &[Vec<f64>]) -> Result<Vec<[f64; 3]>> {
+    /// The rows as (ρ, z, edge), bottom pole first, each value checked, and whether they were
+    /// given top pole first (reversed here).
+    fn checked_rows(points: &[Vec<f64>]) -> Result<(Vec<[f64; 3]>, bool)> {
         let n = points.len();
         if n < 3 {
             return refuse(format!(
@@ -247,14 +248,14 @@ impl Profile {
         for (i, p) in points.iter().enumerate() {
             if p.len() != 2 && p.len() != 3 {
                 return refuse(format!(
-                    "point {i} has {} values; each is (rho, z) or (rho, z, edge)",
+                    "point {i} (counted from 0) has {} values; each is (rho, z) or (rho, z, edge)",
                     p.len()
                 ));
             }
             for (name, &x) in ["rho", "z"].iter().zip(p) {
                 if !x.is_finite() || x.abs() > MAX_PROFILE_COORDINATE {
                     return refuse(format!(
-                        "point {i} has {name} = {}; it must be a finite number of magnitude at most 1e6",
+                        "point {i} (counted from 0) has {name} = {}; it must be a finite number of magnitude at most 1e6",
                         crate::error::show(x)
                     ));
                 }
@@ -262,7 +263,7 @@ impl Profile {
             let edge = p.get(2).copied().unwrap_or(0.0);
             if edge != 0.0 && edge != 1.0 {
                 return refuse(format!(
-                    "point {i} has edge = {}; it must be 0 (smooth) or 1 (a sharp edge)",
+                    "point {i} (counted from 0) has edge = {}; it must be 0 (smooth) or 1 (a sharp edge)",
                     crate::error::show(edge)
                 ));
             }
@@ -276,25 +277,32 @@ impl Profile {
         }
         if let Some(i) = (1..n - 1).find(|&i| rows[i][0] <= 0.0) {
             return refuse(format!(
-                "point {i} has rho = {}; only the first and the last point lie on the axis, the others at rho > 0",
+                "point {i} (counted from 0) has rho = {}; only the first and the last point lie on the axis, the others at rho > 0",
                 crate::error::show(rows[i][0])
             ));
         }
         if rows[0][1] == rows[n - 1][1] {
             return refuse("has both poles at the same height: the body has no thickness".into());
         }
-        if rows[0][1] > rows[n - 1][1] {
+        if let Some(i) = (0..n - 1).find(|&i| rows[i][..2] == rows[i + 1][..2]) {
+            return refuse(format!(
+                "repeats point {i} as point {} (counted from 0)",
+                i + 1
+            ));
+        }
+        let reversed = rows[0][1] > rows[n - 1][1];
+        if reversed {
             rows.reverse();
         }
-        if let Some(i) = (0..n - 1).find(|&i| rows[i][..2] == rows[i + 1][..2]) {
-            return refuse(format!("repeats point {i} (as point {})", i + 1));
-        }
-        Ok(rows)
+        Ok((rows, reversed))
     }
 
-    /// The arc spline through the rows (bottom pole first).
-    fn fit(rows: Vec<[f64; 3]>) -> Result<Self> {
+    /// The arc spline through the rows (bottom pole first; `reversed`: given top pole first,
+    /// which the refusals count their points in).
+    fn fit(rows: Vec<[f64; 3]>, reversed: bool) -> Result<Self> {
         let n = rows.len();
+        // (A table given top pole first was refused by the points' places bottom first.)
+        let given = |i: usize| if reversed { n - 1 - i } else { i };
         let at = |i: usize| [rows[i][0], rows[i][1]];
         // A first or last stretch along a circle z = const from the axis is a flat face, and
         // the point where it ends is an edge.
@@ -339,8 +347,9 @@ impl Profile {
                 let turn = cross.atan2(dot);
                 if !(turn > 0.0 && turn < PI) {
                     return refuse(format!(
-                        "is not convex at point {i} (rho = {}, z = {}): the meridian must turn one way, \
+                        "is not convex at point {} (counted from 0; rho = {}, z = {}): the meridian must turn one way, \
                          from the bottom pole up round the side to the top pole, and not run straight",
+                        given(i),
                         crate::error::show(b[0]),
                         crate::error::show(b[1])
                     ));
@@ -354,10 +363,11 @@ impl Profile {
         }
         let straight = |i: usize| AtlasError::Profile {
             reason: format!(
-                "has a straight side between the edges at points {i} and {} (a cone's or a \
-                 cylinder's side would lie flat on the plane); give points on a curved side or a \
-                 flat face at a pole",
-                i + 1
+                "has a straight side between the edges at points {} and {} (counted from 0; a \
+                 cone's or a cylinder's side would lie flat on the plane); give points on a \
+                 curved side or a flat face at a pole",
+                given(i).min(given(i + 1)),
+                given(i).max(given(i + 1))
             ),
         };
         // The tangents on either side of each edge: where the meridian arrives (one arc from
@@ -400,8 +410,9 @@ impl Profile {
                         let (before, after) = (chord(i - 1), chord(i));
                         if after.partial_cmp(&before) != Some(std::cmp::Ordering::Greater) {
                             return refuse(format!(
-                                "is not convex at the edge at point {i}: the meridian turns back \
-                                 there"
+                                "is not convex at the edge at point {} (counted from 0): the \
+                                 meridian turns back there",
+                                given(i)
                             ));
                         }
                         let margin = 0.25 * (after - before);
@@ -450,9 +461,11 @@ impl Profile {
             let length = chord_length(a, b);
             let not_convex = |what: &str| AtlasError::Profile {
                 reason: format!(
-                    "is not convex between points {i} and {} ({what}): the meridian must turn one \
-                     way, from the bottom pole up round the side to the top pole",
-                    i + 1
+                    "is not convex between points {} and {} (counted from 0; {what}): the \
+                     meridian must turn one way, from the bottom pole up round the side to the \
+                     top pole",
+                    given(i).min(given(i + 1)),
+                    given(i).max(given(i + 1))
                 ),
             };
             if edge(i) {

@@ -13,6 +13,8 @@ use std::path::{Path, PathBuf};
 
 const MAGIC: &[u8; 8] = b"RATLUNIT";
 const FINGERPRINT_FILE: &str = "fingerprint";
+/// What was at the output path when the run started ([`output_identity`]).
+const OUTPUT_FILE: &str = "output";
 
 /// The journal of one output file.
 #[derive(Debug)]
@@ -27,11 +29,13 @@ impl Journal {
         crate::store::with_suffix(out, ".partial.d")
     }
 
-    /// Starts an empty journal (the directory must not exist).
-    pub fn create(dir: &Path, fingerprint: u64, scene_text: &str) -> Result<Journal> {
+    /// Starts an empty journal (the directory must not exist) of a run into `out`, noting
+    /// what is at `out` now: the file the run was allowed to replace, or nothing.
+    pub fn create(dir: &Path, fingerprint: u64, scene_text: &str, out: &Path) -> Result<Journal> {
         std::fs::create_dir(dir).map_err(|e| AtlasError::atlas(dir, e))?;
         std::fs::write(dir.join("scene.toml"), scene_text)
             .map_err(|e| AtlasError::atlas(dir, e))?;
+        write_atomically(&dir.join(OUTPUT_FILE), output_identity(out).as_bytes())?;
         write_atomically(
             &dir.join(FINGERPRINT_FILE),
             format!("{fingerprint:016x}\n").as_bytes(),
@@ -40,6 +44,15 @@ impl Journal {
             dir: dir.to_path_buf(),
             fingerprint,
         })
+    }
+
+    /// Whether what is at `out` now is what was there when the run of the journal in `dir`
+    /// started: the same file, unchanged, or nothing. `--resume` replaces only the file the
+    /// interrupted run was allowed to replace (a file put at the path after the run started
+    /// was replaced without a word: adversary pass 38).
+    pub fn output_unchanged(dir: &Path, out: &Path) -> bool {
+        std::fs::read_to_string(dir.join(OUTPUT_FILE))
+            .is_ok_and(|noted| noted == output_identity(out))
     }
 
     /// The `name` of the scene whose run made the journal in `dir`, if its scene can be read.
@@ -212,6 +225,27 @@ impl Journal {
             _ => Ok(()),
         }
     }
+}
+
+/// What is at `path`, as one line: `absent`, or the file's device, inode, size and time of
+/// last change (what tells another file, or the same one rewritten, from it).
+fn output_identity(path: &Path) -> String {
+    let Ok(meta) = std::fs::symlink_metadata(path) else {
+        return "absent\n".to_string();
+    };
+    let modified = meta
+        .modified()
+        .ok()
+        .and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok())
+        .map_or(0, |d| d.as_nanos());
+    #[cfg(unix)]
+    let (device, inode) = {
+        use std::os::unix::fs::MetadataExt;
+        (meta.dev(), meta.ino())
+    };
+    #[cfg(not(unix))]
+    let (device, inode) = (0u64, 0u64);
+    format!("{device} {inode} {} {modified}\n", meta.len())
 }
 
 /// Writes `bytes` to `path` through a temporary file in the same directory and a rename, so

@@ -473,6 +473,37 @@ fn tables_that_are_no_convex_meridian_are_refused() {
     let mut reversed = ellipse_table(1.0, 9);
     reversed.reverse();
     assert!(std::ptr::eq(p, Profile::from_points(&reversed).unwrap()));
+    // A refusal names a point by its place in the table as given, counted from 0 (as a line
+    // of a file is not), also where the table runs from the top pole down (a dent at point 3
+    // of such a table was "point 2", its place from the bottom: adversary pass 38).
+    let top_down = vec![
+        vec![0.0, 1.0],
+        vec![0.7, 0.7],
+        vec![1.0, 0.0],
+        vec![0.5, -0.3],
+        vec![0.9, -0.6],
+        vec![0.0, -1.0],
+    ];
+    let mut bottom_up = top_down.clone();
+    bottom_up.reverse();
+    for (table, named) in [
+        (top_down, "point 3 (counted from 0"),
+        (bottom_up, "point 2 (counted from 0"),
+    ] {
+        let text = Profile::from_points(&table).unwrap_err().to_string();
+        assert!(text.contains(named) && text.contains("z = -0.3"), "{text}");
+    }
+    let repeated = vec![
+        vec![0.0, 1.0],
+        vec![1.0, 0.0],
+        vec![1.0, 0.0],
+        vec![0.0, -1.0],
+    ];
+    let text = Profile::from_points(&repeated).unwrap_err().to_string();
+    assert!(
+        text.contains("repeats point 1 as point 2 (counted from 0)"),
+        "{text}"
+    );
 }
 
 /// On the egg's N = 0 resonance curve the path runs away: the full equations carry the centre

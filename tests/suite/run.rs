@@ -1261,6 +1261,44 @@ fn a_forced_run_over_an_output_resumes_as_its_stop_message_says() {
     assert!(!journal.exists());
 }
 
+/// `--resume` replaces only the file the interrupted run was allowed to replace (adversary
+/// pass 38: a file put at the output after a run into an empty path had stopped was replaced
+/// without a word). A file put there since, or the old output of a stopped `--force` changed
+/// since, is refused in one line and kept with the journal; moved away, the run resumes.
+#[test]
+fn a_resume_replaces_only_the_file_the_stopped_run_was_allowed_to_replace() {
+    let (_dir, scene, reference, out, journal) = slow_run();
+    let (s, o) = (scene.as_str(), out.to_str().unwrap());
+    let refused_resume = |kept: &[u8]| {
+        let refused = run(&["run", s, "--out", o, "--resume", "--quiet"]);
+        let text = String::from_utf8_lossy(&refused.stderr);
+        assert_eq!(refused.status.code(), Some(2), "{text}");
+        assert!(
+            text.contains("is not what was at this path when the interrupted run started"),
+            "{text}"
+        );
+        assert_eq!(text.trim().lines().count(), 1, "{text}");
+        assert_eq!(std::fs::read(&out).unwrap(), kept);
+        assert!(journal.exists());
+    };
+    // A run into an empty path, stopped; then a file of the user's at the path.
+    if stop_a_run(s, &out, &journal, &[]).is_some() {
+        std::fs::write(&out, "precious\n").unwrap();
+        refused_resume(b"precious\n");
+        std::fs::remove_file(&out).unwrap();
+        ok(&run(&["run", s, "--out", o, "--resume", "--quiet"]));
+        assert_same_arrays(&reference, &out);
+        assert!(!journal.exists());
+    }
+    // A stopped `--force` over an output that was written again since.
+    if stop_a_forced_run(s, &reference, &out, &journal).is_some() {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        let other = std::fs::read(&reference).unwrap();
+        std::fs::write(&out, &other).unwrap();
+        refused_resume(&other);
+    }
+}
+
 /// `--update` over a current output that a stopped `--force` run left its journal beside:
 /// nothing to do, and the journal (with its partial file) goes, rather than lingering for a
 /// later `--resume` to redo the run (adversary pass 4 of issue 22).
