@@ -1755,13 +1755,26 @@ def _read_csv(path: Path) -> xr.Dataset:
     return ds
 
 
+# The index (int32) and flag (uint8) columns of the tables rubber-atlas writes (docs/files.md);
+# every other column is float64.
+_TABLE_COLUMN_TYPES = {"sample": "int32", "segment": "int32", "curve": "int32", "point": "int32",
+                       "component": "int32", "branch": "uint8", "stable": "uint8", "family": "uint8",
+                       "closed": "uint8"}
+
+
 def _csv_types(path: Path, line) -> dict:
-    """The column names and types of a CSV table's ``# columns: name:type …`` line."""
+    """The column names and types of a CSV table's ``# columns: name:type …`` line, each the
+    type rubber-atlas writes that column with (a type edited there had the column read as
+    another: an adversary pass)."""
     types = {}
     for item in str(line).split():
         name, _, kind = item.partition(":")
         if kind not in ("float64", "int32", "uint8") or name in types:
             raise _DamagedTable(f"{path}: the table's '# columns' line is damaged at {item!r}; write it again")
+        written = _TABLE_COLUMN_TYPES.get(name, "float64")
+        if kind != written:
+            raise _DamagedTable(f"{path}: the table's '# columns' line gives {name!r} as {kind}, where rubber-atlas "
+                                f"writes it as {written}: the table was edited or damaged; write it again")
         types[name] = kind
     return types
 

@@ -621,6 +621,13 @@ def test_read_table_refuses_edited_headers_and_typed_columns_and_reads_an_empty_
         deleted = tmp_path / f"no-{key}.csv"
         deleted.write_text("".join(lines[:at] + lines[at + 1:]))
         refused(ValueError, lambda: ra.read_table(deleted), f"no '# {key}' line", "edited")
+    # (Adversary pass 39: a type edited in the '# columns' line had the column read as int64
+    # or float64.)
+    for name, kind in [("branch", "float64"), ("sample", "uint8"), ("kappa", "int32")]:
+        line = re.sub(rf" {name}:\w+", f" {name}:{kind}", lines[columns_line])
+        assert line != lines[columns_line]
+        retyped = edited(f"retyped-{name}.csv", columns_line, line)
+        refused(ValueError, lambda: ra.read_table(retyped), f"gives '{name}' as {kind}", "edited")
 
 
 def test_a_length_one_vector_with_a_longer_one_makes_a_grid():
