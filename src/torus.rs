@@ -222,6 +222,23 @@ pub struct Component {
 }
 
 impl Component {
+    /// The permanent rotation at the minimum `m` of V (ε at its level, to rounding), between
+    /// the critical points `neighbours`.
+    fn resting_at(
+        m: CriticalPoint,
+        family: Family,
+        neighbours: [Option<CriticalPoint>; 2],
+    ) -> Self {
+        Component {
+            lower: m.site,
+            upper: m.site,
+            kind: MotionKind::FixedPoint,
+            family,
+            interior: vec![m],
+            neighbours,
+        }
+    }
+
     /// θ_min.
     pub fn theta_min(&self) -> f64 {
         self.lower.theta
@@ -954,17 +971,11 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             .map(|((first, last), family)| {
                 // A minimum just above ε, within its rounding: the body rests there.
                 if let Some(m) = nodes[first].filter(|m| first == last && m.value > energy) {
-                    return Component {
-                        lower: m.site,
-                        upper: m.site,
-                        kind: MotionKind::FixedPoint,
-                        family,
-                        interior: vec![m],
-                        neighbours: [
-                            first.checked_sub(1).and_then(|i| nodes[i]),
-                            nodes.get(last + 1).copied().flatten(),
-                        ],
-                    };
+                    let neighbours = [
+                        first.checked_sub(1).and_then(|i| nodes[i]),
+                        nodes.get(last + 1).copied().flatten(),
+                    ];
+                    return Component::resting_at(m, family, neighbours);
                 }
                 // A run that starts or ends at a node reaches the top of the circle itself
                 // (κ = 0, a separatrix); otherwise its ends are crossings of V = ε.
@@ -1180,15 +1191,7 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
             && closed[0].kind == CriticalKind::Minimum
             && energy - closed[0].value <= 4.0 * EPS * closed[0].scale;
         if at_minimum {
-            let m = closed[0];
-            return Component {
-                lower: m.site,
-                upper: m.site,
-                kind: MotionKind::FixedPoint,
-                family,
-                interior: vec![m],
-                neighbours,
-            };
+            return Component::resting_at(closed[0], family, neighbours);
         }
         Component {
             lower,
