@@ -764,7 +764,6 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         (slope, psi, psi_slope)
     }
 
-    /// The critical points, and the shoulders ([`Self::shoulders`]).
     /// g′/sin²θ = κ²/sinθ + 3 cosθ U′ + sinθ U″ at `a`, from U′ and U″ there (the
     /// derivative of g = sin³θ V′ that brackets the critical points; see
     /// [`Self::find_critical_points`]).
@@ -772,6 +771,8 @@ impl<'a, S: Shape> EffectivePotential<'a, S> {
         let w = self.kappa / a.sin;
         w * w * a.sin + 3.0 * a.cos * slope + a.sin * second
     }
+
+    /// The critical points, and the shoulders ([`Self::shoulders`]).
     fn find_critical_points(&self, table: &ScanTable) -> (Vec<CriticalPoint>, Vec<Site>) {
         let shape = &self.body.shape;
         // Roots of g = sin³θ V′ = −κ² cosθ + sin³θ U′ (no pole; U′'s roots in (0, π) for

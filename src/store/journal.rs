@@ -238,14 +238,8 @@ fn output_identity(path: &Path) -> String {
         .ok()
         .and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok())
         .map_or(0, |d| d.as_nanos());
-    #[cfg(unix)]
-    let (device, inode) = {
-        use std::os::unix::fs::MetadataExt;
-        (meta.dev(), meta.ino())
-    };
-    #[cfg(not(unix))]
-    let (device, inode) = (0u64, 0u64);
-    format!("{device} {inode} {} {modified}\n", meta.len())
+    use std::os::unix::fs::MetadataExt;
+    format!("{} {} {} {modified}\n", meta.dev(), meta.ino(), meta.len())
 }
 
 /// Writes `bytes` to `path` through a temporary file in the same directory and a rename, so
