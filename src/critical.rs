@@ -197,14 +197,19 @@ pub fn fixed_point_kappa_sq(body: &EllipsoidBody, theta0: f64) -> f64 {
 }
 
 /// ε on the fixed-point curve (`s1`):
-/// ε = (3Z² − 1)/(2Z) + α (3cos²θ0 − 1)/(2cosθ0).
+/// ε = (3Z² − 1)/(2Z) + α (3cos²θ0 − 1)/(2cosθ0). (The paper's closed form; its two terms
+/// cancel near θ0 = π/2 on a needle, where [`fixed_point`] takes V(θ0) instead.)
 pub fn fixed_point_energy(body: &EllipsoidBody, theta0: f64) -> f64 {
     let z = body.shape.centre_height(theta0);
     let c = theta0.cos();
     (3.0 * z * z - 1.0) / (2.0 * z) + body.shape.alpha * (3.0 * c * c - 1.0) / (2.0 * c)
 }
 
-/// The permanent rotation at θ0 (θ0 ≠ π/2, κ² ≥ 0 there).
+/// The permanent rotation at θ0 (θ0 ≠ π/2, κ² ≥ 0 there), at ε = V(θ0) for its κ: the
+/// value of [`fixed_point_energy`] in a form without cancellation (a sum of two positive
+/// terms), so that a cell at the point's (κ, ε) finds ε at its minimum of V to V's rounding.
+/// (The closed form's terms, ±50 at α = 0.2, β = 0.01 beside θ0 = π/2, left ε 100 ulps below
+/// that minimum, and the cell found no motion there: adversary pass 41.)
 pub fn fixed_point(body: &EllipsoidBody, theta0: f64) -> FixedPoint {
     let kappa = fixed_point_kappa_sq(body, theta0).max(0.0).sqrt();
     let sys = ReducedSystem::new(body, kappa);
@@ -214,7 +219,7 @@ pub fn fixed_point(body: &EllipsoidBody, theta0: f64) -> FixedPoint {
     FixedPoint {
         theta0,
         kappa,
-        energy: fixed_point_energy(body, theta0),
+        energy: sys.effective_potential(theta0),
         stable: sys.effective_potential_second(theta0) > 0.0,
         rho_c: z * s / c + body.shape.alpha * s,
         rho_p: b2 * s / (c * z),

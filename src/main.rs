@@ -117,6 +117,12 @@ fn main() -> ExitCode {
             say!("rubber-atlas: stopped by {signal} before the work was done; nothing was written");
             ExitCode::from(status)
         }
+        Err(e) if e.to_string() == cli::PRINTING_FAILED => {
+            // (As a failed `println!` is reported: `completions` and `man` into /dev/full said
+            // "error: …" where every other command says this; adversary pass 41.)
+            say!("rubber-atlas: {}", one_line(&format!("{e:#}")));
+            ExitCode::from(1)
+        }
         Err(e) => {
             say!("error: {}", one_line(&format!("{e:#}")));
             if e.chain().any(|c| {

@@ -407,7 +407,7 @@ pub fn run(cli: Cli) -> Result<()> {
             stdout
                 .write_all(&script)
                 .and_then(|()| stdout.flush())
-                .context("failed printing to stdout")
+                .context(PRINTING_FAILED)
         }
         Command::Man {
             command,
@@ -479,8 +479,7 @@ fn man(name: Option<&str>, dir: Option<&std::path::Path>, force: bool) -> Result
             page_of(c)
         }
     };
-    page.render(&mut std::io::stdout())
-        .context("cannot write the manual page")
+    page.render(&mut std::io::stdout()).context(PRINTING_FAILED)
 }
 
 /// The attributes a command adds to the atlases it writes: its command line, the time, and
@@ -580,6 +579,11 @@ pub(crate) fn command_line() -> String {
 }
 
 /// Tables (`diagram`, `trajectory`, `resonance`).
+/// The context of an error writing a command's text to standard output (a full disk,
+/// `> /dev/full`): `main` reports it as it reports a failed `println!`, in one line with the
+/// program's name.
+pub(crate) const PRINTING_FAILED: &str = "failed printing to stdout";
+
 pub(crate) const TABLE_EXTENSIONS: [&str; 3] = ["csv", "h5", "hdf5"];
 /// Atlases (`run`, `merge`).
 pub(crate) const ATLAS_EXTENSIONS: [&str; 2] = ["h5", "hdf5"];

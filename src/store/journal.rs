@@ -16,6 +16,34 @@ const FINGERPRINT_FILE: &str = "fingerprint";
 /// What was at the output path when the run started ([`output_identity`]).
 const OUTPUT_FILE: &str = "output";
 
+/// The bytes of the regular file at `path`; anything else at the path (a FIFO, a device, a
+/// folder) is an error, found without waiting: a FIFO put in place of a journal's file was
+/// opened for reading and waited on for a writer, and `--resume` hung beyond SIGTERM
+/// (adversary pass 41).
+fn read_regular(path: &Path) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    use std::os::unix::fs::OpenOptionsExt;
+    let mut file = std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NONBLOCK)
+        .open(path)?;
+    if !file.metadata()?.is_file() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "not a regular file",
+        ));
+    }
+    let mut bytes = Vec::new();
+    file.read_to_end(&mut bytes)?;
+    Ok(bytes)
+}
+
+/// [`read_regular`] as UTF-8 text.
+fn read_text(path: &Path) -> std::io::Result<String> {
+    String::from_utf8(read_regular(path)?)
+        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))
+}
+
 /// The journal of one output file.
 #[derive(Debug)]
 pub struct Journal {
@@ -51,13 +79,12 @@ impl Journal {
     /// interrupted run was allowed to replace (a file put at the path after the run started
     /// was replaced without a word: adversary pass 38).
     pub fn output_unchanged(dir: &Path, out: &Path) -> bool {
-        std::fs::read_to_string(dir.join(OUTPUT_FILE))
-            .is_ok_and(|noted| noted == output_identity(out))
+        read_text(&dir.join(OUTPUT_FILE)).is_ok_and(|noted| noted == output_identity(out))
     }
 
     /// The `name` of the scene whose run made the journal in `dir`, if its scene can be read.
     pub fn scene_name_in(dir: &Path) -> Option<String> {
-        let text = std::fs::read_to_string(dir.join("scene.toml")).ok()?;
+        let text = read_text(&dir.join("scene.toml")).ok()?;
         let table = text.parse::<toml::Table>().ok()?;
         table.get("name")?.as_str().map(str::to_string)
     }
@@ -74,7 +101,7 @@ impl Journal {
     /// Opens an existing journal; refuses one of another scene or program version.
     pub fn open(dir: &Path, fingerprint: u64) -> Result<Journal> {
         let path = dir.join(FINGERPRINT_FILE);
-        let text = std::fs::read_to_string(&path).map_err(|e| AtlasError::atlas(&path, e))?;
+        let text = read_text(&path).map_err(|e| AtlasError::atlas(&path, e))?;
         let found =
             u64::from_str_radix(text.trim(), 16).map_err(|e| AtlasError::atlas(&path, e))?;
         if found != fingerprint {
@@ -170,7 +197,7 @@ impl Journal {
         counts: usize,
     ) -> Option<(EncodedUnit, Vec<u64>)> {
         let path = self.unit_path(index);
-        let bytes = std::fs::read(&path).ok()?;
+        let bytes = read_regular(&path).ok()?;
         let unit = self.decode(&bytes, index, chunks, counts);
         if unit.is_none() {
             let _ = std::fs::remove_file(&path);

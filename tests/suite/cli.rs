@@ -1012,11 +1012,14 @@ fn a_run_without_out_writes_beside_its_scene_from_any_folder() {
 /// Standard output that cannot be written (a full disk: /dev/full) is one line on stderr and
 /// exit status 1, never a panic with a backtrace. (Adversary pass of 2026-11-27:
 /// `completions bash` panicked in clap_complete, exit 101 with a backtrace; `--help` and
-/// `--version` exited 0 in silence.)
+/// `--version` exited 0 in silence. Adversary pass 41: `completions` and `man` said "error: …"
+/// where the others say "rubber-atlas: failed printing to stdout: …".)
 #[test]
 fn output_that_cannot_be_written_is_one_line_and_exit_1() {
-    let commands: [&[&str]; 6] = [
+    let commands: [&[&str]; 8] = [
         &["completions", "bash"],
+        &["man"],
+        &["man", "cell"],
         &["--help"],
         &["--version"],
         &[
@@ -1043,8 +1046,10 @@ fn output_that_cannot_be_written_is_one_line_and_exit_1() {
         let text = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(1), "{args:?}: {text}");
         assert!(
-            text.contains("No space left on device") && text.lines().count() == 1,
-            "{text}"
+            text.starts_with("rubber-atlas: failed printing to stdout: ")
+                && text.contains("No space left on device")
+                && text.lines().count() == 1,
+            "{args:?}: {text}"
         );
     }
 }

@@ -961,6 +961,62 @@ fn a_damaged_journal_unit_is_computed_again_and_counted_once() {
     assert_same_arrays(&reference, &out);
 }
 
+/// `args` run to the end, or killed and the test failed where it takes over a minute.
+fn run_within_a_minute(args: &[&str]) -> Output {
+    let mut child = Command::new(BIN)
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > Duration::from_secs(60) {
+            child.kill().unwrap();
+            panic!("{args:?} still ran after a minute");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// A FIFO put in place of a file of the journal (adversary pass 41: `--resume` opened it and
+/// waited for a writer, past SIGTERM, over ten minutes): a unit's is computed again, the
+/// fingerprint's is refused in one line, neither waits.
+#[test]
+fn a_fifo_in_the_journal_is_never_waited_on() {
+    let (_dir, scene, reference, out, journal) = slow_run();
+    let (s, o) = (scene.as_str(), out.to_str().unwrap());
+    let fifo_at = |path: &Path| {
+        std::fs::remove_file(path).unwrap();
+        let made = Command::new("mkfifo").arg(path).status().unwrap();
+        assert!(made.success());
+    };
+    std::fs::remove_file(&out).ok();
+    if stop_a_run(s, &out, &journal, &[]).is_some() {
+        let unit = std::fs::read_dir(&journal)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .find(|p| p.extension().is_some_and(|e| e == "bin"))
+            .unwrap();
+        fifo_at(&unit);
+        let resumed = run_within_a_minute(&["run", s, "--out", o, "--resume"]);
+        let text = String::from_utf8_lossy(&resumed.stderr);
+        assert!(resumed.status.success(), "{text}");
+        assert!(text.contains("a damaged unit of the journal"), "{text}");
+        assert_same_arrays(&reference, &out);
+        std::fs::remove_file(&out).unwrap();
+    }
+    if stop_a_run(s, &out, &journal, &[]).is_some() {
+        fifo_at(&journal.join("fingerprint"));
+        let refused = run_within_a_minute(&["run", s, "--out", o, "--resume", "--quiet"]);
+        let text = String::from_utf8_lossy(&refused.stderr);
+        assert!(!refused.status.success(), "{text}");
+        assert!(text.contains("fingerprint: not a regular file"), "{text}");
+        assert_eq!(text.trim().lines().count(), 1, "{text}");
+    }
+}
+
 /// A scene of an edged body (docs/bodies.md): `shape` and its axes beside α.
 fn edged_scene(dir: &Path, shape: &str, second: &str, plane: &str) -> PathBuf {
     let path = dir.join(format!("{shape}.toml"));
