@@ -88,6 +88,22 @@ pub fn check_output(path: &Path, force: bool, inputs: &[&Path], extensions: &[&s
         if !parent.is_dir() {
             return refuse(format!("the folder {} does not exist", parent.display()));
         }
+        // (Not inside a run's resume journal, which that run removes whole when it ends: a
+        // table written there was deleted with it, without a word to either: adversary pass
+        // 42. Also where a link leads there.)
+        fn journal(folder: &Path) -> Option<&Path> {
+            folder.ancestors().find(|a| {
+                a.file_name()
+                    .is_some_and(|n| n.to_string_lossy().to_lowercase().ends_with(".partial.d"))
+            })
+        }
+        let real = std::fs::canonicalize(parent).ok();
+        if let Some(folder) = journal(parent).or_else(|| real.as_deref().and_then(journal)) {
+            return refuse(format!(
+                "lies inside {}, a folder named as a run's resume journal, which that run                  removes when it ends: choose another folder",
+                folder.display()
+            ));
+        }
     }
     match std::fs::symlink_metadata(path) {
         Ok(meta) if !meta.file_type().is_file() => {

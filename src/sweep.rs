@@ -146,6 +146,16 @@ pub struct RunRequest {
     pub attributes: Vec<(String, AttrValue)>,
 }
 
+/// Removes what a stopped run may have left at its temporary file's path: a file, or a link
+/// (never its target), also a dangling one, which `exists` does not see (the file was then
+/// created beside it and HDF5 refused in a line of its internals: adversary pass 42).
+fn remove_stale(tmp: &Path) -> Result<()> {
+    if std::fs::symlink_metadata(tmp).is_ok() {
+        std::fs::remove_file(tmp).map_err(|e| AtlasError::atlas(tmp, e))?;
+    }
+    Ok(())
+}
+
 /// `<out>.partial.h5`: where the file is written before it is renamed into place.
 fn temporary_path(out: &Path) -> PathBuf {
     crate::store::with_suffix(out, ".partial.h5")
@@ -473,9 +483,7 @@ pub fn run(scene: &Scene, request: &RunRequest, progress: &dyn Progress) -> Resu
     // busy). The file is written afresh by every invocation: the journal, not the file,
     // survives a kill.
     let tmp = temporary_path(out);
-    if tmp.exists() {
-        std::fs::remove_file(&tmp).map_err(|e| AtlasError::atlas(&tmp, e))?;
-    }
+    remove_stale(&tmp)?;
     let mut attributes = scene_attributes(scene, request.shard, units_total);
     attributes.extend(request.attributes.iter().cloned());
     let advance = |cells: usize| progress.advance(cells as u64);
@@ -783,9 +791,7 @@ pub fn merge_until(
     } = open_shards(shards, out, &|_| {})?;
     let shape = scene.shape();
     let tmp = temporary_path(out);
-    if tmp.exists() {
-        std::fs::remove_file(&tmp).map_err(|e| AtlasError::atlas(&tmp, e))?;
-    }
+    remove_stale(&tmp)?;
     let mut attributes = scene_attributes(&scene, Shard::WHOLE, atlas::unit_count(shape));
     let whole = Region::whole(shape);
     let chunk_cells = whole.chunk_cells(shape);

@@ -574,16 +574,23 @@ pub(crate) fn json_name<T: serde::Serialize>(value: &T) -> String {
     }
 }
 
+/// The command line as the files record it: its arguments as given, those that are not
+/// UTF-8 (a file's name may be any bytes) with U+FFFD for each byte that is not.
+/// (`std::env::args` panics on such an argument: every command that writes a file did,
+/// after its work: adversary pass 42.)
 pub(crate) fn command_line() -> String {
-    std::env::args().collect::<Vec<_>>().join(" ")
+    std::env::args_os()
+        .map(|a| a.to_string_lossy().into_owned())
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
-/// Tables (`diagram`, `trajectory`, `resonance`).
 /// The context of an error writing a command's text to standard output (a full disk,
 /// `> /dev/full`): `main` reports it as it reports a failed `println!`, in one line with the
 /// program's name.
 pub(crate) const PRINTING_FAILED: &str = "failed printing to stdout";
 
+/// Tables (`diagram`, `trajectory`, `resonance`).
 pub(crate) const TABLE_EXTENSIONS: [&str; 3] = ["csv", "h5", "hdf5"];
 /// Atlases (`run`, `merge`).
 pub(crate) const ATLAS_EXTENSIONS: [&str; 2] = ["h5", "hdf5"];

@@ -57,6 +57,25 @@ pub struct ResonanceArgs {
     pub force: bool,
 }
 
+/// A whole number in decimal, with its sign; one of more than 30 digits as the largest i128
+/// (beyond any bound it is checked against).
+fn whole_number(text: &str) -> Option<i128> {
+    let text = text.trim();
+    let (negative, digits) = match text.strip_prefix('-') {
+        Some(rest) => (true, rest),
+        None => (false, text.strip_prefix('+').unwrap_or(text)),
+    };
+    if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    let size = if digits.len() > 30 {
+        i128::MAX
+    } else {
+        digits.parse().ok()?
+    };
+    Some(if negative { -size } else { size })
+}
+
 /// P/Q or a decimal.
 pub(super) fn parse_rotation_number(text: &str) -> Result<f64> {
     let bad = || AtlasError::Atlas {
@@ -65,13 +84,16 @@ pub(super) fn parse_rotation_number(text: &str) -> Result<f64> {
     };
     let value = match text.split_once('/') {
         Some((p, q)) => {
-            let p: i64 = p.trim().parse().map_err(|_| bad())?;
-            let q: i64 = q.trim().parse().map_err(|_| bad())?;
+            // (A whole number beyond i64 is refused below as too large, not as "not whole
+            // numbers": adversary pass 42.)
+            let (Some(p), Some(q)) = (whole_number(p), whole_number(q)) else {
+                return Err(bad().into());
+            };
             if q == 0 {
                 return Err(bad().into());
             }
             // Up to 2^53 every whole number is a double, and p/q is rounded once.
-            const EXACT: u64 = 1 << 53;
+            const EXACT: u128 = 1 << 53;
             if p.unsigned_abs() > EXACT || q.unsigned_abs() > EXACT {
                 return Err(AtlasError::Atlas {
                     path: format!("--rotation-number {text}"),

@@ -58,8 +58,8 @@ pub struct VerdictArgs {
     #[arg(value_parser = number, long, default_value_t = 1e-10, allow_hyphen_values = true)]
     pub tol: f64,
     /// κ-lines of each kind and energies per line of the sampling (doubling it halves the
-    /// spacing), 8 … 4096; the time grows about as its square (the paper's body: 0.5 s at 64,
-    /// about 9 minutes at 4096).
+    /// spacing), 8 … 4096 (32 … 4096 with --boundaries); the time grows about as its square
+    /// (the paper's body: 0.5 s at 64, about 9 minutes at 4096).
     #[arg(long, default_value_t = 64, allow_hyphen_values = true, value_parser = resolution)]
     pub resolution: usize,
     /// Print one JSON object (docs/hypothesis.md contract).

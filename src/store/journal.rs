@@ -101,9 +101,19 @@ impl Journal {
     /// Opens an existing journal; refuses one of another scene or program version.
     pub fn open(dir: &Path, fingerprint: u64) -> Result<Journal> {
         let path = dir.join(FINGERPRINT_FILE);
-        let text = read_text(&path).map_err(|e| AtlasError::atlas(&path, e))?;
-        let found =
-            u64::from_str_radix(text.trim(), 16).map_err(|e| AtlasError::atlas(&path, e))?;
+        // (A damaged fingerprint said only "cannot parse integer from empty string":
+        // adversary pass 42.)
+        let damaged = |e: &dyn std::fmt::Display| {
+            AtlasError::atlas(
+                &path,
+                format!(
+                    "the journal's fingerprint is damaged ({e}): its units cannot be trusted; \
+                     start over with --force"
+                ),
+            )
+        };
+        let text = read_text(&path).map_err(|e| damaged(&e))?;
+        let found = u64::from_str_radix(text.trim(), 16).map_err(|e| damaged(&e))?;
         if found != fingerprint {
             return Err(AtlasError::Atlas {
                 path: dir.display().to_string(),
@@ -184,7 +194,17 @@ impl Journal {
             w.inner.flush()
         };
         write().map_err(|e| AtlasError::write_failed(&tmp, e))?;
-        std::fs::rename(&tmp, &path).map_err(|e| AtlasError::write_failed(&path, e))
+        std::fs::rename(&tmp, &path).map_err(|e| {
+            if path.is_dir() {
+                AtlasError::atlas(
+                    &path,
+                    "a folder with files in it, where the journal keeps a unit's file: \
+                     remove it and resume, or start over with --force",
+                )
+            } else {
+                AtlasError::write_failed(&path, e)
+            }
+        })
     }
 
     /// A unit read back — its chunks and counts — if its file is there, whole, of this scene,
@@ -197,10 +217,19 @@ impl Journal {
         counts: usize,
     ) -> Option<(EncodedUnit, Vec<u64>)> {
         let path = self.unit_path(index);
-        let bytes = read_regular(&path).ok()?;
-        let unit = self.decode(&bytes, index, chunks, counts);
+        let unit = read_regular(&path)
+            .ok()
+            .and_then(|bytes| self.decode(&bytes, index, chunks, counts));
         if unit.is_none() {
-            let _ = std::fs::remove_file(&path);
+            // (Whatever is there, but a folder with something in it: an empty folder in a
+            // unit's place made every resume fail where the unit was written again,
+            // adversary pass 42.)
+            let is_dir = std::fs::symlink_metadata(&path).is_ok_and(|m| m.is_dir());
+            let _ = if is_dir {
+                std::fs::remove_dir(&path)
+            } else {
+                std::fs::remove_file(&path)
+            };
         }
         unit
     }

@@ -516,6 +516,11 @@ fn edge_inputs_get_one_line_and_never_a_panic() {
     big.extend(BODY);
     big.extend(["--rotation-number", "9007199254740993/1"]);
     assert_refused(&big, "2^53", None);
+    // (Also beyond i64, which was called "not whole numbers": adversary pass 42.)
+    let mut huge: Vec<&str> = vec!["resonance"];
+    huge.extend(BODY);
+    huge.extend(["--rotation-number", "1/99999999999999999999"]);
+    assert_refused(&huge, "2^53", None);
     // Messages: -inf as a value, a huge θ̇(0), a missing merge input.
     let mut inf: Vec<&str> = vec!["cell", "--alpha", "-inf", "--beta", "3", "--nu", "0.5"];
     inf.extend(["--eta", "0.5", "--kappa", "1", "--energy", "2"]);
@@ -1806,9 +1811,14 @@ fn adversary_pass_of_2026_11_27_command_line() {
     .unwrap();
     // `run --print-out` printed paths the run refuses (exit 0): now the same refusal.
     let demo = concat!(env!("CARGO_MANIFEST_DIR"), "/atlas/demo.toml");
+    // (And a path inside a folder named as a run's journal, which that run removes whole
+    // when it ends: adversary pass 42.)
+    let journal = dir.path().join("o.h5.partial.d");
+    std::fs::create_dir(&journal).unwrap();
     for out in [
         dir.path().join("x.nc"),
         dir.path().join("x.partial.h5"),
+        journal.join("x.h5"),
         dir.path().join("nodir").join("x.h5"),
         dir.path().to_path_buf(),
         std::path::PathBuf::from(demo),
@@ -1831,6 +1841,24 @@ fn adversary_pass_of_2026_11_27_command_line() {
         text.contains("line 4 `eta = 99999999999999999999`") && text.lines().count() == 1,
         "{text}"
     );
+}
+
+/// A file name that is not UTF-8 (any bytes but `/` and NUL are a name on Linux) is written
+/// as given; every command that wrote a file panicked after its work, in recording its
+/// command line (adversary pass 42). Also a table of such a name as a `diagram`'s input.
+#[test]
+fn file_names_that_are_not_utf8_are_written_as_given() {
+    use std::os::unix::ffi::OsStrExt;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join(std::ffi::OsStr::from_bytes(b"bad\xff.csv"));
+    let o = Command::new(env!("CARGO_BIN_EXE_rubber-atlas"))
+        .args("diagram --alpha 0.5 --beta 3 --samples 20 --out".split(' '))
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let table = std::fs::read_to_string(&out).unwrap();
+    assert!(table.contains("bad\u{fffd}.csv"), "{table}");
 }
 
 /// Issue 22, adversary pass of 2026-11-27: the size check of `run` counted whole work units

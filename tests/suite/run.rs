@@ -980,11 +980,14 @@ fn run_within_a_minute(args: &[&str]) -> Output {
     child.wait_with_output().unwrap()
 }
 
-/// A FIFO put in place of a file of the journal (adversary pass 41: `--resume` opened it and
-/// waited for a writer, past SIGTERM, over ten minutes): a unit's is computed again, the
-/// fingerprint's is refused in one line, neither waits.
+/// Files of a stopped run's journal replaced by what no run writes there (adversary passes 41
+/// and 42): a FIFO in a unit's place (opened and waited on for a writer, past SIGTERM, over
+/// ten minutes) or an empty folder (every resume failed where the unit was written again) is
+/// computed again, and a dangling link at `<out>.partial.h5` (refused in a line of HDF5's
+/// internals) replaced; a FIFO or an empty file as the fingerprint is refused in one line
+/// saying the journal is damaged. Nothing waits.
 #[test]
-fn a_fifo_in_the_journal_is_never_waited_on() {
+fn a_journal_with_foreign_files_is_never_waited_on() {
     let (_dir, scene, reference, out, journal) = slow_run();
     let (s, o) = (scene.as_str(), out.to_str().unwrap());
     let fifo_at = |path: &Path| {
@@ -992,14 +995,22 @@ fn a_fifo_in_the_journal_is_never_waited_on() {
         let made = Command::new("mkfifo").arg(path).status().unwrap();
         assert!(made.success());
     };
+    let partial = PathBuf::from(format!("{o}.partial.h5"));
     std::fs::remove_file(&out).ok();
     if stop_a_run(s, &out, &journal, &[]).is_some() {
-        let unit = std::fs::read_dir(&journal)
+        let mut units: Vec<PathBuf> = std::fs::read_dir(&journal)
             .unwrap()
             .map(|e| e.unwrap().path())
-            .find(|p| p.extension().is_some_and(|e| e == "bin"))
-            .unwrap();
-        fifo_at(&unit);
+            .filter(|p| p.extension().is_some_and(|e| e == "bin"))
+            .collect();
+        units.sort();
+        fifo_at(&units[0]);
+        if let Some(unit) = units.get(1) {
+            std::fs::remove_file(unit).unwrap();
+            std::fs::create_dir(unit).unwrap();
+        }
+        std::fs::remove_file(&partial).ok();
+        std::os::unix::fs::symlink("/nonexistent/x.h5", &partial).unwrap();
         let resumed = run_within_a_minute(&["run", s, "--out", o, "--resume"]);
         let text = String::from_utf8_lossy(&resumed.stderr);
         assert!(resumed.status.success(), "{text}");
@@ -1007,13 +1018,27 @@ fn a_fifo_in_the_journal_is_never_waited_on() {
         assert_same_arrays(&reference, &out);
         std::fs::remove_file(&out).unwrap();
     }
-    if stop_a_run(s, &out, &journal, &[]).is_some() {
-        fifo_at(&journal.join("fingerprint"));
+    for fingerprint in ["fifo", "empty"] {
+        if stop_a_run(s, &out, &journal, &[]).is_none() {
+            continue;
+        }
+        let path = journal.join("fingerprint");
+        if fingerprint == "fifo" {
+            fifo_at(&path);
+        } else {
+            std::fs::write(&path, "").unwrap();
+        }
         let refused = run_within_a_minute(&["run", s, "--out", o, "--resume", "--quiet"]);
         let text = String::from_utf8_lossy(&refused.stderr);
         assert!(!refused.status.success(), "{text}");
-        assert!(text.contains("fingerprint: not a regular file"), "{text}");
+        assert!(
+            text.contains("fingerprint: the journal's fingerprint is damaged")
+                && text.contains("--force"),
+            "{text}"
+        );
         assert_eq!(text.trim().lines().count(), 1, "{text}");
+        ok(&run(&["run", s, "--out", o, "--force", "--quiet"]));
+        std::fs::remove_file(&out).unwrap();
     }
 }
 
