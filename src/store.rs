@@ -75,6 +75,15 @@ pub fn check_output(path: &Path, force: bool, inputs: &[&Path], extensions: &[&s
                 .join(", ")
         ));
     }
+    // (HDF5 takes a file's name as UTF-8 only: a run into another name was refused by it
+    // after its journal was made, which then blocked every later run: adversary pass 43.)
+    if matches!(ext.as_str(), "h5" | "hdf5") && path.to_str().is_none() {
+        return refuse(
+            "is not UTF-8, and the HDF5 library takes only UTF-8 file names: choose another \
+             name (a .csv table may have any name)"
+                .into(),
+        );
+    }
     // (A finished atlas by that name was refused by open_atlas as an unfinished run's file:
     // adversary pass of 2026-11-27.)
     if text.to_lowercase().ends_with(".partial.h5") {

@@ -1250,6 +1250,7 @@ def open_atlas(path: str | Path, check: bool = False, **kwargs) -> xr.Dataset:
         ds.close()
         raise ValueError(f"{path}: not a rubber-atlas atlas (a file of `rubber-atlas run` or `merge` has the "
                          "attributes program and scene and the variable cell_status)")
+    _check_layout(ds, path)
     for warning in heard:
         warnings.warn_explicit(warning.message, warning.category, warning.filename, warning.lineno)
     if check:
@@ -1259,6 +1260,42 @@ def open_atlas(path: str | Path, check: bool = False, **kwargs) -> xr.Dataset:
             ds.close()
             raise
     return ds
+
+
+def _check_layout(ds: xr.Dataset, path: Path) -> None:
+    """Refuses an atlas whose variables do not lie along its grid: a dataset whose dimension
+    scales were removed (h5netcdf then matches its axes by size, and on a square plane κ and ε
+    came back swapped, every value silently at another cell: adversary pass 43), or one of
+    another shape (the accessor then failed in xarray's internals). `cell_status` lies along
+    the named axes of the grid (four, three for the disk), `n_components` along them too,
+    every other variable along them and ``component`` (docs/files.md)."""
+    import h5py
+
+    def damaged(why: str) -> ValueError:
+        ds.close()
+        return ValueError(f"{path}: the file is damaged: {why}; compute it again")
+
+    try:
+        with h5py.File(path, "r") as f:
+            lost = []
+            for name, item in f.items():
+                if not isinstance(item, h5py.Dataset) or item.ndim == 0:
+                    continue
+                scale = item.attrs.get("CLASS") in (b"DIMENSION_SCALE", "DIMENSION_SCALE")
+                if not scale and "DIMENSION_LIST" not in item.attrs:
+                    lost.append(name)
+    except (OSError, KeyError, RuntimeError, ValueError, TypeError) as e:
+        raise damaged(f"its structure cannot be read ({_one_line(e)})") from None
+    if lost:
+        raise damaged(f"{lost[0]!r} has lost its dimension scales (which of its axes is which is unknown)")
+    grid = ds["cell_status"].dims
+    # (Four axes, or three for the disk, which has no second shape parameter.)
+    if len(grid) not in (3, 4) or any(str(d).startswith("phony_dim") for d in grid):
+        raise damaged(f"'cell_status' lies along {grid}, not the axes of an atlas's cells")
+    for name, variable in ds.data_vars.items():
+        dims = grid if name in ("cell_status", "n_components") else grid + ("component",)
+        if variable.dims != dims:
+            raise damaged(f"{name!r} lies along {variable.dims}, where the file's grid gives it {dims}")
 
 
 def _dropped(error: BaseException) -> str:
@@ -1682,8 +1719,11 @@ def read_table(path: str | Path) -> xr.Dataset:
             ds = xr.open_dataset(path, engine="h5netcdf")
     except _DamagedTable as e:
         raise ValueError(str(e)) from None
-    except (OSError, ValueError) as e:
-        raise ValueError(f"{path}: not a table ({_one_line(e)}); {tables}") from None
+    except (OSError, ValueError, KeyError, RuntimeError, TypeError, AttributeError, IndexError) as e:
+        # (A column deleted with h5py left its dimension's reference behind: h5py's KeyError
+        # "Unable to open object by token", which named neither file nor column: adversary
+        # pass 43.)
+        raise ValueError(f"{path}: not a table, or a damaged one ({_one_line(e)}); {tables}") from None
     with ds:
         if _is_atlas(ds):
             raise ValueError(f"{path}: an atlas (a file of rubber-atlas run or merge), not a table; {tables}, "
@@ -1691,6 +1731,7 @@ def read_table(path: str | Path) -> xr.Dataset:
         if ds.attrs.get("program") != "rubber-atlas":
             raise ValueError(f"{path}: not a table of rubber-atlas (no root attribute program = "
                              f"'rubber-atlas'); {tables}")
+        _check_table(ds, path)
         with _reading(ds):
             return ds.load()
 
@@ -1760,6 +1801,46 @@ def _read_csv(path: Path) -> xr.Dataset:
 _TABLE_COLUMN_TYPES = {"sample": "int32", "segment": "int32", "curve": "int32", "point": "int32",
                        "component": "int32", "branch": "uint8", "stable": "uint8", "family": "uint8",
                        "closed": "uint8"}
+
+
+# The columns of each table rubber-atlas writes (docs/files.md), by the column that tells
+# them apart; the first is the table's dimension.
+_TABLE_COLUMNS = {
+    "t": ("t", "theta", "theta_dot", "phi", "psi", "x_c", "y_c", "z_c", "x_p", "y_p"),
+    "segment": ("sample", "segment", "branch", "theta0", "kappa", "energy", "stable", "rho_c", "rho_p",
+                "rotation_number"),
+    "curve": ("sample", "curve", "point", "kappa", "energy", "rotation_number", "error_estimate", "component",
+              "family", "theta_min", "theta_max", "well", "closed"),
+}
+
+
+def _check_table(ds: xr.Dataset, path: Path) -> None:
+    """Refuses an HDF5 table whose columns are not those the program writes: one missing or
+    added, not along the table's one dimension, or of another type (an index, a flag, a
+    value), as `_read_csv` refuses a CSV table so edited. (The HDF5 reader took every such
+    edit as given: adversary pass 43.)"""
+    def edited(why: str) -> ValueError:
+        return ValueError(f"{path}: {why}: the table was edited or damaged; write it again")
+
+    kind = next((k for k in _TABLE_COLUMNS if k in ds.variables), None)
+    if kind is None:
+        raise edited("its columns are not those of a trajectory, diagram or resonance table")
+    expected = _TABLE_COLUMNS[kind]
+    dim = expected[0]
+    present = set(map(str, ds.variables))
+    missing = [c for c in expected if c not in present]
+    extra = sorted(present - set(expected))
+    if missing or extra:
+        parts = ([f"no column {', '.join(missing)}"] if missing else []) + \
+            ([f"a column {', '.join(extra)} it never has"] if extra else [])
+        raise edited(f"the table has {' and '.join(parts)}")
+    for name in expected:
+        column = ds[name]
+        if column.dims != (dim,):
+            raise edited(f"its column {name!r} lies along {column.dims}, not ({dim!r},)")
+        written = _TABLE_COLUMN_TYPES.get(name, "float64")
+        if column.dtype != np.dtype(written):
+            raise edited(f"its column {name!r} is {column.dtype}, where rubber-atlas writes it as {written}")
 
 
 def _csv_types(path: Path, line) -> dict:

@@ -849,3 +849,73 @@ def test_a_count_given_as_a_duration_a_masked_value_or_a_tiny_long_double_is_ref
         with pytest.raises(TypeError, match=f"^{count} must be a whole number") as caught:
             ra.verdict(0.5, 3.0, 0.5, 0.5, **{count: value})
         assert "\n" not in str(caught.value), str(caught.value)
+
+
+def _rewritten(path, name, data, scales=None):
+    """Replaces the dataset `name` of the HDF5 file `path` by `data` with its attributes but its
+    dimension list, attaching the datasets `scales` as its dimension scales where given."""
+    with h5py.File(path, "a") as f:
+        attrs = {k: v for k, v in f[name].attrs.items() if k != "DIMENSION_LIST"}
+        del f[name]
+        new = f.create_dataset(name, data=data)
+        for k, v in attrs.items():
+            new.attrs[k] = v
+        for i, scale in enumerate(scales or []):
+            new.dims[i].attach_scale(f[scale])
+
+
+def test_open_atlas_refuses_a_variable_off_its_grid(tmp_path, slice_atlas):
+    """Adversary pass 43: a variable whose dimension scales were removed opened with κ and ε
+    matched by size (on a square plane swapped, every value at another cell, in silence); one
+    reshaped to 4-D opened, and the accessor failed with xarray's AttributeError."""
+    with h5py.File(slice_atlas, "r") as f:
+        values = f["rotation_number"][...]
+    lost = tmp_path / "lost.h5"
+    shutil.copy(slice_atlas, lost)
+    _rewritten(lost, "rotation_number", values)
+    refused(ValueError, lambda: ra.open_atlas(lost), str(lost),
+            "'rotation_number' has lost its dimension scales", "compute it again")
+    flat = tmp_path / "flat.h5"
+    shutil.copy(slice_atlas, flat)
+    _rewritten(flat, "rotation_number", values[..., 0], scales=["alpha", "beta", "kappa", "energy"])
+    refused(ValueError, lambda: ra.open_atlas(flat), str(flat), "'rotation_number' lies along")
+    with ra.open_atlas(slice_atlas) as atlas:
+        assert atlas.rotation_number.dims == ("alpha", "beta", "kappa", "energy", "component")
+
+
+def test_read_table_refuses_an_edited_hdf5_table(tmp_path):
+    """Adversary pass 43: the HDF5 reader took a flag rewritten as 0.5, an index as uint64, a
+    column deleted or of another length, where the CSV reader refuses such edits; a deleted
+    dimension column gave h5py's KeyError, naming neither file nor column."""
+    table = tmp_path / "d.h5"
+    run("diagram", "--alpha", "0.5", "--beta", "3", "--nu", "0.5", "--eta", "0.5", "--samples", "10", "--out", table)
+    assert ra.read_table(table).branch.dtype == np.uint8
+    with h5py.File(table, "r") as f:
+        branch = f["branch"][...]
+        kappa = f["kappa"][...]
+    cases = {
+        "fraction": ("branch", branch.astype(np.float64) + 0.5, ["sample"], "'branch' is float64"),
+        "wide": ("segment", np.zeros(len(branch), dtype=np.uint64), ["sample"], "'segment' is uint64"),
+        "long": ("kappa", np.zeros(len(kappa) + 5), None, "'kappa' lies along"),
+    }
+    for label, (name, data, scales, words) in cases.items():
+        edited = tmp_path / f"{label}.h5"
+        shutil.copy(table, edited)
+        _rewritten(edited, name, data, scales)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            refused(ValueError, lambda: ra.read_table(edited), str(edited), words)
+    missing = tmp_path / "missing.h5"
+    shutil.copy(table, missing)
+    with h5py.File(missing, "a") as f:
+        del f["kappa"]
+    refused(ValueError, lambda: ra.read_table(missing), str(missing), "no column kappa")
+    orbit = tmp_path / "t.h5"
+    run("trajectory", "--alpha", "0.5", "--beta", "3", "--nu", "0.5", "--eta", "0.5", "--kappa", "0.8",
+        "--energy", "2.5", "--periods", "1", "--samples", "10", "--out", orbit)
+    assert ra.read_table(orbit).sizes["t"] == 11
+    with h5py.File(orbit, "a") as f:
+        del f["t"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        refused(ValueError, lambda: ra.read_table(orbit), str(orbit))

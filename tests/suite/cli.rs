@@ -1859,6 +1859,32 @@ fn file_names_that_are_not_utf8_are_written_as_given() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let table = std::fs::read_to_string(&out).unwrap();
     assert!(table.contains("bad\u{fffd}.csv"), "{table}");
+    // An HDF5 file of such a name HDF5 cannot open: refused before anything is made (a run
+    // was refused by HDF5 after making its journal, which then blocked every later run:
+    // adversary pass 43).
+    let demo = concat!(env!("CARGO_MANIFEST_DIR"), "/atlas/demo.toml");
+    let atlas = dir.path().join(std::ffi::OsStr::from_bytes(b"a\xff.h5"));
+    for args in [
+        vec!["run", demo, "--quiet", "--out"],
+        vec!["diagram", "--alpha", "0.5", "--beta", "3", "--out"],
+    ] {
+        let o = Command::new(env!("CARGO_BIN_EXE_rubber-atlas"))
+            .args(&args)
+            .arg(&atlas)
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {text}");
+        assert!(
+            text.contains("is not UTF-8") && text.lines().count() == 1,
+            "{text}"
+        );
+    }
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left.len(), 1, "{left:?}");
 }
 
 /// Issue 22, adversary pass of 2026-11-27: the size check of `run` counted whole work units
