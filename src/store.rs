@@ -109,7 +109,8 @@ pub fn check_output(path: &Path, force: bool, inputs: &[&Path], extensions: &[&s
         let real = std::fs::canonicalize(parent).ok();
         if let Some(folder) = journal(parent).or_else(|| real.as_deref().and_then(journal)) {
             return refuse(format!(
-                "lies inside {}, a folder named as a run's resume journal, which that run                  removes when it ends: choose another folder",
+                "lies inside {}, a folder named as a run's resume journal, which that run \
+                 removes when it ends: choose another folder",
                 folder.display()
             ));
         }

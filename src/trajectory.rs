@@ -294,7 +294,8 @@ impl Start {
             Ok(integrals) => Ok(integrals.period),
             Err(AtlasError::NotPeriodic { .. }) => Err(AtlasError::Unresolved {
                 what: "the theta-period",
-                reason: "epsilon - V has no digit left in double precision inside the turning                          points (kappa and the energy too large); give --t-end",
+                reason: "epsilon - V has no digit left in double precision inside the turning \
+                         points (kappa and the energy too large); give --t-end",
             }),
             Err(e) => Err(e),
         }

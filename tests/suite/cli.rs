@@ -1826,6 +1826,14 @@ fn adversary_pass_of_2026_11_27_command_line() {
         let o = run(&["run", demo, "--print-out", "--out", out.to_str().unwrap()]);
         assert_eq!(o.status.code(), Some(2), "{out:?}");
         assert!(o.stdout.is_empty(), "{out:?}");
+        let text = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(text.trim().lines().count(), 1, "{text}");
+        if out.starts_with(&journal) {
+            assert!(
+                text.contains("a run's resume journal, which that run removes when it ends"),
+                "{text}"
+            );
+        }
     }
     let fine = dir.path().join("x.h5");
     let o = run(&["run", demo, "--print-out", "--out", fine.to_str().unwrap()]);
